@@ -1,0 +1,87 @@
+"""The exceptions visviva raises.
+
+Two families, following the rule "bad input is refused before anything runs; a run that fails
+says when, where and what to do":
+
+* :class:`ModelError` (a ``ValueError``) for invalid input: a problem, argument or scene that
+  cannot be simulated as given. Raised before the first step.
+* :class:`SimulationError` (a ``RuntimeError``) for a numerical failure during a run: the state
+  blew up (:class:`SimulationDiverged`) or an implicit solve did not converge
+  (:class:`NewtonConvergenceError`).
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "ModelError",
+    "NewtonConvergenceError",
+    "SimulationDiverged",
+    "SimulationError",
+    "VisvivaError",
+]
+
+
+class VisvivaError(Exception):
+    """Base class of every exception raised by visviva."""
+
+
+class ModelError(VisvivaError, ValueError):
+    """Invalid input: the message names the field, the value received and the fix."""
+
+
+class SimulationError(VisvivaError, RuntimeError):
+    """A run stopped because the numerics failed.
+
+    Attributes:
+        t: Simulation time of the failure [s].
+        step: Index of the step that failed (0 is the first step), or ``None`` when the failure
+            was raised outside a simulation loop (a direct ``Integrator.step`` call).
+    """
+
+    def __init__(self, message: str, *, t: float, step: int | None) -> None:
+        super().__init__(message)
+        self.t = t
+        self.step = step
+
+
+class SimulationDiverged(SimulationError):
+    """The state became non-finite or left the divergence limit.
+
+    Attributes:
+        component: Name of the first offending state component, e.g. ``"q[3]"`` or
+            ``"y[17, 2]"`` (system 17, coordinate 2 of a batch).
+        value: Its value when the watch fired (``nan``, ``inf`` or a huge number).
+        suggested_dt: The stability advisor's largest stable step for the method, from the
+            Jacobian at the last finite state, or ``None`` if it could not be estimated.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        t: float,
+        step: int | None,
+        component: str,
+        value: float,
+        suggested_dt: float | None,
+    ) -> None:
+        super().__init__(message, t=t, step=step)
+        self.component = component
+        self.value = value
+        self.suggested_dt = suggested_dt
+
+
+class NewtonConvergenceError(SimulationError):
+    """Newton's method did not converge within its iteration cap in an implicit step.
+
+    Attributes:
+        iterations: Iterations performed.
+        update_norm: Scaled norm of the last Newton update (converged means ≤ 1).
+    """
+
+    def __init__(
+        self, message: str, *, t: float, step: int | None, iterations: int, update_norm: float
+    ) -> None:
+        super().__init__(message, t=t, step=step)
+        self.iterations = iterations
+        self.update_norm = update_norm

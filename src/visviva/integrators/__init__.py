@@ -1,0 +1,142 @@
+"""Time integrators and their registry.
+
+Every method is an :class:`Integrator` registered by name::
+
+    >>> import visviva as vv
+    >>> "rk4" in vv.integrators.names()
+    True
+    >>> vv.integrators.get("velocity_verlet").order
+    2
+
+``get`` returns the registered instance; implicit methods take Newton options when built
+directly, e.g. ``vv.integrators.BackwardEuler(rtol=1e-12)``, and any instance can be passed as
+``method=`` wherever a name can. Register your own method with :func:`register`; it then runs
+through the same solver, analysis tools and conformance tests as the built-in ones.
+"""
+
+from __future__ import annotations
+
+from ..errors import ModelError
+from .base import CompiledStep, Integrator
+from .dopri5 import DormandPrince5
+from .implicit import BackwardEuler, ImplicitMidpoint, ImplicitOneStage, Trapezoidal
+from .newton import NewtonOptions
+from .runge_kutta import (
+    ButcherTableau,
+    ExplicitEuler,
+    ExplicitRungeKutta,
+    Heun,
+    Midpoint,
+    RungeKutta4,
+)
+from .symplectic import Leapfrog, SymplecticEuler, SymplecticEulerPositionFirst, VelocityVerlet
+from .taylor import Taylor
+
+__all__ = [
+    "BackwardEuler",
+    "ButcherTableau",
+    "CompiledStep",
+    "DormandPrince5",
+    "ExplicitEuler",
+    "ExplicitRungeKutta",
+    "Heun",
+    "ImplicitMidpoint",
+    "ImplicitOneStage",
+    "Integrator",
+    "Leapfrog",
+    "Midpoint",
+    "NewtonOptions",
+    "RungeKutta4",
+    "SymplecticEuler",
+    "SymplecticEulerPositionFirst",
+    "Taylor",
+    "Trapezoidal",
+    "VelocityVerlet",
+    "get",
+    "names",
+    "register",
+    "unregister",
+]
+
+_REGISTRY: dict[str, Integrator] = {}
+
+
+def register(method: Integrator | type[Integrator], *, replace: bool = False) -> Integrator:
+    """Add a method to the registry under its ``name`` and return the registered instance.
+
+    Args:
+        method: An :class:`Integrator` instance, or a subclass with a no-argument constructor.
+        replace: Allow replacing a method already registered under the same name.
+
+    Raises:
+        ModelError: If the method lacks a declaration, or the name is taken and ``replace``
+            is false.
+    """
+    instance = method() if isinstance(method, type) else method
+    if not isinstance(instance, Integrator):
+        raise ModelError(f"register() takes an Integrator (got {type(instance).__name__})")
+    for attribute in ("name", "order", "evaluations_per_step", "cost", "reference", "summary"):
+        if not hasattr(instance, attribute):
+            raise ModelError(
+                f"integrator {type(instance).__name__} must declare the class attribute "
+                f"`{attribute}`"
+            )
+    if instance.name in _REGISTRY and not replace:
+        raise ModelError(
+            f"an integrator named {instance.name!r} is already registered; "
+            "pass replace=True to replace it"
+        )
+    _REGISTRY[instance.name] = instance
+    return instance
+
+
+def unregister(name: str) -> None:
+    """Remove a registered method (e.g. one a test registered)."""
+    _REGISTRY.pop(name, None)
+
+
+def names() -> list[str]:
+    """Names of the registered methods, in registration order."""
+    return list(_REGISTRY)
+
+
+def get(method: str | Integrator) -> Integrator:
+    """The registered method called ``method`` (an instance is returned as it is).
+
+    Raises:
+        ModelError: For an unknown name; the message lists the valid names.
+    """
+    if isinstance(method, Integrator):
+        return method
+    if not isinstance(method, str):
+        raise ModelError(
+            f"`method` must be a method name or an Integrator (got {type(method).__name__})"
+        )
+    try:
+        return _REGISTRY[method]
+    except KeyError:
+        from .._validation import did_you_mean
+
+        raise ModelError(
+            f"unknown integration method {method!r}.{did_you_mean(method, _REGISTRY)} "
+            f"Valid names: {', '.join(_REGISTRY)}"
+        ) from None
+
+
+for _method in (
+    ExplicitEuler,
+    Taylor,
+    Midpoint,
+    Heun,
+    RungeKutta4,
+    DormandPrince5,
+    SymplecticEuler,
+    SymplecticEulerPositionFirst,
+    VelocityVerlet,
+    Leapfrog,
+    BackwardEuler,
+    Trapezoidal,
+    ImplicitMidpoint,
+):
+    register(_method)
+del _method

@@ -1,0 +1,144 @@
+"""Implicit one-stage methods: backward Euler, the trapezoidal rule and implicit midpoint.
+
+Each step solves one implicit stage with Newton's method (:mod:`.newton`), so the three differ
+only in where the stage sits and how the step is assembled from it:
+
+=================  ======  ===========================  =============================
+method             θ       stage                        step
+=================  ======  ===========================  =============================
+backward Euler     1       ``Y = y + h f(t+h, Y)``      ``y' = Y``
+trapezoidal        ½       ``Y = y + ½h f(t, y)``       ``y' = Y``
+                           ``+ ½h f(t+h, Y)``
+implicit midpoint  ½       ``Y = y + ½h f(t+½h, Y)``    ``y' = 2Y − y``
+=================  ======  ===========================  =============================
+
+All three are A-stable: stable for every ``h > 0`` on every decaying or oscillating mode.
+Backward Euler damps (``|R(iy)| < 1``: it loses energy, seed 000's "overly damped motion") and
+is even stable where the exact solution grows (``λ = +1, h > 2``); the trapezoidal rule and
+implicit midpoint keep ``|R(iy)| = 1`` exactly, and implicit midpoint is symplectic.
+
+References:
+    Seeds 000 and 004; E. Hairer, G. Wanner, *Solving Ordinary Differential Equations II*, 2nd
+    ed., Springer 1996, §IV.3; Hairer, Lubich & Wanner 2006, §II.1.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+
+from ..ode.state import FirstOrderState, SecondOrderState
+from .base import Integrator
+from .newton import NewtonOptions, solve_stage
+from .runge_kutta import ButcherTableau, initial_rate
+
+if TYPE_CHECKING:
+    from ..ode.state import State
+    from ..ode.system import System
+
+__all__ = ["BackwardEuler", "ImplicitMidpoint", "ImplicitOneStage", "Trapezoidal"]
+
+
+class ImplicitOneStage(Integrator):
+    """Common part of the implicit methods: Newton options and assembling the step.
+
+    Args:
+        rtol: Newton's relative tolerance on each update component.
+        atol: Newton's absolute tolerance on each update component.
+        max_iterations: Newton iterations allowed per step before it fails.
+    """
+
+    implicit = True
+    evaluations_per_step = 1
+    cost = "1 Newton solve: per iteration 1 f-evaluation, 1 Jacobian, 1 linear solve"
+    tableau: ClassVar[ButcherTableau]
+    #: Weight θ of the implicit evaluation and its time as a fraction of the step.
+    theta: ClassVar[float]
+    stage_time: ClassVar[float]
+
+    def __init__(self, *, rtol: float = 1e-10, atol: float = 1e-12, max_iterations: int = 20):
+        self.newton = NewtonOptions(rtol=rtol, atol=atol, max_iterations=max_iterations)
+
+    def stability_function(self, z: Any) -> np.ndarray:
+        return self.tableau.stability_function(z)
+
+    def stage_base(self, system: System, state: State, dt: float) -> tuple[np.ndarray, ...]:
+        """The explicit part of the stage: the state itself, unless a method adds to it."""
+        return state.parts
+
+    def step(self, system: System, state: State, dt: float) -> State:
+        theta_h = self.theta * dt
+        base = self.stage_base(system, state, dt)
+        stage, rate = solve_stage(system, state.t + self.stage_time * dt, base, theta_h, self.newton)
+        return self.assemble(state, dt, stage, rate)
+
+    def assemble(
+        self, state: State, dt: float, stage: tuple[np.ndarray, ...], rate: np.ndarray
+    ) -> State:
+        """The new state from the solved stage; the end-point rate is cached for the next step."""
+        t1 = state.t + dt
+        if isinstance(state, FirstOrderState):
+            return FirstOrderState(t1, stage[0], rate)
+        return SecondOrderState(t1, stage[0], stage[1], rate)
+
+
+class BackwardEuler(ImplicitOneStage):
+    """Backward (implicit) Euler: ``y' = y + h f(t + h, y')`` (seeds 000, 004).
+
+    First order, unconditionally stable on decaying and oscillating modes, and dissipative: an
+    undamped oscillator loses energy by the factor ``1/(1 + (ωh)²)`` per step.
+    """
+
+    name = "backward_euler"
+    order = 1
+    theta = 1.0
+    stage_time = 1.0
+    reference = "seeds 000 and 004; Hairer & Wanner 1996, §IV.3"
+    summary = "backward Euler: y' = y + h f(t + h, y'), solved by Newton"
+    tableau = ButcherTableau([[1.0]], [1.0], [1.0])
+
+
+class Trapezoidal(ImplicitOneStage):
+    """The trapezoidal rule (Crank–Nicolson): half a step of explicit, half of implicit Euler.
+
+    Second order; ``|R(iy)| = 1``, so an undamped linear oscillator keeps its energy exactly,
+    but stiff decaying modes are barely damped (``R(−∞) = −1``).
+    """
+
+    name = "trapezoidal"
+    order = 2
+    theta = 0.5
+    stage_time = 1.0
+    reference = "seed 000; J. Crank, P. Nicolson, Proc. Camb. Phil. Soc. 43 (1947) 50"
+    summary = "trapezoidal rule: y' = y + h/2 (f(t, y) + f(t + h, y'))"
+    tableau = ButcherTableau([[0.0, 0.0], [0.5, 0.5]], [0.5, 0.5], [0.0, 1.0])
+
+    def stage_base(self, system: System, state: State, dt: float) -> tuple[np.ndarray, ...]:
+        rate = initial_rate(system, state)
+        return tuple(part + (0.5 * dt) * r for part, r in zip(state.parts, rate, strict=True))
+
+
+class ImplicitMidpoint(ImplicitOneStage):
+    """Implicit midpoint: ``y' = y + h f(t + ½h, ½(y + y'))``, the one-stage Gauss method.
+
+    Second order, symplectic and time-reversible: it conserves every quadratic invariant
+    (angular momentum, the energy of linear systems) exactly up to the Newton tolerance.
+    """
+
+    name = "implicit_midpoint"
+    order = 2
+    symplectic = True
+    theta = 0.5
+    stage_time = 0.5
+    reference = "Hairer, Lubich & Wanner 2006, §II.1 and §VI.4"
+    summary = "implicit midpoint: slope at the mean of the old and new state"
+    tableau = ButcherTableau([[0.5]], [1.0], [0.5])
+
+    def assemble(
+        self, state: State, dt: float, stage: tuple[np.ndarray, ...], rate: np.ndarray
+    ) -> State:
+        # y' = 2Y − y; the rate is at the midpoint, not at y', so nothing is cached.
+        return state.from_parts(
+            state.t + dt, tuple(2.0 * s - p for s, p in zip(stage, state.parts, strict=True))
+        )

@@ -1,0 +1,202 @@
+"""Recordings: the frames a run keeps, and their HDF5 file format.
+
+A :class:`Recording` holds the times of the recorded frames and one array per state field
+(``y``, or ``q`` and ``v``, plus derived series such as ``energy``), each with its unit, and the
+attributes that make the run reproducible (method, step, substeps, library version, work).
+
+File layout (format ``visviva.recording``, version 1), one HDF5 group per run so that a
+comparison of several methods fits in one file::
+
+    /                       attrs: format, format_version, visviva_version, created_utc,
+                                   runs (JSON list of run names, in order)
+    /<run>/                 attrs: the recording's attributes (method, dt, substeps, t0, ...);
+                                   values that are not numbers or strings are stored as JSON
+                                   strings under the key prefixed with "json:"
+    /<run>/time             float64 (frames,), attr units = "s"
+    /<run>/fields/<name>    (frames, ...) float64 or complex128, attr units, chunked per frame
+
+Files are written to a temporary name next to the target and renamed when complete, so a
+crash never leaves a truncated file under the real name.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Mapping
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._version import __version__
+from ..errors import ModelError
+
+__all__ = ["FORMAT", "FORMAT_VERSION", "Recording", "read_recordings", "write_recordings"]
+
+FORMAT = "visviva.recording"
+FORMAT_VERSION = 1
+
+
+class Recording:
+    """Frames of one run: times, named state arrays with units, and attributes.
+
+    Args:
+        time: Frame times [s], shape ``(frames,)``.
+        fields: Arrays with a leading frame axis, e.g. ``{"q": (frames, n), "v": ...}``.
+        units: Unit of each field (``""`` for dimensionless or unknown).
+        attrs: Run attributes: strings, numbers, booleans, or JSON-serialisable values.
+
+    Example:
+        >>> import numpy as np
+        >>> rec = Recording(np.array([0.0, 0.5]), {"q": np.zeros((2, 3))}, units={"q": "m"})
+        >>> rec.frames, rec["q"].shape, rec.units["q"]
+        (2, (2, 3), 'm')
+    """
+
+    def __init__(
+        self,
+        time: np.ndarray,
+        fields: Mapping[str, np.ndarray],
+        *,
+        units: Mapping[str, str] | None = None,
+        attrs: Mapping[str, Any] | None = None,
+    ) -> None:
+        self.time = np.asarray(time, dtype=np.float64)
+        self.fields = {name: np.asarray(value) for name, value in fields.items()}
+        for name, value in self.fields.items():
+            if value.shape[:1] != self.time.shape:
+                raise ModelError(
+                    f"field {name!r} has {value.shape[:1]} frames but time has {self.time.shape}"
+                )
+        self.units = {name: "" for name in self.fields} | dict(units or {})
+        self.attrs: dict[str, Any] = dict(attrs or {})
+
+    @property
+    def frames(self) -> int:
+        """Number of recorded frames."""
+        return self.time.shape[0]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self.fields[name]
+        except KeyError:
+            raise KeyError(
+                f"recording has no field {name!r}; fields: {', '.join(self.fields)}"
+            ) from None
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.fields
+
+    def save(self, path: str | os.PathLike[str], *, run: str = "run") -> Path:
+        """Write this recording as the only run of an HDF5 file (see the module docstring)."""
+        return write_recordings(path, {run: self})
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str], run: str | None = None) -> Recording:
+        """Read one run from a recording file (the only one, or the one named ``run``)."""
+        runs = read_recordings(path)
+        if run is None:
+            if len(runs) != 1:
+                raise ModelError(
+                    f"{os.fspath(path)} holds {len(runs)} runs ({', '.join(runs)}); "
+                    "pass run=NAME to choose one"
+                )
+            return next(iter(runs.values()))
+        if run not in runs:
+            raise ModelError(f"{os.fspath(path)} has no run {run!r}; runs: {', '.join(runs)}")
+        return runs[run]
+
+    def __repr__(self) -> str:
+        shapes = ", ".join(f"{k}{tuple(v.shape)}" for k, v in self.fields.items())
+        return f"Recording({self.frames} frames: {shapes})"
+
+
+def write_recordings(path: str | os.PathLike[str], runs: Mapping[str, Recording]) -> Path:
+    """Write runs to one HDF5 file atomically (temporary file, then rename).
+
+    Args:
+        path: Target file (``.h5``); its directory must exist.
+        runs: Run name → recording; names must be valid HDF5 group names without ``/``.
+
+    Returns:
+        The path written.
+    """
+    import h5py
+
+    target = Path(path)
+    if not runs:
+        raise ModelError("write_recordings() needs at least one run")
+    for name in runs:
+        if not name or "/" in name or name.startswith("."):
+            raise ModelError(f"run name {name!r} must be non-empty, without '/' or leading '.'")
+    handle, temporary = tempfile.mkstemp(dir=target.parent or ".", prefix=f".{target.name}.")
+    os.close(handle)
+    try:
+        with h5py.File(temporary, "w") as file:
+            file.attrs["format"] = FORMAT
+            file.attrs["format_version"] = FORMAT_VERSION
+            file.attrs["visviva_version"] = __version__
+            file.attrs["created_utc"] = datetime.now(UTC).isoformat(timespec="seconds")
+            file.attrs["runs"] = json.dumps(list(runs))
+            for name, recording in runs.items():
+                _write_run(file.create_group(name), recording)
+        os.replace(temporary, target)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return target
+
+
+def _write_run(group: Any, recording: Recording) -> None:
+    for key, value in recording.attrs.items():
+        if isinstance(value, (str, bool, int, float, np.integer, np.floating)):
+            group.attrs[key] = value
+        elif value is None:
+            group.attrs[f"json:{key}"] = "null"
+        else:
+            group.attrs[f"json:{key}"] = json.dumps(value)
+    time = group.create_dataset("time", data=recording.time)
+    time.attrs["units"] = "s"
+    fields = group.create_group("fields")
+    for name, value in recording.fields.items():
+        chunks = (1, *value.shape[1:]) if value.ndim > 1 and value.size else None
+        dataset = fields.create_dataset(name, data=value, chunks=chunks)
+        dataset.attrs["units"] = recording.units.get(name, "")
+
+
+def read_recordings(path: str | os.PathLike[str]) -> dict[str, Recording]:
+    """Read every run of a recording file, in the order they were written."""
+    import h5py
+
+    source = Path(path)
+    if not source.is_file():
+        raise ModelError(f"recording file {os.fspath(path)!r} does not exist")
+    try:
+        file = h5py.File(source, "r")
+    except OSError as exc:
+        raise ModelError(f"{os.fspath(path)} is not an HDF5 file ({exc})") from None
+    with file:
+        if file.attrs.get("format") != FORMAT:
+            raise ModelError(f"{os.fspath(path)} is not a visviva recording")
+        version = int(file.attrs["format_version"])
+        if version > FORMAT_VERSION:
+            raise ModelError(
+                f"{os.fspath(path)} has recording format {version}; this visviva reads up to "
+                f"{FORMAT_VERSION} (upgrade visviva)"
+            )
+        runs = {}
+        for name in json.loads(file.attrs["runs"]):
+            group = file[name]
+            attrs: dict[str, Any] = {}
+            for key, value in group.attrs.items():
+                if key.startswith("json:"):
+                    attrs[key[5:]] = json.loads(value)
+                else:
+                    attrs[key] = value.item() if isinstance(value, np.generic) else value
+            fields = {k: d[()] for k, d in group["fields"].items()}
+            units = {k: str(d.attrs.get("units", "")) for k, d in group["fields"].items()}
+            runs[name] = Recording(group["time"][()], fields, units=units, attrs=attrs)
+    return runs

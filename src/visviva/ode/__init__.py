@@ -1,0 +1,24 @@
+"""Initial value problems, their states and their run-time systems.
+
+See :mod:`visviva.ode.problems` for the two problem kinds and :mod:`visviva.ode.functions` for
+the NumPy and Numba function conventions.
+"""
+
+from .mass import Mass
+from .problems import FirstOrderProblem, Problem, SecondOrderProblem
+from .state import FirstOrderState, SecondOrderState, State
+from .system import FirstOrderSystem, SecondOrderSystem, System, WorkCounters
+
+__all__ = [
+    "FirstOrderProblem",
+    "FirstOrderState",
+    "FirstOrderSystem",
+    "Mass",
+    "Problem",
+    "SecondOrderProblem",
+    "SecondOrderState",
+    "SecondOrderSystem",
+    "State",
+    "System",
+    "WorkCounters",
+]

@@ -1,0 +1,126 @@
+"""Compiled loops that apply a one-system Numba function to every system of a batch.
+
+A Numba function written for one system (``y`` of shape ``(n,)``) is wrapped here into a
+parallel loop over the leading batch axis, so the rest of visviva can treat it exactly like a
+NumPy function that takes the whole batch. The loops are closures over the user's function, so
+they compile once per function per process (Numba cannot cache a function that calls a
+dispatcher it receives at run time).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from .functions import UserFunction
+
+__all__ = ["batched"]
+
+
+def batched(function: UserFunction, result: str) -> Callable[..., Any]:
+    """Return ``call(t, *states) -> result`` over a batch for a one-system Numba function.
+
+    Args:
+        function: A compiled user function (``function.compiled`` is true).
+        result: What one call returns per system: ``"array"`` (same shape as the first state,
+            e.g. a derivative), ``"matrix"`` (an ``(n, n)`` Jacobian), ``"pair"`` (two
+            ``(n, n)`` Jacobians) or ``"scalar"`` (an energy).
+
+    Returns:
+        A Python callable taking ``t`` and one or two arrays of shape ``(batch, n)`` and
+        returning the stacked results: ``(batch, n)``, ``(batch, n, n)``, a pair of those, or
+        ``(batch,)``.
+    """
+    import numba
+
+    func = function.func
+    two = function.state_arguments == 2
+    writes_out = function.writes_out
+
+    if result == "array":
+        if writes_out:
+            if two:
+                @numba.njit(parallel=True)
+                def loop_out2(t, a, b, out):  # pragma: no cover - compiled
+                    for i in numba.prange(a.shape[0]):
+                        func(t, a[i], b[i], out[i])
+                kernel: Any = loop_out2
+            else:
+                @numba.njit(parallel=True)
+                def loop_out1(t, a, out):  # pragma: no cover - compiled
+                    for i in numba.prange(a.shape[0]):
+                        func(t, a[i], out[i])
+                kernel = loop_out1
+        elif two:
+            @numba.njit(parallel=True)
+            def loop_ret2(t, a, b, out):  # pragma: no cover - compiled
+                for i in numba.prange(a.shape[0]):
+                    out[i, :] = func(t, a[i], b[i])
+            kernel = loop_ret2
+        else:
+            @numba.njit(parallel=True)
+            def loop_ret1(t, a, out):  # pragma: no cover - compiled
+                for i in numba.prange(a.shape[0]):
+                    out[i, :] = func(t, a[i])
+            kernel = loop_ret1
+
+        def call_array(t: float, *states: np.ndarray) -> np.ndarray:
+            out = np.empty_like(states[0])
+            kernel(t, *states, out)
+            return out
+
+        return call_array
+
+    if result == "matrix":
+        @numba.njit(parallel=True)
+        def loop_matrix(t, a, out):  # pragma: no cover - compiled
+            for i in numba.prange(a.shape[0]):
+                out[i, :, :] = func(t, a[i])
+
+        def call_matrix(t: float, a: np.ndarray) -> np.ndarray:
+            out = np.empty(a.shape + a.shape[-1:], dtype=a.dtype)
+            loop_matrix(t, a, out)
+            return out
+
+        return call_matrix
+
+    if result == "pair":
+        @numba.njit(parallel=True)
+        def loop_pair(t, a, b, out_q, out_v):  # pragma: no cover - compiled
+            for i in numba.prange(a.shape[0]):
+                jq, jv = func(t, a[i], b[i])
+                out_q[i, :, :] = jq
+                out_v[i, :, :] = jv
+
+        def call_pair(t: float, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            out_q = np.empty(a.shape + a.shape[-1:], dtype=a.dtype)
+            out_v = np.empty_like(out_q)
+            loop_pair(t, a, b, out_q, out_v)
+            return out_q, out_v
+
+        return call_pair
+
+    if result == "scalar":
+        if two:
+            @numba.njit(parallel=True)
+            def loop_scalar2(t, a, b, out):  # pragma: no cover - compiled
+                for i in numba.prange(a.shape[0]):
+                    out[i] = func(t, a[i], b[i])
+            scalar_kernel: Any = loop_scalar2
+        else:
+            @numba.njit(parallel=True)
+            def loop_scalar1(t, a, out):  # pragma: no cover - compiled
+                for i in numba.prange(a.shape[0]):
+                    out[i] = func(t, a[i])
+            scalar_kernel = loop_scalar1
+
+        def call_scalar(t: float, *states: np.ndarray) -> np.ndarray:
+            out = np.empty(states[0].shape[0])
+            scalar_kernel(t, *states, out)
+            return out
+
+        return call_scalar
+
+    raise ValueError(f"unknown result kind {result!r}")

@@ -1,0 +1,236 @@
+"""The run-time face of a problem: what integrators call, with work counters.
+
+A *system* evaluates a problem's functions on states (whole batches at once), supplies
+Jacobians — the user's or finite differences of the same function — and counts the work. One
+system is made per run, so the counters belong to that run; the problem itself stays immutable
+and reusable.
+
+Later models (particles, springs, rigid bodies) implement the same two interfaces, which is all
+an integrator ever sees.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .batching import batched
+from .functions import UserFunction
+
+if TYPE_CHECKING:
+    from .mass import Mass
+    from .problems import FirstOrderProblem, SecondOrderProblem
+
+__all__ = ["FirstOrderSystem", "SecondOrderSystem", "System", "WorkCounters"]
+
+#: Relative perturbation of forward finite differences: √ε balances truncation and round-off.
+FINITE_DIFFERENCE_STEP = float(np.sqrt(np.finfo(np.float64).eps))
+
+
+@dataclass
+class WorkCounters:
+    """Work done by one run. A call on a whole batch counts once.
+
+    Attributes:
+        f_evaluations: Evaluations of ``f`` (first-order) or of the force/acceleration
+            (second-order), including those made for finite-difference Jacobians.
+        jacobian_evaluations: Jacobians formed (analytic or by finite differences).
+        linear_solves: Linear systems solved by implicit methods.
+        newton_iterations: Newton iterations of implicit methods.
+        accepted_steps: Steps taken (for adaptive methods, the accepted ones).
+        rejected_steps: Steps rejected by error control (adaptive methods only).
+    """
+
+    f_evaluations: int = 0
+    jacobian_evaluations: int = 0
+    linear_solves: int = 0
+    newton_iterations: int = 0
+    accepted_steps: int = 0
+    rejected_steps: int = 0
+
+    def as_dict(self) -> dict[str, int]:
+        """The counters as a plain dict (for JSON summaries)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+def evaluator(function: UserFunction, batch: bool, result: str = "array") -> Callable[..., Any]:
+    """Return ``call(t, *states)`` evaluating a user function on a whole (batched) state.
+
+    NumPy functions are called as they are (allocating ``out`` for those that write into it);
+    a one-system Numba function on a batch is wrapped in a compiled parallel loop.
+    """
+    func = function.func
+    if function.compiled and batch:
+        return batched(function, result)
+    if function.writes_out:
+        def call_out(t: float, *states: np.ndarray) -> np.ndarray:
+            out = np.empty_like(states[0])
+            func(t, *states, out)
+            return out
+        return call_out
+    return func
+
+
+class FirstOrderSystem:
+    """Evaluates ``y' = f(t, y)`` for integrators.
+
+    Attributes:
+        problem: The problem being integrated.
+        counters: Work done so far in this run.
+    """
+
+    kind = "first_order"
+
+    def __init__(self, problem: FirstOrderProblem, counters: WorkCounters | None = None) -> None:
+        self.problem = problem
+        self.counters = counters if counters is not None else WorkCounters()
+        batch = problem.y0.ndim == 2
+        self._f = evaluator(problem.f, batch)
+        self._jacobian = (
+            None if problem.jacobian is None else evaluator(problem.jacobian, batch, "matrix")
+        )
+        self._energy = None if problem.energy is None else evaluator(problem.energy, batch, "scalar")
+
+    @property
+    def has_energy(self) -> bool:
+        """True if the problem defines a monitored energy."""
+        return self._energy is not None
+
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        """``f(t, y)``, same shape as ``y``."""
+        self.counters.f_evaluations += 1
+        return np.asarray(self._f(t, y))
+
+    def derivative(self, t: float, parts: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
+        """Time derivative of the state arrays: ``(f(t, y),)``."""
+        return (self.rhs(t, parts[0]),)
+
+    def jacobian(self, t: float, y: np.ndarray, rate: np.ndarray | None = None) -> Any:
+        """``∂f/∂y`` at ``(t, y)``: ``(n, n)``, ``(batch, n, n)`` or a sparse ``(n, n)``.
+
+        Uses the problem's Jacobian when it has one, else forward finite differences of ``f``
+        (``n`` extra evaluations; ``rate`` = ``f(t, y)`` saves one).
+        """
+        self.counters.jacobian_evaluations += 1
+        if self._jacobian is not None:
+            return self._jacobian(t, y)
+        if rate is None:
+            rate = self.rhs(t, y)
+        return _finite_difference(lambda x: self.rhs(t, x), y, rate)
+
+    def energy(self, t: float, parts: tuple[np.ndarray, ...]) -> np.ndarray | None:
+        """The problem's monitored energy per system, or ``None`` if it defines none."""
+        if self._energy is None:
+            return None
+        return np.asarray(self._energy(t, parts[0]), dtype=np.float64)
+
+
+class SecondOrderSystem:
+    """Evaluates ``M q'' = F(t, q, v)`` for integrators.
+
+    For a problem given by its acceleration, ``mass`` is ``None`` and ``force`` *is* the
+    acceleration (unit mass), so implicit methods see one form.
+
+    Attributes:
+        problem: The problem being integrated.
+        counters: Work done so far in this run.
+        mass: The mass matrix, or ``None`` for an acceleration-form problem.
+        velocity_dependent: True if the force takes ``v``; methods that would lose an order of
+            accuracy with velocity-dependent forces use this to evaluate where they must.
+    """
+
+    kind = "second_order"
+
+    def __init__(self, problem: SecondOrderProblem, counters: WorkCounters | None = None) -> None:
+        self.problem = problem
+        self.counters = counters if counters is not None else WorkCounters()
+        self.mass: Mass | None = problem.mass
+        self.velocity_dependent = problem.force.state_arguments == 2
+        batch = problem.q0.ndim == 2
+        self._force = evaluator(problem.force, batch)
+        jacobian = problem.jacobian
+        if jacobian is None:
+            self._jacobian = None
+        else:
+            kind = "pair" if jacobian.state_arguments == 2 else "matrix"
+            self._jacobian = evaluator(jacobian, batch, kind)
+        self._energy = None if problem.energy is None else evaluator(problem.energy, batch, "scalar")
+
+    @property
+    def has_energy(self) -> bool:
+        """True if the problem defines a monitored energy."""
+        return self._energy is not None
+
+    def force(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``F(t, q, v)`` (the acceleration for a problem without mass), shape of ``q``."""
+        self.counters.f_evaluations += 1
+        if self.velocity_dependent:
+            return np.asarray(self._force(t, q, v))
+        return np.asarray(self._force(t, q))
+
+    def acceleration(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``q'' = M⁻¹ F(t, q, v)``, shape of ``q``."""
+        force = self.force(t, q, v)
+        return force if self.mass is None else self.mass.solve(force)
+
+    def derivative(self, t: float, parts: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
+        """Time derivative of ``(q, v)``: ``(v, q'')``."""
+        q, v = parts
+        return (v, self.acceleration(t, q, v))
+
+    def force_jacobian(
+        self, t: float, q: np.ndarray, v: np.ndarray, force: np.ndarray | None = None
+    ) -> tuple[Any, Any]:
+        """``(∂F/∂q, ∂F/∂v)`` at ``(t, q, v)``; the second is ``None`` for position-only forces.
+
+        Each is ``(n, n)``, ``(batch, n, n)`` or sparse ``(n, n)``. Uses the problem's Jacobian
+        when given, else forward finite differences of ``F`` (``force`` = ``F(t, q, v)`` saves
+        one evaluation).
+        """
+        self.counters.jacobian_evaluations += 1
+        if self._jacobian is not None:
+            # The problem checked that the Jacobian takes the same arguments as the force.
+            if self.velocity_dependent:
+                stiffness, damping = self._jacobian(t, q, v)
+                return stiffness, damping
+            return self._jacobian(t, q), None
+        if force is None:
+            force = self.force(t, q, v)
+        stiffness = _finite_difference(lambda x: self.force(t, x, v), q, force)
+        if not self.velocity_dependent:
+            return stiffness, None
+        damping = _finite_difference(lambda x: self.force(t, q, x), v, force)
+        return stiffness, damping
+
+    def energy(self, t: float, parts: tuple[np.ndarray, ...]) -> np.ndarray | None:
+        """The problem's monitored energy per system, or ``None`` if it defines none."""
+        if self._energy is None:
+            return None
+        q, v = parts
+        return np.asarray(self._energy(t, q, v), dtype=np.float64)
+
+
+System = FirstOrderSystem | SecondOrderSystem
+
+
+def _finite_difference(
+    func: Callable[[np.ndarray], np.ndarray], x: np.ndarray, fx: np.ndarray
+) -> np.ndarray:
+    """Forward-difference Jacobian ``∂func/∂x``: ``(n, n)`` or ``(batch, n, n)``.
+
+    Column ``j`` perturbs coordinate ``j`` of every system at once, so a batch costs ``n``
+    evaluations, not ``batch × n``.
+    """
+    n = x.shape[-1]
+    jacobian = np.empty(x.shape + (n,), dtype=np.result_type(x, fx))
+    for j in range(n):
+        step = FINITE_DIFFERENCE_STEP * np.maximum(1.0, np.abs(x[..., j]))
+        shifted = x.copy()
+        shifted[..., j] += step
+        # Divide by the step actually taken, which rounding makes differ from `step`.
+        taken = (shifted[..., j] - x[..., j]).real
+        jacobian[..., :, j] = (func(shifted) - fx) / taken[..., None]
+    return jacobian

@@ -1,0 +1,16 @@
+"""The simulation loop, the adaptive driver and ``solve``."""
+
+from .adaptive import DenseOutput
+from .loop import Schedule, simulate
+from .solve import Solution, solve
+from .watch import DEFAULT_DIVERGENCE_LIMIT, DivergenceWatch
+
+__all__ = [
+    "DEFAULT_DIVERGENCE_LIMIT",
+    "DenseOutput",
+    "DivergenceWatch",
+    "Schedule",
+    "Solution",
+    "simulate",
+    "solve",
+]

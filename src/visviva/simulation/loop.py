@@ -1,0 +1,384 @@
+"""The one fixed-step simulation loop every model runs through.
+
+``simulate`` advances a problem from ``t0`` to ``t_end`` in steps of ``dt``, each made of
+``substeps`` integrator steps of ``h = dt/substeps``. Time is never accumulated: integrator step
+``k`` ends at ``t0 + (k + 1)·h``, computed from the integer counter, so a million steps land on
+the same times as one would by hand (``t += dt`` drifts by ``~k·ε``). If ``t_end − t0`` is not a
+whole number of steps, the last step is shortened to end exactly at ``t_end``.
+
+Every ``record_every``-th step (and the last) becomes a frame of the :class:`Recording`. After
+every integrator step the divergence watch checks the state; a blow-up stops the run with
+:class:`~visviva.errors.SimulationDiverged`, whose ``recording`` attribute holds the frames
+recorded before it.
+
+When the problem's functions are Numba functions and the method has a compiled step, the whole
+loop runs compiled (:mod:`visviva.integrators.compiled`) with the same schedule, frames and
+watch; ``compiled=False`` forces the NumPy path.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .._validation import real_number, whole_number
+from .._version import __version__
+from ..errors import ModelError, SimulationError
+from ..integrators import Integrator, get
+from ..io.recording import Recording
+from ..ode.state import FirstOrderState, SecondOrderState
+from .progress import Progress
+from .watch import DivergenceWatch
+
+if TYPE_CHECKING:
+    from ..integrators.base import CompiledStep
+    from ..ode.problems import Problem
+    from ..ode.state import State
+    from ..ode.system import System
+
+__all__ = ["Schedule", "initial_state", "simulate"]
+
+#: System-steps per compiled chunk: large enough to hide the call overhead, small enough for the
+#: progress bar to move and the frame buffer to stay small.
+CHUNK_SYSTEM_STEPS = 200_000
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """When each step happens: ``full_steps`` steps of ``dt``, then possibly one shorter step.
+
+    Attributes:
+        t0: Start time [s].
+        t_end: End time [s].
+        dt: Step [s].
+        substeps: Integrator steps per step.
+        full_steps: Number of steps of exactly ``dt``.
+        last_dt: Length of the final shortened step [s], or 0 if ``t_end − t0`` is a whole
+            number of steps.
+    """
+
+    t0: float
+    t_end: float
+    dt: float
+    substeps: int
+    full_steps: int
+    last_dt: float
+
+    @classmethod
+    def build(cls, t0: float, t_end: float, dt: float, substeps: int) -> Schedule:
+        """Plan the steps from ``t0`` to ``t_end`` (a remainder below 1e-9 steps is rounding)."""
+        ratio = (t_end - t0) / dt
+        nearest = round(ratio)
+        if nearest >= 1 and abs(ratio - nearest) <= 1e-9 * max(1.0, ratio):
+            return cls(t0, t_end, dt, substeps, int(nearest), 0.0)
+        full = math.floor(ratio)
+        return cls(t0, t_end, dt, substeps, full, (t_end - t0) - full * dt)
+
+    @property
+    def steps(self) -> int:
+        """Number of steps, the shortened one included."""
+        return self.full_steps + (1 if self.last_dt > 0.0 else 0)
+
+    @property
+    def h(self) -> float:
+        """Integrator step of the full steps [s]."""
+        return self.dt / self.substeps
+
+    def substep(self, step: int, sub: int) -> tuple[float, float]:
+        """``(h, t_after)`` of substep ``sub`` of step ``step`` (time from integer counters)."""
+        if step < self.full_steps:
+            k = step * self.substeps + sub + 1
+            t_after = self.t_end if k == self.steps * self.substeps else self.t0 + k * self.h
+            return self.h, t_after
+        h_last = self.last_dt / self.substeps
+        if sub + 1 == self.substeps:
+            return h_last, self.t_end
+        start = self.t0 + self.full_steps * self.substeps * self.h
+        return h_last, start + (sub + 1) * h_last
+
+
+def initial_state(problem: Problem) -> State:
+    """The state a problem starts from."""
+    if problem.kind == "first_order":
+        return FirstOrderState(problem.t0, problem.y0.copy())  # type: ignore[union-attr]
+    return SecondOrderState(problem.t0, problem.q0.copy(), problem.v0.copy())  # type: ignore[union-attr]
+
+
+class FrameRecorder:
+    """Collects the frames of a run.
+
+    Args:
+        template: A state of the run (its kind and shapes); recorded as the first frame unless
+            ``include`` is false.
+        include: Record ``template`` as the first frame.
+    """
+
+    def __init__(self, template: State, include: bool = True) -> None:
+        self.template = template
+        self.names = ("y",) if isinstance(template, FirstOrderState) else ("q", "v")
+        self.times: list[float] = []
+        self.parts: list[list[np.ndarray]] = [[] for _ in self.names]
+        if include:
+            self.append(template)
+
+    def append(self, state: State) -> None:
+        """Record ``state`` as the next frame (copied)."""
+        self.times.append(state.t)
+        for store, part in zip(self.parts, state.parts, strict=True):
+            store.append(np.array(part))
+
+    def extend(self, times: np.ndarray, stacked: np.ndarray, n: int, batch: bool) -> None:
+        """Append frames from the compiled path: ``stacked`` is ``(frames, batch, m)``."""
+        for t, frame in zip(times, stacked, strict=True):
+            self.times.append(float(t))
+            pieces = (frame,) if len(self.names) == 1 else (frame[:, :n], frame[:, n:])
+            for store, piece in zip(self.parts, pieces, strict=True):
+                store.append(np.array(piece if batch else piece[0]))
+
+    def last(self) -> State:
+        """The most recent frame as a state."""
+        return self.template.from_parts(self.times[-1], tuple(store[-1] for store in self.parts))
+
+    def recording(self, attrs: dict[str, Any]) -> Recording:
+        """The frames so far as a :class:`Recording` with ``attrs``."""
+        fields = {
+            name: np.stack(store) if store else np.empty((0, *part.shape), part.dtype)
+            for name, store, part in zip(self.names, self.parts, self.template.parts, strict=True)
+        }
+        return Recording(np.array(self.times, dtype=np.float64), fields, attrs=attrs)
+
+
+def simulate(
+    problem: Problem,
+    method: str | Integrator = "rk4",
+    *,
+    dt: float,
+    t_end: float,
+    substeps: int = 1,
+    record_every: int = 1,
+    progress: bool | None = None,
+    divergence_limit: float | None = None,
+    compiled: bool | None = None,
+) -> Recording:
+    """Run ``problem`` with fixed steps and return the recorded frames.
+
+    Args:
+        problem: A :class:`~visviva.ode.FirstOrderProblem` or
+            :class:`~visviva.ode.SecondOrderProblem`.
+        method: Integrator name or instance (see ``vv.integrators.names()``).
+        dt: Step [s]; must be positive.
+        t_end: End time [s]; must not be before the problem's ``t0``.
+        substeps: Integrator steps per step (each of ``dt/substeps``).
+        record_every: Record every k-th step (the initial and the final state always).
+        progress: Show a progress bar on long runs (default: only if stderr is a terminal).
+        divergence_limit: Largest allowed ``|component|`` before the run counts as diverged
+            (default ``1e10 × max(1, max |initial state|)``).
+        compiled: ``None`` to run compiled when possible, ``False`` to force the NumPy path,
+            ``True`` to require the compiled path.
+
+    Returns:
+        The :class:`~visviva.io.Recording`, with fields ``y`` (first-order) or ``q`` and ``v``,
+        plus ``energy`` if the problem defines it; its ``attrs`` hold the method, step, work
+        counters and wall time.
+
+    Raises:
+        ModelError: For invalid arguments, before any step.
+        SimulationDiverged: If the state blows up; ``error.recording`` holds the frames so far.
+        NewtonConvergenceError: If an implicit step fails; ``error.recording`` likewise.
+    """
+    integrator = get(method)
+    dt = real_number("dt", dt, positive=True, unit=" s")
+    t_end = real_number("t_end", t_end, unit=" s")
+    if t_end < problem.t0:
+        raise ModelError(f"`t_end` ({t_end!r}) must not be before t0 ({problem.t0!r})")
+    substeps = whole_number("substeps", substeps, minimum=1)
+    record_every = whole_number("record_every", record_every, minimum=1)
+    if divergence_limit is not None:
+        divergence_limit = real_number("divergence_limit", divergence_limit, positive=True)
+    system = problem.system()
+    integrator.check(system)
+    compiled_step = _compiled_step(integrator, problem, compiled)
+
+    schedule = Schedule.build(problem.t0, t_end, dt, substeps)
+    state = initial_state(problem)
+    recorder = FrameRecorder(state)
+    watch = DivergenceWatch(system, integrator, dt, state, divergence_limit)
+    attrs: dict[str, Any] = {
+        "method": integrator.name,
+        "dt": dt,
+        "substeps": substeps,
+        "record_every": record_every,
+        "t0": problem.t0,
+        "t_end": t_end,
+        "problem": problem.name,
+        "kind": problem.kind,
+        "batch_size": problem.batch_size,
+        "compiled": compiled_step is not None,
+        "visviva_version": __version__,
+    }
+    started = time.perf_counter()
+    error: SimulationError | None = None
+    with Progress(schedule.steps, f"{integrator.name}", progress) as bar:
+        try:
+            if compiled_step is None:
+                _run_numpy(integrator, system, state, schedule, record_every, recorder, watch, bar)
+            else:
+                _run_compiled(compiled_step, problem, system, state, schedule, record_every,
+                              recorder, watch, bar)
+        except SimulationError as failure:
+            error = failure
+    attrs["wall_time_s"] = time.perf_counter() - started
+    attrs["steps"] = system.counters.accepted_steps
+    attrs |= system.counters.as_dict()
+    attrs["success"] = error is None
+    attrs["message"] = "completed" if error is None else str(error)
+    recording = recorder.recording(attrs)
+    add_energy(recording, system)
+    if error is not None:
+        error.recording = recording  # type: ignore[attr-defined]
+        raise error
+    return recording
+
+
+def _compiled_step(
+    integrator: Integrator, problem: Problem, compiled: bool | None
+) -> CompiledStep | None:
+    if compiled is False:
+        return None
+    step = integrator.compiled_step(problem)
+    if step is None and compiled:
+        raise ModelError(
+            f"compiled=True needs Numba functions and a method with a compiled step "
+            f"(explicit fixed-step methods); {integrator.name!r} with this problem has none"
+        )
+    return step
+
+
+def _run_numpy(
+    integrator: Integrator,
+    system: System,
+    state: State,
+    schedule: Schedule,
+    record_every: int,
+    recorder: FrameRecorder,
+    watch: DivergenceWatch,
+    bar: Progress,
+) -> None:
+    substeps = schedule.substeps
+    for step in range(schedule.steps):
+        for sub in range(substeps):
+            h, t_after = schedule.substep(step, sub)
+            previous = state
+            try:
+                state = integrator.step(system, state, h).at_time(t_after)
+            except SimulationError as failure:
+                failure.step = step * substeps + sub
+                raise
+            system.counters.accepted_steps += 1
+            if not watch.healthy(state):
+                raise watch.diverged(state, step * substeps + sub, previous)
+        if (step + 1) % record_every == 0 or step + 1 == schedule.steps:
+            recorder.append(state)
+        bar.advance(1)
+
+
+def _stack(state: State) -> np.ndarray:
+    """The state as ``(batch, m)`` rows: ``y``, or ``[q, v]`` side by side."""
+    parts = [p if p.ndim == 2 else p[None, :] for p in state.parts]
+    return np.ascontiguousarray(np.concatenate(parts, axis=1))
+
+
+def _run_compiled(
+    step: CompiledStep,
+    problem: Problem,
+    system: System,
+    state: State,
+    schedule: Schedule,
+    record_every: int,
+    recorder: FrameRecorder,
+    watch: DivergenceWatch,
+    bar: Progress,
+) -> None:
+    """The same schedule, frames and watch as :func:`_run_numpy`, in compiled chunks."""
+    from ..integrators.compiled import make_runner
+
+    run = make_runner(step)
+    batch = state.parts[0].ndim == 2
+    n = problem.size
+    y = _stack(state)
+    systems, m = y.shape
+    work = np.zeros((systems, step.work_size), dtype=y.dtype)
+    status = np.full(systems, -1, dtype=np.int64)
+    evaluations = np.zeros(systems, dtype=np.int64)
+    substeps = schedule.substeps
+
+    def advance(origin: float, h: float, first: int, count: int, every: int, frames: int,
+                offset: int, fresh: bool) -> None:
+        """Run substeps ``first … first + count − 1`` of size ``h`` timed from ``origin``.
+
+        A frame is recorded after every ``every``-th substep; ``offset`` is the index of the
+        first substep in the whole run (for messages).
+        """
+        buffer = np.empty((frames, systems, m), dtype=y.dtype)
+        run(y, work, fresh, origin, h, first, count, every, buffer, watch.limit, status,
+            evaluations)
+        system.counters.f_evaluations = int(evaluations.max())
+        failed = status >= 0
+        done = count if not failed.any() else int(status[failed].min()) - first
+        system.counters.accepted_steps += done
+        valid = min(frames, done // every)
+        times = origin + (first + every * np.arange(1, valid + 1)) * h
+        if valid and offset + valid * every == schedule.steps * substeps:
+            times[-1] = schedule.t_end
+        recorder.extend(times, buffer[:valid], n, batch)
+        if done < count:
+            bad = state.from_parts(origin + (first + done + 1) * h, _unstack(y, n, batch, state))
+            raise watch.diverged(bad, offset + done, recorder.last())
+
+    h = schedule.h
+    per_frame = record_every * substeps
+    chunk_frames = max(1, CHUNK_SYSTEM_STEPS // (systems * per_frame))
+    done = 0  # full steps done
+    while done < schedule.full_steps:
+        remaining = schedule.full_steps - done
+        if remaining >= record_every:
+            frames = min(chunk_frames, remaining // record_every)
+            steps, every = frames * record_every, per_frame
+        else:
+            # The tail after the last multiple of record_every: a frame only if the run ends.
+            steps = remaining
+            frames = 1 if schedule.last_dt == 0.0 else 0
+            every = steps * substeps if frames else steps * substeps + 1
+        first = done * substeps
+        advance(schedule.t0, h, first, steps * substeps, every, frames, first, done == 0)
+        done += steps
+        bar.advance(steps)
+    if schedule.last_dt > 0.0:
+        start = schedule.t0 + schedule.full_steps * substeps * h
+        advance(start, schedule.last_dt / substeps, 0, substeps, substeps, 1,
+                schedule.full_steps * substeps, schedule.full_steps == 0)
+        bar.advance(1)
+
+
+def _unstack(y: np.ndarray, n: int, batch: bool, template: State) -> tuple[np.ndarray, ...]:
+    rows = y if batch else y[0]
+    if isinstance(template, FirstOrderState):
+        return (rows.copy(),)
+    return (rows[..., :n].copy(), rows[..., n:].copy())
+
+
+def add_energy(recording: Recording, system: System) -> None:
+    """Add the problem's energy at every frame as the field ``energy`` (if it defines one)."""
+    if not system.has_energy:
+        return
+    names = ("y",) if system.kind == "first_order" else ("q", "v")
+    values = [
+        system.energy(float(t), tuple(recording[name][i] for name in names))
+        for i, t in enumerate(recording.time)
+    ]
+    recording.fields["energy"] = np.array(values, dtype=np.float64)
+    recording.units["energy"] = ""

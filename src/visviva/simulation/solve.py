@@ -1,0 +1,236 @@
+"""``vv.solve``: integrate a problem with any registered method and get a :class:`Solution`.
+
+Fixed-step methods run through the one simulation loop (:func:`~visviva.simulation.simulate`);
+adaptive ones (``dopri5``) through the adaptive driver unless ``adaptive=False``. A numerical
+failure does not raise here: the solution reports ``success=False`` with a message and keeps
+the frames computed before it (call :meth:`Solution.raise_for_status` to turn that into the
+exception). Invalid arguments always raise :class:`~visviva.errors.ModelError` before any step.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .._validation import real_number, whole_number
+from ..errors import ModelError, SimulationError
+from ..integrators import Integrator, get, names
+from ..ode.problems import FirstOrderProblem, SecondOrderProblem
+from .adaptive import DenseOutput, integrate_adaptive
+from .loop import simulate
+
+if TYPE_CHECKING:
+    from ..io.recording import Recording
+    from ..ode.problems import Problem
+
+__all__ = ["Solution", "solve"]
+
+
+@dataclass(frozen=True)
+class Solution:
+    """The result of :func:`solve`.
+
+    Attributes:
+        recording: The frames (times, state arrays, energy) and run attributes.
+        success: False if the run stopped early (divergence, Newton failure, step underflow).
+        message: ``"completed"`` or the reason it stopped.
+        error: The exception that stopped the run, if any.
+        sol: With ``dense_output=True`` (adaptive methods), the continuous solution
+            ``sol(t) -> (y,)`` or ``(q, v)``; else ``None``.
+    """
+
+    recording: Recording
+    success: bool
+    message: str
+    error: SimulationError | None = None
+    sol: DenseOutput | None = None
+
+    @property
+    def t(self) -> np.ndarray:
+        """Frame times [s], shape ``(frames,)``."""
+        return self.recording.time
+
+    @property
+    def y(self) -> np.ndarray:
+        """States of a first-order problem, ``(frames, n)`` or ``(frames, batch, n)``."""
+        return self._field("y")
+
+    @property
+    def q(self) -> np.ndarray:
+        """Coordinates of a second-order problem, ``(frames, n)`` or ``(frames, batch, n)``."""
+        return self._field("q")
+
+    @property
+    def v(self) -> np.ndarray:
+        """Velocities of a second-order problem, shape of :attr:`q`."""
+        return self._field("v")
+
+    @property
+    def energy(self) -> np.ndarray:
+        """The problem's energy at every frame, ``(frames,)`` or ``(frames, batch)``."""
+        return self._field("energy")
+
+    @property
+    def method(self) -> str:
+        """Name of the integrator used."""
+        return str(self.recording.attrs["method"])
+
+    @property
+    def counters(self) -> dict[str, int]:
+        """Work done: f-evaluations, Jacobians, linear solves, Newton iterations, steps."""
+        keys = ("f_evaluations", "jacobian_evaluations", "linear_solves", "newton_iterations",
+                "accepted_steps", "rejected_steps")
+        return {k: int(self.recording.attrs[k]) for k in keys}
+
+    def _field(self, name: str) -> np.ndarray:
+        if name not in self.recording:
+            raise AttributeError(
+                f"this solution has no {name!r}; it has: {', '.join(self.recording.fields)}"
+            )
+        return self.recording[name]
+
+    def raise_for_status(self) -> Solution:
+        """Raise the run's error if it failed; return the solution otherwise (for chaining)."""
+        if self.error is not None:
+            raise self.error
+        return self
+
+
+def solve(
+    problem: Problem,
+    method: str | Integrator = "rk4",
+    *,
+    t_end: float,
+    dt: float | None = None,
+    record_every: int = 1,
+    substeps: int = 1,
+    adaptive: bool | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    t_eval: Any = None,
+    dense_output: bool = False,
+    max_steps: int = 1_000_000,
+    progress: bool | None = None,
+    divergence_limit: float | None = None,
+    compiled: bool | None = None,
+) -> Solution:
+    """Integrate ``problem`` from its ``t0`` to ``t_end``.
+
+    Args:
+        problem: A :class:`~visviva.ode.FirstOrderProblem` or
+            :class:`~visviva.ode.SecondOrderProblem`.
+        method: Integrator name (``vv.integrators.names()``) or instance.
+        t_end: End time [s], not before ``problem.t0``.
+        dt: Step [s] for fixed-step methods (required); for adaptive ones, the first step
+            (chosen automatically if omitted).
+        record_every: Fixed-step methods: record every k-th step (first and last always).
+        substeps: Fixed-step methods: integrator steps per ``dt``.
+        adaptive: Use error control; default: if the method supports it.
+        rtol, atol: Adaptive methods: relative and absolute local error tolerances (defaults
+            1e-6 and 1e-9).
+        t_eval: Adaptive methods: times at which to record (interpolated); default: every step.
+        dense_output: Adaptive methods: keep the continuous solution in ``Solution.sol``.
+        max_steps: Adaptive methods: give up after this many accepted steps.
+        progress: Progress bar on long runs (default: only when stderr is a terminal).
+        divergence_limit: Largest allowed ``|component|``; see :func:`simulate`.
+        compiled: Fixed-step methods: ``None`` compiles the whole loop when the problem's
+            functions are Numba functions, ``False`` never, ``True`` requires it.
+
+    Returns:
+        A :class:`Solution`.
+
+    Raises:
+        ModelError: For invalid arguments, before any step.
+
+    Example:
+        >>> import visviva as vv
+        >>> spring = vv.ode.SecondOrderProblem(lambda t, q: -q, q0=[1.0], v0=[0.0])
+        >>> sol = vv.solve(spring, "symplectic_euler", dt=0.1, t_end=10.0, record_every=10)
+        >>> sol.success, sol.q.shape, sol.counters["f_evaluations"]
+        (True, (11, 1), 100)
+    """
+    if not isinstance(problem, (FirstOrderProblem, SecondOrderProblem)):
+        raise ModelError(
+            "`problem` must be a vv.ode.FirstOrderProblem or vv.ode.SecondOrderProblem "
+            f"(got {type(problem).__name__})"
+        )
+    integrator = get(method)
+    use_adaptive = integrator.adaptive if adaptive is None else bool(adaptive)
+    if use_adaptive and not integrator.adaptive:
+        raise ModelError(
+            f"method {integrator.name!r} has no error control; adaptive methods: "
+            + ", ".join(n for n in names() if get(n).adaptive)
+        )
+    t_end = real_number("t_end", t_end, unit=" s")
+    if t_end < problem.t0:
+        raise ModelError(f"`t_end` ({t_end!r}) must not be before t0 ({problem.t0!r})")
+    try:
+        if use_adaptive:
+            return _solve_adaptive(problem, integrator, t_end, dt, rtol, atol, t_eval,
+                                   dense_output, max_steps, progress, divergence_limit,
+                                   record_every, substeps, compiled)
+        for name, value in (("rtol", rtol), ("atol", atol), ("t_eval", t_eval)):
+            if value is not None:
+                raise ModelError(
+                    f"`{name}` applies to adaptive methods only; {integrator.name!r} takes "
+                    "fixed steps of `dt`"
+                )
+        if dense_output:
+            raise ModelError("`dense_output` applies to adaptive methods only")
+        if dt is None:
+            raise ModelError(f"`dt` is required for the fixed-step method {integrator.name!r}")
+        recording = simulate(problem, integrator, dt=dt, t_end=t_end, substeps=substeps,
+                             record_every=record_every, progress=progress,
+                             divergence_limit=divergence_limit, compiled=compiled)
+        return Solution(recording, True, "completed")
+    except SimulationError as failure:
+        return Solution(failure.recording, False, str(failure), failure)  # type: ignore[attr-defined]
+
+
+def _solve_adaptive(
+    problem: Problem,
+    integrator: Integrator,
+    t_end: float,
+    dt: float | None,
+    rtol: float | None,
+    atol: float | None,
+    t_eval: Any,
+    dense_output: bool,
+    max_steps: int,
+    progress: bool | None,
+    divergence_limit: float | None,
+    record_every: int,
+    substeps: int,
+    compiled: bool | None,
+) -> Solution:
+    if record_every != 1 or substeps != 1:
+        raise ModelError("`record_every` and `substeps` apply to fixed-step runs; use `t_eval`")
+    if compiled:
+        raise ModelError("compiled=True applies to fixed-step explicit methods only")
+    rtol = 1e-6 if rtol is None else real_number("rtol", rtol, positive=True)
+    atol = 1e-9 if atol is None else real_number("atol", atol, nonnegative=True)
+    first_step = None if dt is None else real_number("dt", dt, positive=True, unit=" s")
+    max_steps = whole_number("max_steps", max_steps, minimum=1)
+    if divergence_limit is not None:
+        divergence_limit = real_number("divergence_limit", divergence_limit, positive=True)
+    times = None
+    if t_eval is not None:
+        times = np.asarray(t_eval, dtype=np.float64).ravel()
+        if times.size == 0 or not np.isfinite(times).all():
+            raise ModelError("`t_eval` must be a non-empty array of finite times")
+        if np.any(np.diff(times) <= 0):
+            raise ModelError("`t_eval` must be strictly increasing")
+        if times[0] < problem.t0 or times[-1] > t_end:
+            raise ModelError(
+                f"`t_eval` must lie within [t0, t_end] = [{problem.t0!r}, {t_end!r}] "
+                f"(got [{times[0]!r}, {times[-1]!r}])"
+            )
+    recording, dense = integrate_adaptive(
+        problem, integrator,  # type: ignore[arg-type]
+        t_end=t_end, rtol=rtol, atol=atol, first_step=first_step, t_eval=times,
+        dense_output=dense_output, max_steps=max_steps, progress=progress,
+        divergence_limit=divergence_limit,
+    )
+    return Solution(recording, True, "completed", sol=dense)

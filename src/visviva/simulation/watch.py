@@ -1,0 +1,128 @@
+"""The divergence watch: stop a blown-up run with an explanation instead of a screen of NaNs.
+
+After every step the watch checks that every state component is finite and within the
+divergence limit. When one is not, it raises :class:`~visviva.errors.SimulationDiverged`
+naming the time, the step, the first offending component and its value, and asks the stability
+advisor for the largest stable step of the method at the last finite state, so the message says
+what to do next.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import SimulationDiverged
+
+if TYPE_CHECKING:
+    from ..integrators import Integrator
+    from ..ode.state import State
+    from ..ode.system import System
+
+__all__ = ["DEFAULT_DIVERGENCE_LIMIT", "DivergenceWatch"]
+
+#: A state component beyond this many times the initial state's scale (at least 1) counts as
+#: diverged: 1e10 for states of order one, scaled up for, say, orbits in metres.
+DEFAULT_DIVERGENCE_LIMIT = 1e10
+
+
+class DivergenceWatch:
+    """Checks states for blow-up and explains it.
+
+    Args:
+        system: The system being integrated (for the advisor's Jacobian).
+        method: The integrator in use.
+        dt: The step in use [s] (for the message).
+        initial: The initial state (its scale sets the default limit).
+        limit: Largest allowed ``|component|``; ``None`` for
+            ``DEFAULT_DIVERGENCE_LIMIT × max(1, max|initial state|)``.
+    """
+
+    def __init__(
+        self,
+        system: System,
+        method: Integrator,
+        dt: float,
+        initial: State,
+        limit: float | None = None,
+    ) -> None:
+        self.system = system
+        self.method = method
+        self.dt = dt
+        self.names = ("y",) if system.kind == "first_order" else ("q", "v")
+        if limit is None:
+            scale = max(float(np.max(np.abs(part))) for part in initial.parts)
+            limit = DEFAULT_DIVERGENCE_LIMIT * max(1.0, scale)
+        self.limit = float(limit)
+
+    def healthy(self, state: State) -> bool:
+        """True if every component is finite and within the limit."""
+        # max() propagates NaN, so one pass per array catches NaN, inf and huge values.
+        return all(bool(np.max(np.abs(part)) <= self.limit) for part in state.parts)
+
+    def diverged(self, state: State, step: int, last_good: State) -> SimulationDiverged:
+        """The exception describing why ``state`` (reached by step ``step``) is not healthy."""
+        component, value, system_index = self._first_offender(state)
+        suggestion = self._advice(last_good, system_index)
+        message = (
+            f"simulation diverged at t={state.t:.6g} s (step {step}): {component} = {value!r} "
+            f"{'is not finite' if not np.isfinite(value) else f'exceeds the limit {self.limit:.3g}'}. "
+            f"{self._explain(suggestion)}"
+        )
+        return SimulationDiverged(
+            message, t=state.t, step=step, component=component, value=value,
+            suggested_dt=suggestion,
+        )
+
+    def _first_offender(self, state: State) -> tuple[str, float, int | None]:
+        for name, part in zip(self.names, state.parts, strict=True):
+            with np.errstate(invalid="ignore"):
+                bad = ~(np.abs(part) <= self.limit)
+            if bad.any():
+                index = tuple(int(i) for i in np.argwhere(bad)[0])
+                value = complex(part[index]) if np.iscomplexobj(part) else float(part[index])
+                label = f"{name}[{', '.join(map(str, index))}]"
+                if part.ndim == 2:
+                    label += f" (system {index[0]})"
+                return label, value, (index[0] if part.ndim == 2 else None)  # type: ignore[return-value]
+        raise ValueError("state is healthy")
+
+    def _advice(self, last_good: State, system_index: int | None) -> float | None:
+        """The advisor's largest stable step at the last finite state, or None if unavailable."""
+        from ..analysis.stability import max_stable_dt, state_jacobian
+
+        try:
+            jacobian = state_jacobian(self.system, last_good)
+            if system_index is not None:
+                jacobian = jacobian[system_index]
+            return max_stable_dt(self.method, jacobian=jacobian)
+        except Exception:  # noqa: BLE001 - advice is best effort; the divergence is the news
+            return None
+
+    def _explain(self, suggestion: float | None) -> str:
+        name = self.method.name
+        if suggestion is None:
+            return (
+                f"The stability advisor could not estimate a stable step. Reduce dt (now "
+                f"{self.dt:.3g} s) or try an implicit method such as 'backward_euler'."
+            )
+        if suggestion == 0.0:
+            return (
+                f"The linearized system has undamped oscillating modes, on which {name!r} is "
+                "unstable for every step; use a symplectic method ('velocity_verlet', "
+                "'symplectic_euler') or an implicit one ('implicit_midpoint', 'backward_euler')."
+            )
+        if not np.isfinite(suggestion):
+            return (
+                f"{name!r} is stable for every step on this system's linearization at the last "
+                "finite state, so the growth comes from the model itself (a growing mode or "
+                "strong nonlinearity): check its parameters, or reduce dt."
+            )
+        verdict = "above" if self.dt > suggestion else "within"
+        return (
+            f"The stability advisor estimates the largest stable step of {name!r} at "
+            f"dt ≈ {suggestion:.4g} s (from the Jacobian's eigenvalues at the last finite state); "
+            f"dt = {self.dt:.4g} s is {verdict} it. Use dt below {0.9 * suggestion:.3g} s or an "
+            "implicit method such as 'backward_euler'."
+        )
