@@ -1,5 +1,14 @@
 """Analysis of integrators and runs: stability, convergence order, invariants."""
 
+from .convergence import ConvergenceStudy, convergence_order
+from .invariants import (
+    angular_momentum,
+    center_of_mass,
+    energy_drift,
+    linear_momentum,
+    max_energy_error,
+    relative_change,
+)
 from .stability import (
     max_stable_dt,
     spectrum,
@@ -10,7 +19,15 @@ from .stability import (
 )
 
 __all__ = [
+    "ConvergenceStudy",
+    "angular_momentum",
+    "center_of_mass",
+    "convergence_order",
+    "energy_drift",
+    "linear_momentum",
+    "max_energy_error",
     "max_stable_dt",
+    "relative_change",
     "spectrum",
     "stability_function",
     "stability_interval",

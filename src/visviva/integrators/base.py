@@ -33,14 +33,15 @@ class CompiledStep:
     Attributes:
         kernel: ``kernel(t, h, y, work, fresh) -> evaluations``: advances the stacked
             one-system state ``y`` (``y`` for first-order, ``[q, v]`` for second-order
-            problems) in place by ``h``; ``work`` is per-system scratch kept across steps;
-            ``fresh`` is true when ``work`` holds nothing from a previous step.
-        work_size: Length of the float64 scratch vector per system.
+            problems, length ``m``) in place by ``h``; ``work`` is the system's scratch of shape
+            ``(rows, m)``, kept across steps; ``fresh`` is true when ``work`` holds nothing
+            from a previous step.
+        rows: Rows of the scratch array.
     """
 
-    def __init__(self, kernel: Callable[..., int], work_size: int) -> None:
+    def __init__(self, kernel: Callable[..., int], rows: int) -> None:
         self.kernel = kernel
-        self.work_size = work_size
+        self.rows = rows
 
 
 class Integrator(ABC):

@@ -76,12 +76,29 @@ class ButcherTableau:
         return bool(np.all(np.triu(self.a) == 0.0))
 
     def stability_function(self, z: Any) -> np.ndarray:
-        """``R(z) = 1 + z bᵀ (I − zA)⁻¹ 𝟙`` for complex ``z`` of any shape."""
+        """``R(z) = 1 + z bᵀ (I − zA)⁻¹ 𝟙`` for complex ``z`` of any shape (``inf`` at a pole).
+
+        For an explicit tableau ``A`` is nilpotent and ``R`` is the polynomial
+        ``1 + Σ_k z^k bᵀ A^(k−1) 𝟙``, evaluated by Horner's rule (the linear solve would be
+        ill-conditioned at large ``|z|``).
+        """
         z = np.asarray(z, dtype=np.complex128)
         s = self.stages
-        matrices = np.eye(s) - z[..., None, None] * self.a
-        stage_growth = np.linalg.solve(matrices, np.ones(z.shape + (s, 1)))[..., 0]
-        return 1.0 + z * (stage_growth @ self.b)
+        if self.explicit:
+            coefficients = [1.0]
+            power = np.ones(s)
+            for _ in range(s):
+                coefficients.append(float(self.b @ power))
+                power = self.a @ power
+            result = np.full(z.shape, coefficients[-1], dtype=np.complex128)
+            for coefficient in reversed(coefficients[:-1]):
+                result = result * z + coefficient
+            return result
+        # Implicit: R(z) = det(I − z(A − 𝟙bᵀ)) / det(I − zA), finite except at the poles.
+        numerator = np.linalg.det(np.eye(s) - z[..., None, None] * (self.a - self.b[None, :]))
+        denominator = np.linalg.det(np.eye(s) - z[..., None, None] * self.a)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.asarray(numerator / denominator, dtype=np.complex128)
 
 
 def combine(

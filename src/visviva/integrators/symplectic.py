@@ -169,8 +169,8 @@ class Leapfrog(_Split):
         return self._compile(problem, _leapfrog_kernel)
 
 
-# Compiled one-system kernels. `y` is the stacked state [q, v]; `work` holds the acceleration
-# (and a predicted velocity) between calls. Each returns the number of evaluations it made.
+# Compiled one-system kernels. `y` is the stacked state [q, v]; row 0 of `work` holds the
+# acceleration between calls, row 1 a predicted velocity. Each returns its evaluation count.
 
 
 def _symplectic_euler_kernel(accel: Callable[..., None], n: int, vd: bool) -> CompiledStep:
@@ -178,14 +178,14 @@ def _symplectic_euler_kernel(accel: Callable[..., None], n: int, vd: bool) -> Co
 
     @numba.njit
     def step(t, h, y, work, fresh):  # pragma: no cover - compiled
-        q, v, a = y[:n], y[n:], work[:n]
+        q, v, a = y[:n], y[n:], work[0, :n]
         accel(t, q, v, a)
         for k in range(n):
             v[k] += h * a[k]
             q[k] += h * v[k]
         return 1
 
-    return CompiledStep(step, n)
+    return CompiledStep(step, 1)
 
 
 def _symplectic_euler_position_first_kernel(
@@ -195,7 +195,7 @@ def _symplectic_euler_position_first_kernel(
 
     @numba.njit
     def step(t, h, y, work, fresh):  # pragma: no cover - compiled
-        q, v, a = y[:n], y[n:], work[:n]
+        q, v, a = y[:n], y[n:], work[0, :n]
         for k in range(n):
             q[k] += h * v[k]
         accel(t + h, q, v, a)
@@ -203,7 +203,7 @@ def _symplectic_euler_position_first_kernel(
             v[k] += h * a[k]
         return 1
 
-    return CompiledStep(step, n)
+    return CompiledStep(step, 1)
 
 
 def _velocity_verlet_kernel(accel: Callable[..., None], n: int, vd: bool) -> CompiledStep:
@@ -211,7 +211,7 @@ def _velocity_verlet_kernel(accel: Callable[..., None], n: int, vd: bool) -> Com
 
     @numba.njit
     def step(t, h, y, work, fresh):  # pragma: no cover - compiled
-        q, v, a, predicted = y[:n], y[n:], work[:n], work[n:]
+        q, v, a, predicted = y[:n], y[n:], work[0, :n], work[1, :n]
         evaluations = 1
         if fresh or vd:
             accel(t, q, v, a)
@@ -228,7 +228,7 @@ def _velocity_verlet_kernel(accel: Callable[..., None], n: int, vd: bool) -> Com
             v[k] += 0.5 * h * a[k]
         return evaluations
 
-    return CompiledStep(step, 2 * n)
+    return CompiledStep(step, 2)
 
 
 def _leapfrog_kernel(accel: Callable[..., None], n: int, vd: bool) -> CompiledStep:
@@ -236,7 +236,7 @@ def _leapfrog_kernel(accel: Callable[..., None], n: int, vd: bool) -> CompiledSt
 
     @numba.njit
     def step(t, h, y, work, fresh):  # pragma: no cover - compiled
-        q, v, a, mid = y[:n], y[n:], work[:n], work[n:]
+        q, v, a, mid = y[:n], y[n:], work[0, :n], work[1, :n]
         evaluations = 1
         if vd:
             accel(t, q, v, a)
@@ -254,4 +254,4 @@ def _leapfrog_kernel(accel: Callable[..., None], n: int, vd: bool) -> CompiledSt
             q[k] += 0.5 * h * v[k]
         return evaluations
 
-    return CompiledStep(step, 2 * n)
+    return CompiledStep(step, 2)

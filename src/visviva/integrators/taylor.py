@@ -59,11 +59,11 @@ def _kernel(accel: Callable[..., None], n: int) -> CompiledStep:
 
     @numba.njit
     def step(t, h, y, work, fresh):  # pragma: no cover - compiled
-        q, v, a = y[:n], y[n:], work[:n]
+        q, v, a = y[:n], y[n:], work[0, :n]
         accel(t, q, v, a)
         for k in range(n):
             q[k] += h * v[k] + 0.5 * h * h * a[k]
             v[k] += h * a[k]
         return 1
 
-    return CompiledStep(step, n)
+    return CompiledStep(step, 1)

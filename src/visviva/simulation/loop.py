@@ -311,7 +311,7 @@ def _run_compiled(
     n = problem.size
     y = _stack(state)
     systems, m = y.shape
-    work = np.zeros((systems, step.work_size), dtype=y.dtype)
+    work = np.zeros((systems, step.rows, m), dtype=y.dtype)
     status = np.full(systems, -1, dtype=np.int64)
     evaluations = np.zeros(systems, dtype=np.int64)
     substeps = schedule.substeps

@@ -1,0 +1,166 @@
+"""Empirical order of accuracy: error against step size on a log–log scale.
+
+A method of order ``p`` has global error ``≈ C·dt^p`` at a fixed time once ``dt`` is small
+enough (seed 000: "halving Δt should reduce the error by a factor of 2" for a first-order
+method). :func:`convergence_order` runs a method at successively halved steps, measures the
+error at ``t_end`` against a reference solution, and fits the slope over the *asymptotic range*:
+points above the round-off floor whose local slopes agree, found by starting from the finest
+steps and adding coarser ones while they stay on the same line.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import ModelError
+from ..integrators import Integrator, get
+
+if TYPE_CHECKING:
+    from ..ode.problems import Problem
+
+__all__ = ["ConvergenceStudy", "convergence_order"]
+
+#: Errors below this fraction of the solution's size are round-off, not truncation.
+ROUND_OFF_FLOOR = 1e-11
+#: Largest change of the local slope still counted as the same asymptotic line.
+SLOPE_AGREEMENT = 0.25
+
+
+@dataclass(frozen=True)
+class ConvergenceStudy:
+    """Errors of one method at a sequence of step sizes, and the fitted order.
+
+    Attributes:
+        method: Method name.
+        declared_order: The order the method declares.
+        dt: Step sizes [s], decreasing.
+        error: Max-norm error at ``t_end`` for each step size.
+        used: Mask of the points in the asymptotic fit.
+        order: Fitted slope of ``log(error)`` against ``log(dt)`` (``nan`` if fewer than three
+            points are usable).
+        constant: Fitted ``C`` in ``error ≈ C·dt^order``.
+    """
+
+    method: str
+    declared_order: int
+    dt: np.ndarray
+    error: np.ndarray
+    used: np.ndarray
+    order: float
+    constant: float
+
+    def local_orders(self) -> np.ndarray:
+        """Slopes between consecutive step sizes, shape ``(len(dt) − 1,)``."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.log(self.error[:-1] / self.error[1:]) / np.log(self.dt[:-1] / self.dt[1:])
+
+
+def _reference_parts(reference: Any, problem: Problem, t_end: float) -> tuple[np.ndarray, ...]:
+    if callable(reference):
+        value = reference(t_end)
+    else:
+        value = reference
+    parts = tuple(np.asarray(v) for v in value) if isinstance(value, tuple) else (np.asarray(value),)
+    expected = 1 if problem.kind == "first_order" else 2
+    if len(parts) != expected:
+        raise ModelError(
+            f"`reference` must give {'y' if expected == 1 else '(q, v)'} at t_end for a "
+            f"{problem.kind.replace('_', '-')} problem"
+        )
+    return parts
+
+
+def convergence_order(
+    problem: Problem,
+    method: str | Integrator,
+    *,
+    t_end: float,
+    dt: Sequence[float] | None = None,
+    reference: Callable[[float], Any] | Any = None,
+    levels: int = 8,
+) -> ConvergenceStudy:
+    """Measure the order of accuracy of ``method`` on ``problem``.
+
+    Args:
+        problem: The problem to integrate.
+        method: Method name or instance (adaptive methods run with fixed steps here).
+        t_end: Time at which the error is measured [s].
+        dt: Step sizes to try; default ``(t_end − t0)/8`` halved ``levels − 1`` times.
+        reference: The exact solution at ``t_end``: a callable ``reference(t)`` or the value,
+            ``y`` or ``(q, v)``. Default: a Dormand–Prince solution at ``rtol = 1e-13``, which
+            limits the measurable error to about 1e-10.
+        levels: Number of step sizes when ``dt`` is not given.
+
+    Returns:
+        A :class:`ConvergenceStudy`.
+
+    Example:
+        >>> import numpy as np, visviva as vv
+        >>> decay = vv.ode.FirstOrderProblem(lambda t, y: -y, [1.0])
+        >>> study = vv.analysis.convergence_order(decay, "heun", t_end=1.0,
+        ...                                       reference=lambda t: np.exp(-t))
+        >>> round(study.order, 1)
+        2.0
+    """
+    from ..simulation.solve import solve
+
+    integrator = get(method)
+    span = t_end - problem.t0
+    if not span > 0:
+        raise ModelError(f"`t_end` must be after t0 (got t_end={t_end!r}, t0={problem.t0!r})")
+    steps = (
+        np.array([span / (8 * 2**k) for k in range(levels)], dtype=np.float64)
+        if dt is None
+        else np.sort(np.asarray(dt, dtype=np.float64))[::-1]
+    )
+    floor_scale = 1.0
+    if reference is None:
+        accurate = solve(problem, "dopri5", t_end=t_end, rtol=1e-13, atol=1e-13).raise_for_status()
+        names = ("y",) if problem.kind == "first_order" else ("q", "v")
+        exact = tuple(accurate.recording[name][-1] for name in names)
+        floor_scale = 100.0  # the reference itself is only good to ~1e-11
+    else:
+        exact = _reference_parts(reference, problem, t_end)
+    scale = max(1.0, max(float(np.max(np.abs(p))) for p in exact))
+    errors = np.empty(steps.size)
+    for i, h in enumerate(steps):
+        solution = solve(problem, integrator, t_end=t_end, dt=float(h), adaptive=False,
+                         record_every=10**9)
+        if not solution.success:
+            errors[i] = np.inf
+            continue
+        names = ("y",) if problem.kind == "first_order" else ("q", "v")
+        final = tuple(solution.recording[name][-1] for name in names)
+        errors[i] = max(float(np.max(np.abs(f - e))) for f, e in zip(final, exact, strict=True))
+    used = _asymptotic_range(steps, errors, ROUND_OFF_FLOOR * floor_scale * scale)
+    if used.sum() >= 3:
+        slope, intercept = np.polyfit(np.log(steps[used]), np.log(errors[used]), 1)
+        order, constant = float(slope), float(np.exp(intercept))
+    else:
+        order, constant = float("nan"), float("nan")
+    return ConvergenceStudy(integrator.name, integrator.order, steps, errors, used, order, constant)
+
+
+def _asymptotic_range(dt: np.ndarray, error: np.ndarray, floor: float) -> np.ndarray:
+    """Mask of the finest run of consecutive points above ``floor`` on one straight line."""
+    valid = np.isfinite(error) & (error > floor)
+    used = np.zeros(dt.size, dtype=bool)
+    indices = np.flatnonzero(valid)
+    if indices.size < 2:
+        return used
+    # Finest usable point, then walk towards coarser steps while the slope stays put.
+    finest = indices[-1]
+    start = finest
+    slopes: list[float] = []
+    while start - 1 >= 0 and valid[start - 1]:
+        slope = np.log(error[start - 1] / error[start]) / np.log(dt[start - 1] / dt[start])
+        if slopes and abs(slope - slopes[0]) > SLOPE_AGREEMENT:
+            break
+        slopes.append(float(slope))
+        start -= 1
+    used[start : finest + 1] = True
+    return used
