@@ -1,0 +1,145 @@
+"""Problems with exact solutions, for measuring accuracy (tests, ``visviva convergence``).
+
+Each is chosen to catch a particular mistake: the pendulum is nonlinear (its exact motion uses
+Jacobi elliptic functions); the forced oscillator's force depends on time, so a method that
+evaluates stages at the wrong time loses order; the damped oscillator's force depends on
+velocity, which costs careless kick–drift methods an order; the first-order system is nonlinear
+and time-dependent.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._validation import did_you_mean
+from ..errors import ModelError
+from ..ode.problems import FirstOrderProblem, Problem, SecondOrderProblem
+
+__all__ = ["ReferenceProblem", "reference_problem", "reference_problems"]
+
+
+@dataclass(frozen=True)
+class ReferenceProblem:
+    """A problem and its exact solution.
+
+    Attributes:
+        name: Short name (``visviva convergence --problem NAME``).
+        description: One line.
+        problem: The problem.
+        exact: ``exact(t)`` → ``(y,)`` or ``(q, v)`` at time ``t``.
+    """
+
+    name: str
+    description: str
+    problem: Problem
+    exact: Callable[[float], tuple[np.ndarray, ...]]
+
+
+def _pendulum(theta0: float = 1.0, omega: float = 1.0) -> ReferenceProblem:
+    """``θ'' = −ω² sin θ`` released at rest from ``θ0``.
+
+    With ``k = sin(θ0/2)`` and ``K`` the complete elliptic integral of the first kind,
+    ``θ(t) = 2 arcsin(k sn(K − ωt, k))`` and ``θ'(t) = −2kω cn(K − ωt, k)``.
+    """
+    from scipy.special import ellipj, ellipk
+
+    k = np.sin(theta0 / 2.0)
+    quarter = ellipk(k**2)
+
+    def exact(t: float) -> tuple[np.ndarray, ...]:
+        sn, cn, _, _ = ellipj(quarter - omega * t, k**2)
+        return np.array([2.0 * np.arcsin(k * sn)]), np.array([-2.0 * k * omega * cn])
+
+    problem = SecondOrderProblem(
+        lambda t, q: -(omega**2) * np.sin(q),
+        q0=[theta0],
+        v0=[0.0],
+        jacobian=lambda t, q: (-(omega**2) * np.cos(q))[..., None],
+        energy=lambda t, q, v: 0.5 * v[..., 0] ** 2 + omega**2 * (1.0 - np.cos(q[..., 0])),
+        name=f"pendulum, theta0 = {theta0} rad",
+    )
+    return ReferenceProblem("pendulum", "pendulum θ'' = -sin θ from θ0 = 1 rad (elliptic "
+                            "functions)", problem, exact)
+
+
+def _forced() -> ReferenceProblem:
+    """``q'' = −q + cos 2t`` from rest at ``q = 1``: ``q = (4/3) cos t − (1/3) cos 2t``."""
+
+    def exact(t: float) -> tuple[np.ndarray, ...]:
+        return (np.array([4 / 3 * np.cos(t) - np.cos(2 * t) / 3]),
+                np.array([-4 / 3 * np.sin(t) + 2 / 3 * np.sin(2 * t)]))
+
+    problem = SecondOrderProblem(lambda t, q: -q + np.cos(2.0 * t), q0=[1.0], v0=[0.0],
+                                 name="forced oscillator q'' = -q + cos 2t")
+    return ReferenceProblem("forced", "time-dependent force q'' = -q + cos 2t", problem, exact)
+
+
+def _damped(omega: float = 2.0, zeta: float = 0.1) -> ReferenceProblem:
+    """``q'' = −ω²q − 2ζω q'`` from ``q = 1`` at rest (underdamped closed form)."""
+    decay = zeta * omega
+    omega_d = omega * np.sqrt(1.0 - zeta**2)
+
+    def exact(t: float) -> tuple[np.ndarray, ...]:
+        envelope = np.exp(-decay * t)
+        c, s = np.cos(omega_d * t), np.sin(omega_d * t)
+        q = envelope * (c + decay / omega_d * s)
+        v = -envelope * (omega**2 / omega_d) * s
+        return np.array([q]), np.array([v])
+
+    problem = SecondOrderProblem(
+        lambda t, q, v: -(omega**2) * q - 2.0 * zeta * omega * v,
+        q0=[1.0],
+        v0=[0.0],
+        jacobian=lambda t, q, v: (np.full(q.shape + (1,), -(omega**2)),
+                                  np.full(q.shape + (1,), -2.0 * zeta * omega)),
+        name="damped oscillator",
+    )
+    return ReferenceProblem("damped", "velocity-dependent force q'' = -4q - 0.4q'", problem, exact)
+
+
+def _first_order() -> ReferenceProblem:
+    """``y0' = y0 cos t``, ``y1' = −y1²`` from ``(1, 1)``: ``(e^{sin t}, 1/(1 + t))``."""
+
+    def f(t: float, y: np.ndarray) -> np.ndarray:
+        return np.stack([y[..., 0] * np.cos(t), -y[..., 1] ** 2], axis=-1)
+
+    def jacobian(t: float, y: np.ndarray) -> np.ndarray:
+        matrix = np.zeros(y.shape + (2,))
+        matrix[..., 0, 0] = np.cos(t)
+        matrix[..., 1, 1] = -2.0 * y[..., 1]
+        return matrix
+
+    def exact(t: float) -> tuple[np.ndarray, ...]:
+        return (np.array([np.exp(np.sin(t)), 1.0 / (1.0 + t)]),)
+
+    problem = FirstOrderProblem(f, [1.0, 1.0], jacobian=jacobian,
+                                name="y0' = y0 cos t, y1' = -y1^2")
+    return ReferenceProblem("first-order", "nonlinear, time-dependent y' = (y0 cos t, -y1^2)",
+                            problem, exact)
+
+
+_BUILDERS: dict[str, Callable[[], ReferenceProblem]] = {
+    "pendulum": _pendulum,
+    "forced": _forced,
+    "damped": _damped,
+    "first-order": _first_order,
+}
+
+
+def reference_problems() -> list[str]:
+    """Names of the reference problems."""
+    return list(_BUILDERS)
+
+
+def reference_problem(name: str, **parameters: Any) -> ReferenceProblem:
+    """Build the reference problem ``name`` (see :func:`reference_problems`)."""
+    if name not in _BUILDERS:
+        raise ModelError(
+            f"unknown reference problem {name!r}.{did_you_mean(name, _BUILDERS)} "
+            f"Available: {', '.join(_BUILDERS)}"
+        )
+    return _BUILDERS[name](**parameters)

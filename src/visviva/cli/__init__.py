@@ -1,0 +1,1 @@
+"""The visviva command-line interface."""

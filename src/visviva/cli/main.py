@@ -1,0 +1,206 @@
+"""The ``visviva`` command.
+
+Thin by design: each command parses its options and calls the library. Heavy modules (NumPy,
+SciPy, Numba, matplotlib) are imported inside the commands, so ``visviva --help`` stays fast.
+User errors (:class:`~visviva.errors.ModelError`) print one line and exit with status 2;
+numerical failures exit with status 1.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+app = typer.Typer(
+    name="visviva",
+    help="Physically based animation: time integration, mechanics and simulation.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+OutputOption = Annotated[Path, typer.Option("--output", "-o", help="Output file or directory.")]
+JsonOption = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON.")]
+ForceOption = Annotated[bool, typer.Option("--force", help="Replace existing output files.")]
+
+
+def _print_json(data: Any) -> None:
+    from ..demos.output import _plain
+
+    typer.echo(json.dumps(_plain(data), indent=2, allow_nan=False))
+
+
+@app.command("integrators")
+def integrators_command(as_json: JsonOption = False) -> None:
+    """List the time integrators with their order and properties."""
+    from .. import integrators
+
+    methods = [integrators.get(name) for name in integrators.names()]
+    if as_json:
+        _print_json([m.describe() for m in methods])
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title="visviva integrators", title_justify="left")
+    table.add_column("name", no_wrap=True)
+    table.add_column("order", justify="right")
+    table.add_column("kind", no_wrap=True)
+    table.add_column("what it does")
+    for m in methods:
+        kind = ", ".join(k for k, on in (("implicit", m.implicit), ("symplectic", m.symplectic),
+                                         ("adaptive", m.adaptive)) if on) or "explicit"
+        table.add_row(m.name, str(m.order), kind, m.summary)
+    console = Console()
+    if not console.is_terminal:
+        console.width = 120
+    console.print(table)
+
+
+@app.command("stability")
+def stability_command(
+    methods: Annotated[list[str], typer.Argument(help="Method names, e.g. rk4 explicit_euler.")],
+    output: Annotated[Path | None, typer.Option("--output", "-o",
+                                                help="Write the region plot (PNG).")] = None,
+    as_json: JsonOption = False,
+    force: ForceOption = False,
+) -> None:
+    """Stability intervals on the real and imaginary axes, and region plots."""
+    from ..analysis.stability import stability_interval
+    from ..integrators import get
+
+    instances = [get(name) for name in methods]
+    if output is not None:
+        _check_new_file(output, force)
+    intervals = {
+        m.name: {
+            # `+ 0.0` turns a computed -0.0 into 0.0.
+            "real": tuple(x + 0.0 for x in stability_interval(m, "real")),
+            "imaginary": tuple(x + 0.0 for x in stability_interval(m, "imaginary")),
+        }
+        for m in instances
+    }
+    if output is not None:
+        from ..viz.plots import plot_stability_regions
+
+        _save_figure(plot_stability_regions(instances), output)
+    if as_json:
+        _print_json({name: {axis: list(v) for axis, v in axes.items()}
+                     for name, axes in intervals.items()})
+        return
+    for name, axes in intervals.items():
+        real, imaginary = axes["real"], axes["imaginary"]
+        typer.echo(f"{name:34s} real [{real[0]:.6g}, {real[1]:.6g}]   "
+                   f"imaginary [{imaginary[0]:.6g}, {imaginary[1]:.6g}]")
+    if output is not None:
+        typer.echo(f"wrote {output}")
+
+
+@app.command("convergence")
+def convergence_command(
+    methods: Annotated[list[str] | None, typer.Argument(help="Methods (default: all).")] = None,
+    problem: Annotated[str, typer.Option(
+        help="Reference problem: pendulum, forced, damped or first-order.")] = "pendulum",
+    t_end: Annotated[float, typer.Option(help="Time of the error measurement [s].")] = 2.0,
+    levels: Annotated[int, typer.Option(help="Number of halved step sizes.")] = 8,
+    output: Annotated[Path | None, typer.Option("--output", "-o",
+                                                help="Write the log-log plot (PNG).")] = None,
+    as_json: JsonOption = False,
+    force: ForceOption = False,
+) -> None:
+    """Measure each method's order of accuracy against an exact solution."""
+    from ..analysis.convergence import convergence_order
+    from ..analysis.reference_problems import reference_problem
+    from ..integrators import get, names
+
+    instances = [get(name) for name in (methods or names())]
+    if output is not None:
+        _check_new_file(output, force)
+    test = reference_problem(problem)
+    studies = [
+        convergence_order(test.problem, m, t_end=t_end, reference=test.exact,
+                          dt=[t_end / (10 * 2**k) for k in range(levels)])
+        for m in instances
+    ]
+    if output is not None:
+        from ..viz.plots import plot_convergence
+
+        _save_figure(plot_convergence(studies), output)
+    rows = [
+        {"method": s.method, "declared_order": s.declared_order, "measured_order": s.order,
+         "points_fitted": int(s.used.sum()), "dt": s.dt.tolist(), "error": s.error.tolist()}
+        for s in studies
+    ]
+    if as_json:
+        _print_json({"problem": problem, "t_end": t_end, "methods": rows})
+        return
+    typer.echo(f"problem: {test.description}, error at t = {t_end:g} s")
+    for row in rows:
+        typer.echo(f"{row['method']:34s} declared {row['declared_order']}  measured "
+                   f"{row['measured_order']:.3f}  ({row['points_fitted']} points)")
+    if output is not None:
+        typer.echo(f"wrote {output}")
+
+
+@app.command("demo")
+def demo_command(
+    name: Annotated[str | None, typer.Argument(help="Demo to run; omit to list them.")] = None,
+    output: Annotated[Path | None, typer.Option("--output", "-o",
+                                                help="Output directory.")] = None,
+    duration: Annotated[float | None, typer.Option(help="Simulated duration [s].")] = None,
+    force: ForceOption = False,
+) -> None:
+    """Run a demonstration and write its recording, summary and figures (no NAME: list them)."""
+    from ..demos import demos, run_demo
+
+    if name is None:
+        for demo in sorted(demos().values(), key=lambda d: d.name):
+            typer.echo(f"{demo.name:16s} {demo.summary}")
+        return
+    directory = output if output is not None else Path("out") / name
+    written = run_demo(name, directory, duration=duration, force=force)
+    for path in written:
+        typer.echo(f"wrote {path}")
+
+
+def _check_new_file(path: Path, force: bool) -> None:
+    from ..errors import ModelError
+
+    if path.exists() and not force:
+        raise ModelError(f"{path} already exists; pass --force to replace it")
+    if not path.parent.exists():
+        raise ModelError(f"directory {path.parent} does not exist")
+
+
+def _save_figure(figure: Any, path: Path) -> None:
+    """Save atomically: render to a temporary name, then rename."""
+    import os
+    import tempfile
+
+    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",
+                                         suffix=path.suffix or ".png")
+    os.close(handle)
+    try:
+        figure.savefig(temporary, dpi=110)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def main() -> None:
+    """Entry point: run the app; user errors exit 2 with one line, failures exit 1."""
+    from ..errors import ModelError, SimulationError
+
+    try:
+        app()
+    except ModelError as error:
+        typer.echo(f"error: {error}", err=True)
+        sys.exit(2)
+    except SimulationError as error:
+        typer.echo(f"simulation failed: {error}", err=True)
+        sys.exit(1)

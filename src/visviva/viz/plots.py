@@ -1,0 +1,176 @@
+"""Figures for teaching and checking: stability regions, energy, convergence, phase portraits.
+
+Every function returns a :class:`matplotlib.figure.Figure` built without pyplot (no global
+state, no display needed); save it with ``figure.savefig(path)``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from ..analysis.convergence import ConvergenceStudy
+    from ..io.recording import Recording
+
+__all__ = [
+    "plot_convergence",
+    "plot_energy",
+    "plot_phase",
+    "plot_stability_regions",
+]
+
+STABLE_COLOR = "#9ecae1"
+BOUNDARY_COLOR = "#08519c"
+
+
+def _figure(panels: int, *, width: float = 3.2, height: float = 3.0, columns: int = 4) -> Figure:
+    from matplotlib.figure import Figure
+
+    columns = min(columns, panels)
+    rows = math.ceil(panels / columns)
+    figure = Figure(figsize=(width * columns, height * rows), layout="constrained")
+    figure.subplots(rows, columns, squeeze=False)
+    for extra in figure.axes[panels:]:
+        extra.set_visible(False)
+    return figure
+
+
+def plot_stability_regions(
+    methods: Sequence[str | Any],
+    *,
+    bounds: tuple[float, float, float, float] = (-5.0, 3.0, -4.0, 4.0),
+    resolution: int = 401,
+    columns: int = 4,
+) -> Figure:
+    """One panel per method: the region ``|R(z)| ≤ 1`` of the ``z = hλ`` plane, shaded.
+
+    Args:
+        methods: Method names or instances.
+        bounds: ``(re_min, re_max, im_min, im_max)`` of each panel.
+        resolution: Grid points per axis.
+        columns: Panels per row.
+    """
+    from ..analysis.stability import stability_region
+    from ..integrators import get
+
+    integrators = [get(m) for m in methods]
+    figure = _figure(len(integrators), columns=columns)
+    for ax, method in zip(figure.axes, integrators, strict=False):
+        re, im, modulus = stability_region(method, bounds, resolution)
+        stable = np.where(np.isfinite(modulus), modulus, np.inf) <= 1.0 + 1e-12
+        ax.contourf(re, im, stable.astype(float), levels=[0.5, 1.5], colors=[STABLE_COLOR])
+        ax.contour(re, im, np.nan_to_num(modulus, nan=np.inf, posinf=1e300), levels=[1.0],
+                   colors=[BOUNDARY_COLOR], linewidths=1.2)
+        ax.axhline(0.0, color="0.3", linewidth=0.6)
+        ax.axvline(0.0, color="0.3", linewidth=0.6)
+        ax.set_xlim(bounds[0], bounds[1])
+        ax.set_ylim(bounds[2], bounds[3])
+        ax.set_aspect("equal")
+        ax.set_title(method.name, fontsize=10)
+        ax.set_xlabel("Re(hλ)")
+        ax.set_ylabel("Im(hλ)")
+    figure.suptitle("Stability regions |R(hλ)| ≤ 1 (shaded = stable)")
+    return figure
+
+
+def _styles(count: int) -> list[dict[str, Any]]:
+    """Distinct colour/line-style pairs for up to 40 curves on one axis."""
+    from matplotlib import colormaps
+
+    colors = colormaps["tab20"].colors
+    dashes = ("-", "--")
+    return [{"color": colors[(2 * i) % 20 + (i // 10) % 2], "linestyle": dashes[(i // 20) % 2]}
+            for i in range(count)]
+
+
+def plot_energy(
+    recordings: Mapping[str, Recording],
+    *,
+    title: str = "Energy relative to its initial value",
+) -> Figure:
+    """``E(t)/E(0)`` (top) and ``|E(t)/E(0) − 1|`` (bottom) of several runs, log scales.
+
+    The top panel shows growth and decay; the bottom one separates the methods that keep the
+    energy within round-off from those with a bounded oscillation or a slow drift. Runs without
+    an energy are skipped; for a batch, system 0 is shown.
+    """
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(9.0, 8.0), layout="constrained")
+    ratio_ax, error_ax = figure.subplots(2, 1, sharex=True)
+    runs = [(n, r) for n, r in recordings.items() if "energy" in r and r.frames > 0]
+    for (name, recording), style in zip(runs, _styles(len(runs)), strict=True):
+        energy = recording["energy"]
+        energy = energy if energy.ndim == 1 else energy[:, 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = energy / energy[0]
+        ratio_ax.plot(recording.time, ratio, label=name, linewidth=1.3, **style)
+        # Exact zeros would vanish from a log axis; floor them at the double-precision epsilon.
+        error_ax.plot(recording.time, np.maximum(np.abs(ratio - 1.0), np.finfo(float).eps),
+                      linewidth=1.1, **style)
+    ratio_ax.set_yscale("log")
+    ratio_ax.set_ylabel("E(t) / E(0)")
+    ratio_ax.legend(fontsize=8, ncol=3)
+    ratio_ax.set_title(title)
+    error_ax.set_yscale("log")
+    error_ax.set_ylabel("|E(t) / E(0) − 1|")
+    error_ax.set_xlabel("time [s]")
+    for ax in (ratio_ax, error_ax):
+        ax.grid(True, which="both", alpha=0.3)
+    return figure
+
+
+def plot_phase(
+    recordings: Mapping[str, Recording],
+    *,
+    exact: tuple[np.ndarray, np.ndarray] | None = None,
+    columns: int = 4,
+    labels: tuple[str, str] = ("q", "v"),
+) -> Figure:
+    """Phase portraits ``(q, v)`` of the first coordinate, one panel per run.
+
+    Args:
+        recordings: Run name → recording of a second-order problem.
+        exact: Optional exact curve ``(q, v)`` drawn under every panel.
+        columns: Panels per row.
+        labels: Axis labels.
+    """
+    figure = _figure(len(recordings), columns=columns)
+    for ax, (name, recording) in zip(figure.axes, recordings.items(), strict=False):
+        q, v = recording["q"], recording["v"]
+        q = q[..., 0] if q.ndim == 2 else q[:, 0, 0]
+        v = v[..., 0] if v.ndim == 2 else v[:, 0, 0]
+        if exact is not None:
+            ax.plot(exact[0], exact[1], color="0.6", linewidth=2.5, label="exact")
+        ax.plot(q, v, color=BOUNDARY_COLOR, linewidth=0.9)
+        ax.plot(q[:1], v[:1], "o", color="#e6550d", markersize=4)
+        ax.set_title(name, fontsize=10)
+        ax.set_xlabel(labels[0])
+        ax.set_ylabel(labels[1])
+        ax.set_aspect("equal", adjustable="datalim")
+    return figure
+
+
+def plot_convergence(studies: Sequence[ConvergenceStudy]) -> Figure:
+    """Error against step size, log–log, with the fitted order of each method."""
+    figure = _figure(1, width=7.5, height=5.5)
+    ax = figure.axes[0]
+    for study, style in zip(studies, _styles(len(studies)), strict=True):
+        finite = np.isfinite(study.error) & (study.error > 0)
+        ax.loglog(study.dt[finite], study.error[finite], marker="o", markersize=3,
+                  label=f"{study.method}: {study.order:.2f} (declared {study.declared_order})",
+                  **style)
+        ax.loglog(study.dt[study.used], study.error[study.used], "o", markersize=6,
+                  color=style["color"], markerfacecolor="none")
+    ax.set_xlabel("dt [s]")
+    ax.set_ylabel("error at t_end (max norm)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("Convergence: circled points are in the fitted asymptotic range")
+    return figure
