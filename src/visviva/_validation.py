@@ -16,11 +16,19 @@ import numpy as np
 
 from .errors import ModelError
 
-__all__ = ["did_you_mean", "real_number", "state_array", "whole_number"]
+__all__ = ["describe", "did_you_mean", "real_number", "state_array", "whole_number"]
 
 
-def _describe(value: Any) -> str:
-    text = repr(value)
+def describe(value: Any) -> str:
+    """``value`` as the user would write it, shortened: NumPy scalars print as plain numbers."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    elif isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, list) and len(value) > 6:
+        text = repr(value[:6])[:-1] + ", ...]"
+    else:
+        text = repr(value)
     return text if len(text) <= 80 else text[:77] + "..."
 
 
@@ -43,8 +51,12 @@ def real_number(
     """
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ModelError(f"`{name}` must be a real number{unit and ' in' + unit} "
-                         f"(got {_describe(value)})")
-    number = float(value)
+                         f"(got {describe(value)})")
+    try:
+        number = float(value)
+    except OverflowError:
+        raise ModelError(f"`{name}` must be finite (got {describe(value)}, beyond the range "
+                         "of a float)") from None
     if not math.isfinite(number):
         raise ModelError(f"`{name}` must be finite (got {number!r})")
     if positive and not number > 0.0:
@@ -57,7 +69,7 @@ def real_number(
 def whole_number(name: str, value: Any, *, minimum: int = 0) -> int:
     """Return ``value`` as an int ≥ ``minimum``, or raise naming ``name``."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise ModelError(f"`{name}` must be a whole number (got {_describe(value)})")
+        raise ModelError(f"`{name}` must be a whole number (got {describe(value)})")
     if value < minimum:
         raise ModelError(f"`{name}` must be at least {minimum} (got {int(value)})")
     return int(value)
@@ -71,12 +83,12 @@ def state_array(name: str, value: Any) -> np.ndarray:
     """
     try:
         array = np.array(value, copy=True)
-    except (TypeError, ValueError) as exc:
-        raise ModelError(f"`{name}` must be an array of numbers (got {_describe(value)})") from exc
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ModelError(f"`{name}` must be an array of numbers (got {describe(value)})") from exc
     if array.dtype == object or not (
         np.issubdtype(array.dtype, np.number) or array.dtype == np.bool_
     ):
-        raise ModelError(f"`{name}` must be an array of numbers (got dtype {array.dtype})")
+        raise ModelError(f"`{name}` must be an array of numbers (got {describe(value)})")
     dtype = np.complex128 if np.iscomplexobj(array) else np.float64
     array = np.atleast_1d(array.astype(dtype))
     if array.ndim > 2:
@@ -90,9 +102,7 @@ def state_array(name: str, value: Any) -> np.ndarray:
     if bad.any():
         index = tuple(int(i) for i in np.argwhere(bad)[0])
         where = index[0] if len(index) == 1 else index
-        raise ModelError(
-            f"`{name}` must be finite; entry {where} is {array[index]!r}"
-        )
+        raise ModelError(f"`{name}` must be finite; entry {where} is {describe(array[index])}")
     array.setflags(write=False)
     return array
 

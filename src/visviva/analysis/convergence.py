@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._validation import describe, real_number, whole_number
 from ..errors import ModelError
 from ..integrators import Integrator, get
 
@@ -25,9 +26,9 @@ if TYPE_CHECKING:
 __all__ = ["ConvergenceStudy", "convergence_order"]
 
 #: Errors below this fraction of the solution's size are round-off, not truncation.
-ROUND_OFF_FLOOR = 1e-11
+ROUND_OFF_FLOOR = 1e-12
 #: Largest change of the local slope still counted as the same asymptotic line.
-SLOPE_AGREEMENT = 0.25
+SLOPE_AGREEMENT = 0.15
 
 
 @dataclass(frozen=True)
@@ -93,7 +94,7 @@ def convergence_order(
         reference: The exact solution at ``t_end``: a callable ``reference(t)`` or the value,
             ``y`` or ``(q, v)``. Default: a Dormand–Prince solution at ``rtol = 1e-13``, which
             limits the measurable error to about 1e-10.
-        levels: Number of step sizes when ``dt`` is not given.
+        levels: Number of step sizes when ``dt`` is not given (at least 3).
 
     Returns:
         A :class:`ConvergenceStudy`.
@@ -109,20 +110,25 @@ def convergence_order(
     from ..simulation.solve import solve
 
     integrator = get(method)
+    t_end = real_number("t_end", t_end, unit=" s")
     span = t_end - problem.t0
     if not span > 0:
         raise ModelError(f"`t_end` must be after t0 (got t_end={t_end!r}, t0={problem.t0!r})")
-    steps = (
-        np.array([span / (8 * 2**k) for k in range(levels)], dtype=np.float64)
-        if dt is None
-        else np.sort(np.asarray(dt, dtype=np.float64))[::-1]
-    )
+    if dt is None:
+        levels = whole_number("levels", levels, minimum=3)
+        steps = np.array([span / (8 * 2**k) for k in range(levels)], dtype=np.float64)
+    else:
+        steps = np.sort(np.asarray(dt, dtype=np.float64).ravel())[::-1]
+        if steps.size < 3 or not np.all(np.isfinite(steps)) or steps[-1] <= 0:
+            raise ModelError(
+                f"`dt` must hold at least three positive finite step sizes (got {describe(dt)})"
+            )
     floor_scale = 1.0
     if reference is None:
         accurate = solve(problem, "dopri5", t_end=t_end, rtol=1e-13, atol=1e-13).raise_for_status()
         names = ("y",) if problem.kind == "first_order" else ("q", "v")
         exact = tuple(accurate.recording[name][-1] for name in names)
-        floor_scale = 100.0  # the reference itself is only good to ~1e-11
+        floor_scale = 1000.0  # the reference itself is only good to ~1e-11
     else:
         exact = _reference_parts(reference, problem, t_end)
     scale = max(1.0, max(float(np.max(np.abs(p))) for p in exact))

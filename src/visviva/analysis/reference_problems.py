@@ -4,7 +4,7 @@ Each is chosen to catch a particular mistake: the pendulum is nonlinear (its exa
 Jacobi elliptic functions); the forced oscillator's force depends on time, so a method that
 evaluates stages at the wrong time loses order; the damped oscillator's force depends on
 velocity, which costs careless kick–drift methods an order; the first-order system is nonlinear
-and time-dependent.
+and time-dependent, for the methods' first-order code paths.
 """
 
 from __future__ import annotations
@@ -102,24 +102,33 @@ def _damped(omega: float = 2.0, zeta: float = 0.1) -> ReferenceProblem:
 
 
 def _first_order() -> ReferenceProblem:
-    """``y0' = y0 cos t``, ``y1' = −y1²`` from ``(1, 1)``: ``(e^{sin t}, 1/(1 + t))``."""
+    """The pendulum as a first-order system plus a driven decay, ``y = (θ, θ', z)``.
+
+    ``θ'' = −sin θ`` from 1 rad at rest (as :func:`_pendulum`) and ``z' = −z + cos t`` from
+    ``z = 1``, whose solution is ``z = (cos t + sin t)/2 + e^{−t}/2``: nonlinear and
+    time-dependent at once.
+    """
+    pendulum = _pendulum()
 
     def f(t: float, y: np.ndarray) -> np.ndarray:
-        return np.stack([y[..., 0] * np.cos(t), -y[..., 1] ** 2], axis=-1)
+        return np.stack([y[..., 1], -np.sin(y[..., 0]), np.cos(t) - y[..., 2]], axis=-1)
 
     def jacobian(t: float, y: np.ndarray) -> np.ndarray:
-        matrix = np.zeros(y.shape + (2,))
-        matrix[..., 0, 0] = np.cos(t)
-        matrix[..., 1, 1] = -2.0 * y[..., 1]
+        matrix = np.zeros(y.shape + (3,))
+        matrix[..., 0, 1] = 1.0
+        matrix[..., 1, 0] = -np.cos(y[..., 0])
+        matrix[..., 2, 2] = -1.0
         return matrix
 
     def exact(t: float) -> tuple[np.ndarray, ...]:
-        return (np.array([np.exp(np.sin(t)), 1.0 / (1.0 + t)]),)
+        (theta,), (rate,) = pendulum.exact(t)
+        z = 0.5 * (np.cos(t) + np.sin(t)) + 0.5 * np.exp(-t)
+        return (np.array([theta, rate, z]),)
 
-    problem = FirstOrderProblem(f, [1.0, 1.0], jacobian=jacobian,
-                                name="y0' = y0 cos t, y1' = -y1^2")
-    return ReferenceProblem("first-order", "nonlinear, time-dependent y' = (y0 cos t, -y1^2)",
-                            problem, exact)
+    problem = FirstOrderProblem(f, [1.0, 0.0, 1.0], jacobian=jacobian,
+                                name="pendulum as a first-order system, plus z' = -z + cos t")
+    return ReferenceProblem("first-order", "first-order pendulum plus driven decay "
+                            "z' = -z + cos t", problem, exact)
 
 
 _BUILDERS: dict[str, Callable[[], ReferenceProblem]] = {

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._validation import describe
 from ..errors import ModelError
 from ..integrators import Integrator, get
 
@@ -39,8 +40,11 @@ STABILITY_TOLERANCE = 1e-14
 RAY_LIMIT = 1e6
 #: Systems up to this size get all their eigenvalues (dense); larger ones the extreme few.
 DENSE_EIGEN_LIMIT = 1500
-#: Eigenvalues requested from the sparse (Arnoldi/Lanczos) solver for large systems.
+#: Eigenvalues requested from the sparse (Arnoldi) solver for large systems, and their
+#: relative accuracy: an advisor needs a few digits, and clustered spectra (a long chain of
+#: springs) converge slowly to full precision.
 SPARSE_EIGEN_COUNT = 8
+SPARSE_EIGEN_TOLERANCE = 1e-4
 
 
 def stability_function(method: str | Integrator, z: Any) -> np.ndarray:
@@ -129,7 +133,8 @@ def spectrum(jacobian: Any, *, count: int = SPARSE_EIGEN_COUNT) -> np.ndarray:
         jacobian: ``(m, m)`` dense array, ``scipy.sparse`` matrix or
             ``scipy.sparse.linalg.LinearOperator``.
         count: How many largest-magnitude eigenvalues to compute when the matrix is large
-            (ARPACK's implicitly restarted Arnoldi iteration).
+            (ARPACK's implicitly restarted Arnoldi iteration, to a relative accuracy of
+            :data:`SPARSE_EIGEN_TOLERANCE`).
 
     Returns:
         Complex eigenvalues, shape ``(k,)``.
@@ -144,7 +149,8 @@ def spectrum(jacobian: Any, *, count: int = SPARSE_EIGEN_COUNT) -> np.ndarray:
     from scipy.sparse.linalg import eigs
 
     operator = sp.csr_matrix(jacobian) if dense else jacobian
-    return eigs(operator, k=min(count, m - 2), which="LM", return_eigenvectors=False)
+    return eigs(operator, k=min(count, m - 2), which="LM", tol=SPARSE_EIGEN_TOLERANCE,
+                return_eigenvectors=False)
 
 
 def _to_dense(matrix: Any) -> np.ndarray:
@@ -184,13 +190,18 @@ def max_stable_dt(
     integrator = get(method)
     if (eigenvalues is None) == (jacobian is None):
         raise ModelError("pass exactly one of `eigenvalues` and `jacobian`")
-    lam = (
-        np.asarray(eigenvalues, dtype=np.complex128).ravel()
-        if eigenvalues is not None
-        else spectrum(jacobian)
-    )
-    if not np.isfinite(lam).all():
-        raise ModelError("`eigenvalues` must be finite (the Jacobian holds nan or inf)")
+    if eigenvalues is not None:
+        try:
+            lam = np.asarray(eigenvalues, dtype=np.complex128).ravel()
+        except (TypeError, ValueError):
+            raise ModelError(
+                f"`eigenvalues` must be numbers (got {describe(eigenvalues)})"
+            ) from None
+        if not np.isfinite(lam).all():
+            i = int(np.argmax(~np.isfinite(lam)))
+            raise ModelError(f"`eigenvalues` must be finite; entry {i} is {describe(lam[i])}")
+    else:
+        lam = spectrum(_checked_jacobian(jacobian))
     size = np.abs(lam)
     if size.size == 0 or size.max() == 0.0:
         return float("inf")
@@ -206,6 +217,27 @@ def max_stable_dt(
     unique, inverse = np.unique(directions, return_inverse=True)
     exits = _ray_exit(integrator, unique)[inverse]
     return float(np.min(exits / size))
+
+
+def _checked_jacobian(jacobian: Any) -> Any:
+    """The Jacobian if it is a finite square matrix (dense, sparse or operator)."""
+    import scipy.sparse as sp
+
+    shape = getattr(jacobian, "shape", None)
+    if shape is None and not sp.issparse(jacobian):
+        try:
+            jacobian = np.asarray(jacobian, dtype=np.complex128)
+        except (TypeError, ValueError):
+            raise ModelError(f"`jacobian` must be a matrix (got {describe(jacobian)})") from None
+        shape = jacobian.shape
+    if len(shape) != 2 or shape[0] != shape[1] or shape[0] == 0:
+        raise ModelError(f"`jacobian` must be a square (m, m) matrix (got shape {tuple(shape)})")
+    values = jacobian.data if sp.issparse(jacobian) else (
+        jacobian if isinstance(jacobian, np.ndarray) else None
+    )
+    if values is not None and not np.isfinite(values).all():
+        raise ModelError("`jacobian` must be finite (it holds nan or inf)")
+    return jacobian
 
 
 def state_jacobian(system: System, state: State) -> Any:

@@ -106,7 +106,7 @@ def convergence_command(
     problem: Annotated[str, typer.Option(
         help="Reference problem: pendulum, forced, damped or first-order.")] = "pendulum",
     t_end: Annotated[float, typer.Option(help="Time of the error measurement [s].")] = 2.0,
-    levels: Annotated[int, typer.Option(help="Number of halved step sizes.")] = 8,
+    levels: Annotated[int, typer.Option(help="Number of halved step sizes (at least 3).")] = 8,
     output: Annotated[Path | None, typer.Option("--output", "-o",
                                                 help="Write the log-log plot (PNG).")] = None,
     as_json: JsonOption = False,
@@ -117,7 +117,11 @@ def convergence_command(
     from ..analysis.reference_problems import reference_problem
     from ..integrators import get, names
 
+    from .._validation import real_number, whole_number
+
     instances = [get(name) for name in (methods or names())]
+    levels = whole_number("levels", levels, minimum=3)
+    t_end = real_number("t_end", t_end, positive=True, unit=" s")
     if output is not None:
         _check_new_file(output, force)
     test = reference_problem(problem)
@@ -170,6 +174,8 @@ def demo_command(
 def _check_new_file(path: Path, force: bool) -> None:
     from ..errors import ModelError
 
+    if path.is_dir():
+        raise ModelError(f"output {path} is a directory; give a file name such as {path}/plot.png")
     if path.exists() and not force:
         raise ModelError(f"{path} already exists; pass --force to replace it")
     if not path.parent.exists():
@@ -177,19 +183,11 @@ def _check_new_file(path: Path, force: bool) -> None:
 
 
 def _save_figure(figure: Any, path: Path) -> None:
-    """Save atomically: render to a temporary name, then rename."""
-    import os
-    import tempfile
+    """Save so that the file appears complete or not at all."""
+    from ..io.files import atomic_path
 
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",
-                                         suffix=path.suffix or ".png")
-    os.close(handle)
-    try:
-        figure.savefig(temporary, dpi=110)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    with atomic_path(path) as temporary:
+        figure.savefig(temporary, dpi=110, format=path.suffix.lstrip(".") or "png")
 
 
 def main() -> None:

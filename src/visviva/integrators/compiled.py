@@ -196,8 +196,13 @@ def runge_kutta_step(tableau: ButcherTableau, problem: Problem) -> CompiledStep 
     return _memoized(("runge_kutta", tableau.a.tobytes(), tableau.b.tobytes(), *key), build)  # type: ignore[no-any-return]
 
 
-def make_runner(step: CompiledStep) -> Callable[..., None]:
-    """The parallel loop over systems and steps around a compiled step kernel.
+#: Batches at least this large run on all cores; smaller ones on one (a parallel loop costs
+#: more to compile and to start than it saves on a handful of systems).
+PARALLEL_MIN_SYSTEMS = 64
+
+
+def make_runner(step: CompiledStep, systems: int) -> Callable[..., None]:
+    """The loop over systems and steps around a compiled step kernel (parallel for big batches).
 
     The returned ``run(y, work, fresh, t0, h, first, count, record_every, frames, limit,
     status, evaluations)`` advances every system of ``y`` (``(batch, m)``, in place, with
@@ -213,7 +218,7 @@ def make_runner(step: CompiledStep) -> Callable[..., None]:
 
         kernel = step.kernel
 
-        @numba.njit(parallel=True)
+        @numba.njit(parallel=parallel)
         def run(y, work, fresh, t0, h, first, count, record_every, frames, limit, status,
                 evaluations):  # pragma: no cover - compiled
             batch, m = y.shape
@@ -246,4 +251,5 @@ def make_runner(step: CompiledStep) -> Callable[..., None]:
 
         return run
 
-    return _memoized(("runner", step), build)  # type: ignore[no-any-return]
+    parallel = systems >= PARALLEL_MIN_SYSTEMS
+    return _memoized(("runner", step, parallel), build)  # type: ignore[no-any-return]

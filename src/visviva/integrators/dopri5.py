@@ -17,12 +17,10 @@ References:
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..ode.state import FirstOrderState
 from .base import Integrator
 from .runge_kutta import ButcherTableau, combine, initial_rate
 
@@ -131,8 +129,7 @@ class DormandPrince5(Integrator):
         t1 = state.t + dt
         last = system.derivative(t1, y1)
         rates.append(last)
-        end = state.from_parts(t1, y1)
-        end = _with_rate(end, last)
+        end = state.from_parts(t1, y1).with_derivative(last)
         return Step(state, end, rates, dt)
 
     def step(self, system: System, state: State, dt: float) -> State:
@@ -141,9 +138,3 @@ class DormandPrince5(Integrator):
     def stability_function(self, z: Any) -> np.ndarray:
         return self.tableau.stability_function(z)
 
-
-def _with_rate(state: State, rate: tuple[np.ndarray, ...]) -> State:
-    """``state`` carrying its own derivative (reused as the next step's first stage)."""
-    if isinstance(state, FirstOrderState):
-        return replace(state, rate=rate[0])
-    return replace(state, acceleration=rate[1])

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from collections.abc import Mapping
 from datetime import UTC, datetime
 from pathlib import Path
@@ -33,6 +32,7 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import ModelError
+from .files import atomic_path
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "Recording", "read_recordings", "write_recordings"]
 
@@ -132,21 +132,14 @@ def write_recordings(path: str | os.PathLike[str], runs: Mapping[str, Recording]
     for name in runs:
         if not name or "/" in name or name.startswith("."):
             raise ModelError(f"run name {name!r} must be non-empty, without '/' or leading '.'")
-    handle, temporary = tempfile.mkstemp(dir=target.parent or ".", prefix=f".{target.name}.")
-    os.close(handle)
-    try:
-        with h5py.File(temporary, "w") as file:
-            file.attrs["format"] = FORMAT
-            file.attrs["format_version"] = FORMAT_VERSION
-            file.attrs["visviva_version"] = __version__
-            file.attrs["created_utc"] = datetime.now(UTC).isoformat(timespec="seconds")
-            file.attrs["runs"] = json.dumps(list(runs))
-            for name, recording in runs.items():
-                _write_run(file.create_group(name), recording)
-        os.replace(temporary, target)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    with atomic_path(target) as temporary, h5py.File(temporary, "w") as file:
+        file.attrs["format"] = FORMAT
+        file.attrs["format_version"] = FORMAT_VERSION
+        file.attrs["visviva_version"] = __version__
+        file.attrs["created_utc"] = datetime.now(UTC).isoformat(timespec="seconds")
+        file.attrs["runs"] = json.dumps(list(runs))
+        for name, recording in runs.items():
+            _write_run(file.create_group(name), recording)
     return target
 
 

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validation import describe
 from ..errors import ModelError
 
 __all__ = ["Mass"]
@@ -57,9 +58,14 @@ class Mass:
             self._factor = sp.linalg.splu(matrix)
             return
 
-        array = np.asarray(mass, dtype=np.float64)
+        try:
+            array = np.asarray(mass, dtype=np.float64)
+        except (TypeError, ValueError, OverflowError):
+            raise ModelError(
+                f"`mass` must be a number, an array or a scipy.sparse matrix (got {describe(mass)})"
+            ) from None
         if not np.isfinite(array).all():
-            raise ModelError(f"`mass` must be finite (got {_show(array)})")
+            raise ModelError(f"`mass` must be finite ({_first(array, ~np.isfinite(array))})")
         if array.ndim <= q0.ndim:
             try:
                 np.broadcast_shapes(array.shape, q0.shape)
@@ -69,7 +75,7 @@ class Mass:
                     f"(got shape {array.shape})"
                 ) from None
             if (array <= 0).any():
-                raise ModelError(f"`mass` must be positive (got {_show(array)})")
+                raise ModelError(f"`mass` must be positive ({_first(array, array <= 0)})")
             self.kind = "diagonal"
             self.values = array
             return
@@ -87,12 +93,11 @@ class Mass:
         asymmetry = np.abs(array - np.swapaxes(array, -1, -2)).max()
         if asymmetry > SYMMETRY_TOLERANCE * scale:
             raise ModelError(f"`mass` must be symmetric (max |M - M^T| = {asymmetry:.3g})")
-        try:
-            np.linalg.cholesky(array)
-        except np.linalg.LinAlgError:
+        smallest = float(np.linalg.eigvalsh(array).min())
+        if smallest <= 0.0:
             raise ModelError(
-                "`mass` must be positive definite (its Cholesky factorization failed)"
-            ) from None
+                f"`mass` must be positive definite (its smallest eigenvalue is {smallest:.6g})"
+            )
         self.kind = "dense"
         self.values = array
 
@@ -125,5 +130,10 @@ class Mass:
         return matrices
 
 
-def _show(array: np.ndarray) -> str:
-    return repr(array.item()) if array.size == 1 else f"array of shape {array.shape}"
+def _first(array: np.ndarray, bad: np.ndarray) -> str:
+    """``got X`` for a scalar, ``entry I is X`` for the first offending entry of an array."""
+    if array.ndim == 0:
+        return f"got {describe(array)}"
+    index = tuple(int(i) for i in np.argwhere(bad)[0])
+    where = index[0] if len(index) == 1 else index
+    return f"entry {where} is {describe(array[index])}"

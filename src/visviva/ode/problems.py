@@ -19,7 +19,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from .._validation import real_number, state_array
+from .._validation import describe, real_number, state_array
 from ..errors import ModelError
 from .functions import UserFunction
 from .mass import Mass
@@ -294,8 +294,9 @@ def _check_result(name: str, value: Any, shape: tuple[int, ...], what: str) -> n
     bad = ~np.isfinite(array)
     if bad.any():
         index = tuple(int(i) for i in np.argwhere(bad)[0])
+        where = index[0] if len(index) == 1 else index
         raise ModelError(
-            f"`{name}` returned {array[index]!r} at entry {index} for the initial state"
+            f"`{name}` returned {describe(array[index])} at entry {where} for the initial state"
         )
     return array
 

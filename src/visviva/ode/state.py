@@ -44,6 +44,10 @@ class FirstOrderState:
         """The same state stamped with time ``t`` (the loop's exact time from its counter)."""
         return replace(self, t=t)
 
+    def with_derivative(self, derivative: tuple[np.ndarray, ...]) -> FirstOrderState:
+        """The same state carrying its derivative ``(f(t, y),)``, evaluated by the caller."""
+        return replace(self, rate=derivative[0])
+
 
 @dataclass(frozen=True, eq=False)
 class SecondOrderState:
@@ -75,6 +79,10 @@ class SecondOrderState:
     def at_time(self, t: float) -> SecondOrderState:
         """The same state stamped with time ``t`` (the loop's exact time from its counter)."""
         return replace(self, t=t)
+
+    def with_derivative(self, derivative: tuple[np.ndarray, ...]) -> SecondOrderState:
+        """The same state carrying its derivative ``(v, q'')``, evaluated by the caller."""
+        return replace(self, acceleration=derivative[1])
 
 
 State = FirstOrderState | SecondOrderState

@@ -18,6 +18,7 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import SimulationError
+from ..integrators.runge_kutta import initial_rate
 from .loop import FrameRecorder, add_energy, initial_state
 from .progress import Progress
 from .watch import DivergenceWatch
@@ -70,9 +71,12 @@ def _error_norm(error: tuple[np.ndarray, ...], before: tuple[np.ndarray, ...],
 
 def _initial_step(method: DormandPrince5, system: Any, state: State, t_end: float,
                   rtol: float, atol: float) -> float:
-    """Starting step from the sizes of y, f and a finite-difference estimate of f'."""
+    """Starting step from the sizes of y, f and a finite-difference estimate of f'.
+
+    ``state`` must carry its derivative (see :meth:`FirstOrderState.with_derivative`).
+    """
     parts = state.parts
-    rates = system.derivative(state.t, parts)
+    rates = initial_rate(system, state)
 
     def norm(values: tuple[np.ndarray, ...]) -> float:
         scaled = [v / (atol + rtol * np.abs(y)) for v, y in zip(values, parts, strict=True)]
@@ -124,6 +128,8 @@ def integrate_adaptive(
     system = problem.system()
     method.check(system)
     state = initial_state(problem)
+    # Evaluate f at the start once; every attempt from here reuses it.
+    state = state.with_derivative(system.derivative(state.t, state.parts))
     t0 = state.t
     starts_at_t0 = t_eval is None or t_eval[0] == t0
     recorder = FrameRecorder(state, include=starts_at_t0)

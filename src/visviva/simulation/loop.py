@@ -42,6 +42,8 @@ if TYPE_CHECKING:
 
 __all__ = ["Schedule", "initial_state", "simulate"]
 
+#: A fixed-step run may take at most this many steps; more is a mistake in dt, not a plan.
+MAX_STEPS = 10**10
 #: System-steps per compiled chunk: large enough to hide the call overhead, small enough for the
 #: progress bar to move and the frame buffer to stay small.
 CHUNK_SYSTEM_STEPS = 200_000
@@ -190,11 +192,20 @@ def simulate(
         SimulationDiverged: If the state blows up; ``error.recording`` holds the frames so far.
         NewtonConvergenceError: If an implicit step fails; ``error.recording`` likewise.
     """
+    check_problem(problem)
     integrator = get(method)
     dt = real_number("dt", dt, positive=True, unit=" s")
-    t_end = real_number("t_end", t_end, unit=" s")
-    if t_end < problem.t0:
-        raise ModelError(f"`t_end` ({t_end!r}) must not be before t0 ({problem.t0!r})")
+    t_end = check_end_time(problem, t_end)
+    span = t_end - problem.t0
+    if dt > span > 0.0:
+        raise ModelError(
+            f"`dt` ({dt!r} s) is longer than the run (t_end - t0 = {span!r} s); use dt <= {span!r}"
+        )
+    if span / dt > MAX_STEPS:
+        raise ModelError(
+            f"`dt` ({dt!r} s) would take {span / dt:.3g} steps to reach t_end; the limit is "
+            f"{MAX_STEPS:.0e} (use a larger dt)"
+        )
     substeps = whole_number("substeps", substeps, minimum=1)
     record_every = whole_number("record_every", record_every, minimum=1)
     if divergence_limit is not None:
@@ -242,6 +253,25 @@ def simulate(
         error.recording = recording  # type: ignore[attr-defined]
         raise error
     return recording
+
+
+def check_problem(problem: Any) -> None:
+    """Refuse anything that is not one of the problem kinds."""
+    from ..ode.problems import FirstOrderProblem, SecondOrderProblem
+
+    if not isinstance(problem, (FirstOrderProblem, SecondOrderProblem)):
+        raise ModelError(
+            "`problem` must be a vv.ode.FirstOrderProblem or vv.ode.SecondOrderProblem "
+            f"(got {type(problem).__name__})"
+        )
+
+
+def check_end_time(problem: Problem, t_end: Any) -> float:
+    """``t_end`` as a float, not before the problem's ``t0``."""
+    t_end = real_number("t_end", t_end, unit=" s")
+    if t_end < problem.t0:
+        raise ModelError(f"`t_end` ({t_end!r}) must not be before t0 ({problem.t0!r})")
+    return t_end
 
 
 def _compiled_step(
@@ -306,11 +336,11 @@ def _run_compiled(
     """The same schedule, frames and watch as :func:`_run_numpy`, in compiled chunks."""
     from ..integrators.compiled import make_runner
 
-    run = make_runner(step)
     batch = state.parts[0].ndim == 2
     n = problem.size
     y = _stack(state)
     systems, m = y.shape
+    run = make_runner(step, systems)
     work = np.zeros((systems, step.rows, m), dtype=y.dtype)
     status = np.full(systems, -1, dtype=np.int64)
     evaluations = np.zeros(systems, dtype=np.int64)

@@ -14,12 +14,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._validation import real_number, whole_number
+from .._validation import describe, real_number, whole_number
 from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get, names
-from ..ode.problems import FirstOrderProblem, SecondOrderProblem
 from .adaptive import DenseOutput, integrate_adaptive
-from .loop import simulate
+from .loop import check_end_time, check_problem, simulate
 
 if TYPE_CHECKING:
     from ..io.recording import Recording
@@ -151,11 +150,7 @@ def solve(
         >>> sol.success, sol.q.shape, sol.counters["f_evaluations"]
         (True, (11, 1), 100)
     """
-    if not isinstance(problem, (FirstOrderProblem, SecondOrderProblem)):
-        raise ModelError(
-            "`problem` must be a vv.ode.FirstOrderProblem or vv.ode.SecondOrderProblem "
-            f"(got {type(problem).__name__})"
-        )
+    check_problem(problem)
     integrator = get(method)
     use_adaptive = integrator.adaptive if adaptive is None else bool(adaptive)
     if use_adaptive and not integrator.adaptive:
@@ -163,9 +158,7 @@ def solve(
             f"method {integrator.name!r} has no error control; adaptive methods: "
             + ", ".join(n for n in names() if get(n).adaptive)
         )
-    t_end = real_number("t_end", t_end, unit=" s")
-    if t_end < problem.t0:
-        raise ModelError(f"`t_end` ({t_end!r}) must not be before t0 ({problem.t0!r})")
+    t_end = check_end_time(problem, t_end)
     try:
         if use_adaptive:
             return _solve_adaptive(problem, integrator, t_end, dt, rtol, atol, t_eval,
@@ -208,25 +201,17 @@ def _solve_adaptive(
     if record_every != 1 or substeps != 1:
         raise ModelError("`record_every` and `substeps` apply to fixed-step runs; use `t_eval`")
     if compiled:
-        raise ModelError("compiled=True applies to fixed-step explicit methods only")
+        raise ModelError(
+            f"compiled=True applies to fixed-step explicit methods; {integrator.name!r} runs "
+            "adaptively here (pass adaptive=False for fixed steps)"
+        )
     rtol = 1e-6 if rtol is None else real_number("rtol", rtol, positive=True)
     atol = 1e-9 if atol is None else real_number("atol", atol, nonnegative=True)
     first_step = None if dt is None else real_number("dt", dt, positive=True, unit=" s")
     max_steps = whole_number("max_steps", max_steps, minimum=1)
     if divergence_limit is not None:
         divergence_limit = real_number("divergence_limit", divergence_limit, positive=True)
-    times = None
-    if t_eval is not None:
-        times = np.asarray(t_eval, dtype=np.float64).ravel()
-        if times.size == 0 or not np.isfinite(times).all():
-            raise ModelError("`t_eval` must be a non-empty array of finite times")
-        if np.any(np.diff(times) <= 0):
-            raise ModelError("`t_eval` must be strictly increasing")
-        if times[0] < problem.t0 or times[-1] > t_end:
-            raise ModelError(
-                f"`t_eval` must lie within [t0, t_end] = [{problem.t0!r}, {t_end!r}] "
-                f"(got [{times[0]!r}, {times[-1]!r}])"
-            )
+    times = None if t_eval is None else _check_times(t_eval, problem.t0, t_end)
     recording, dense = integrate_adaptive(
         problem, integrator,  # type: ignore[arg-type]
         t_end=t_end, rtol=rtol, atol=atol, first_step=first_step, t_eval=times,
@@ -234,3 +219,30 @@ def _solve_adaptive(
         divergence_limit=divergence_limit,
     )
     return Solution(recording, True, "completed", sol=dense)
+
+
+def _check_times(t_eval: Any, t0: float, t_end: float) -> np.ndarray:
+    """``t_eval`` as a strictly increasing float array within ``[t0, t_end]``."""
+    try:
+        times = np.asarray(t_eval, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise ModelError(f"`t_eval` must be an array of times (got {describe(t_eval)})") from None
+    if times.size == 0:
+        raise ModelError("`t_eval` must not be empty")
+    bad = ~np.isfinite(times)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ModelError(f"`t_eval` must be finite; entry {i} is {describe(times[i])}")
+    steps = np.diff(times)
+    if np.any(steps <= 0):
+        i = int(np.argmax(steps <= 0)) + 1
+        raise ModelError(
+            f"`t_eval` must be strictly increasing; entry {i} ({describe(times[i])}) follows "
+            f"{describe(times[i - 1])}"
+        )
+    if times[0] < t0 or times[-1] > t_end:
+        raise ModelError(
+            f"`t_eval` must lie within [t0, t_end] = [{describe(t0)}, {describe(t_end)}] "
+            f"(got [{describe(times[0])}, {describe(times[-1])}])"
+        )
+    return times

@@ -1,0 +1,14 @@
+"""Shared test setup: the documented custom integrator joins every conformance test."""
+
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "examples"))
+
+import custom_integrator  # noqa: E402 - needs the path above
+
+custom_integrator.register()
