@@ -17,8 +17,10 @@ Parts:
     DOP853 (rtol 1e-9, atol 1e-12), then wall times and f-evaluations are compared.
 (c) CLI start-up: wall time of ``visviva --help`` in a fresh process.
 
-Every timing is the median of ``--repeats`` runs after one warm-up run; the warm-up (first)
-call is reported separately because it includes Numba compilation.
+Every timing is the median of at least ``--repeats`` runs after one warm-up run (short calls
+are repeated until the runs fill 0.5 s); the warm-up (first) call is reported separately
+because it includes Numba compilation. The machine may be shared: each figure comes with the
+share of the CPU that other processes used meanwhile, and a contended figure is re-measured.
 """
 
 from __future__ import annotations
@@ -212,7 +214,7 @@ class Contention:
         wall = end[0] - self.start[0]
         foreign = (end[1] - self.start[1]) - (end[2] - self.start[2])
         cores = os.cpu_count() or 1
-        return max(0.0, foreign / (wall * cores)) if wall > 0 else None
+        return min(1.0, max(0.0, foreign / (wall * cores))) if wall > 0 else None
 
 
 @dataclass
@@ -231,7 +233,7 @@ class Timing:
 
     @property
     def spread(self) -> str:
-        return f"{fmt_time(min(self.times))}–{fmt_time(max(self.times))}"
+        return f"{fmt_time(min(self.times))}–{fmt_time(max(self.times))} ({len(self.times)})"
 
     @property
     def compile_estimate(self) -> float:
@@ -252,7 +254,7 @@ class Timing:
 #: warning if every attempt was contended.
 CONTENTION_WARNING = 0.05
 CONTENDED: list[str] = []
-PATIENCE = {"quiet_wait": 60.0, "retries": 2}
+PATIENCE = {"quiet_wait": 30.0, "retries": 2}
 
 
 def wait_for_quiet(max_wait: float) -> None:
@@ -268,13 +270,19 @@ def wait_for_quiet(max_wait: float) -> None:
         quiet = quiet + 1 if others < CONTENTION_WARNING else 0
 
 
+#: Short calls are repeated beyond ``repeats`` until the timed runs fill this many seconds, so
+#: that the median is stable and the contention meter (10 ms clock ticks) is meaningful.
+MIN_WINDOW = 0.5
+MAX_RUNS = 2000
+
+
 def measure_once(call: Callable[[], Any], repeats: int) -> Timing:
     start = time.perf_counter()
     result = call()
     first = time.perf_counter() - start
-    times = []
+    times: list[float] = []
     meter = Contention()
-    for _ in range(repeats):
+    while len(times) < repeats or (sum(times) < MIN_WINDOW and len(times) < MAX_RUNS):
         start = time.perf_counter()
         result = call()
         times.append(time.perf_counter() - start)
@@ -435,7 +443,8 @@ def print_header(args: argparse.Namespace) -> None:
     print(f"visviva:           {vv.__version__} ({source_state()})")
     print(f"NUMBA_NUM_THREADS: {numba.config.NUMBA_NUM_THREADS} "
           f"({'set in the environment' if env_threads else 'default'})")
-    print(f"timing:            median of {args.repeats} runs after one warm-up run; up to "
+    print(f"timing:            median of {args.repeats} runs after one warm-up run (more runs "
+          f"for calls under {MIN_WINDOW / args.repeats:.2g} s, to fill {MIN_WINDOW:g} s); up to "
           f"{args.retries} re-measurements if other processes were busy")
     print(f"load average:      {load_average()} at start")
 
@@ -531,7 +540,7 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
     print()
     print_table(
         ["path", "system-steps/s", "target", "meets target", "vs same-kind peer",
-         "median wall", "min–max", "first call", "others' CPU"],
+         "median wall", "min–max (runs)", "first call", "others' CPU"],
         rows,
     )
     print()
@@ -593,7 +602,7 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
 # (b) Accuracy-matched single system
 # --------------------------------------------------------------------------------------------
 
-#: Steps per run on an E24-like ladder (two significant digits) from 100 to ~10 million.
+#: Steps per run on an E24-like ladder (two significant digits), from 100 to 91 million.
 E24 = (10, 11, 12, 13, 15, 16, 18, 20, 22, 24, 27, 30, 33, 36, 39, 43, 47, 51, 56, 62, 68, 75,
        82, 91)
 STEP_LADDER = tuple(m * 10**k for k in range(1, 7) for m in E24)
@@ -713,9 +722,9 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
     rows: list[list[str]] = []
 
     def add_row(label: str, setting: str, timing: Timing, final: np.ndarray, evaluations: int,
-                steps: int) -> None:
+                steps: str) -> None:
         rows.append([
-            label, setting, sci(error_of(final)), f"{evaluations:,}", f"{steps:,}",
+            label, setting, sci(error_of(final)), f"{evaluations:,}", steps,
             fmt_time(timing.median), timing.spread,
             f"{timing.median / rk45.median:.2f}", f"{timing.median / dop853.median:.2f}",
             timing.busy,
@@ -724,13 +733,13 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
     for name, timing in (("RK45", rk45), ("DOP853", dop853)):
         result = timing.result
         add_row(f"solve_ivp {name}", "rtol 1e-9, atol 1e-12", timing, result.y[:, -1],
-                result.nfev, result.t.size - 1)
+                result.nfev, f"{result.t.size - 1:,} (–)")
 
     def add_visviva(label: str, timing: Timing, setting: str) -> None:
         solution = timing.result
         counters = solution.counters
         add_row(label, setting, timing, solution.y[-1], counters["f_evaluations"],
-                counters["accepted_steps"] + counters["rejected_steps"])
+                f"{counters['accepted_steps']:,} ({counters['rejected_steps']:,})")
 
     same = measure(lambda: visviva_dopri5(RTOL_LADDER[same_tolerance]), args.repeats,
                    "(b) visviva dopri5, same tolerances")
@@ -748,13 +757,14 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
                     f"rtol {sci(rtol, 2)}, atol {sci(1e-3 * rtol, 2)}")
     print()
     print_table(
-        ["run", "setting", "final error", "f-evals", "steps", "median wall", "min–max",
-         "÷ RK45", "÷ DOP853", "others' CPU"],
+        ["run", "setting", "final error", "f-evals", "steps (rejected)", "median wall",
+         "min–max (runs)", "÷ RK45", "÷ DOP853", "others' CPU"],
         rows,
     )
     print()
     print("  f-evals: solve_ivp nfev; visviva solution.counters['f_evaluations']. steps: "
-          "accepted + rejected. '÷ RK45', '÷ DOP853': wall-time ratio to that solve_ivp run "
+          "accepted (rejected; solve_ivp does not report them). '÷ RK45', '÷ DOP853': wall-time "
+          "ratio to that solve_ivp run "
           "(below 1 = visviva faster);")
     print("  others' CPU: share of the machine used by other processes during the timed repeats.")
     print("  visviva rk4 runs the compiled Numba loop (record_every = all steps: first and last "
@@ -826,7 +836,7 @@ def bench_cli(args: argparse.Namespace) -> None:
         rows.append([f"(context) {label}", fmt_time(timing.median), timing.spread,
                      fmt_time(first), "", "", timing.busy])
     print()
-    print_table(["command", f"median of {repeats}", "min–max", "first", "target", "meets",
+    print_table(["command", "median", "min–max (runs)", "first", "target", "meets",
                  "others' CPU"], rows)
     if not available:
         print("  (the entry point visviva.cli.main:main does not exist yet; rerun once it does)")
@@ -844,9 +854,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--retries", type=int, default=None,
                         help="re-measure a figure taken while other processes were busy up to "
                              "this many times (default 2, --quick 0)")
-    parser.add_argument("--quiet-wait", type=float, default=60.0,
+    parser.add_argument("--quiet-wait", type=float, default=30.0,
                         help="before a retry, wait up to this many seconds for the machine to "
-                             "be idle (default 60)")
+                             "be idle (default 30)")
     args = parser.parse_args(argv)
     if args.repeats is None:
         args.repeats = 3 if args.quick else 5
