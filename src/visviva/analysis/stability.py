@@ -76,7 +76,9 @@ def _ray_exit(method: Integrator, directions: np.ndarray) -> np.ndarray:
             bad = np.abs(method.stability_function(middle * d)) > 1.0 + STABILITY_TOLERANCE
             high = np.where(bad, middle, high)
             low = np.where(bad, low, middle)
-        exits[refine] = low
+        # The tolerance lets the bisection end up to ~1e-14 beyond the true boundary; report
+        # 12 significant digits so that, e.g., explicit Euler's limit reads 2, not 2.00000000000001.
+        exits[refine] = [float(f"{r:.12g}") for r in low]
     return exits
 
 

@@ -1,0 +1,5 @@
+"""``python -m visviva`` runs the command-line interface."""
+
+from .cli.main import main
+
+main()
