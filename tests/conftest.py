@@ -9,6 +9,6 @@ matplotlib.use("Agg")
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "examples"))
 
-import custom_integrator  # noqa: E402 - needs the path above
+import custom_integrator
 
 custom_integrator.register()

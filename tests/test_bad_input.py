@@ -91,8 +91,9 @@ def test_second_order_construction_calls_each_function_exactly_once():
     force = counted(lambda t, q, v: -4.0 * q - 0.1 * v)
     jacobian = counted(lambda t, q, v: (-4.0 * np.eye(2), -0.1 * np.eye(2)))
     energy = counted(lambda t, q, v: 0.5 * np.sum(2.0 * v**2 + 4.0 * q**2))
-    SecondOrderProblem.from_force(force, 2.0, [1.0, 0.5], [0.0, 0.0],
-                                  jacobian=jacobian, energy=energy)
+    SecondOrderProblem.from_force(
+        force, 2.0, [1.0, 0.5], [0.0, 0.0], jacobian=jacobian, energy=energy
+    )
     assert (force.calls, jacobian.calls, energy.calls) == (1, 1, 1)
 
 
@@ -116,8 +117,9 @@ def test_non_finite_initial_state_is_refused(argument, bad, shown):
     """A nan or infinite initial coordinate is named by argument, entry and value; f never runs."""
     f = counted(restoring)
     name = argument.split()[0]
-    refused(lambda: STATE_ARGUMENTS[argument]([1.0, bad], f),
-            f"`{name}`", "finite", "entry 1", shown)
+    refused(
+        lambda: STATE_ARGUMENTS[argument]([1.0, bad], f), f"`{name}`", "finite", "entry 1", shown
+    )
     assert f.calls == 0
 
 
@@ -132,8 +134,9 @@ def test_initial_state_that_is_not_numbers_is_refused(argument, bad):
 
 
 @pytest.mark.parametrize("argument", list(STATE_ARGUMENTS))
-@pytest.mark.parametrize(("bad", "shape"), [([], "(0,)"), (np.empty((3, 0)), "(3, 0)")],
-                         ids=["empty", "batch-of-empty"])
+@pytest.mark.parametrize(
+    ("bad", "shape"), [([], "(0,)"), (np.empty((3, 0)), "(3, 0)")], ids=["empty", "batch-of-empty"]
+)
 def test_empty_initial_state_is_refused(argument, bad, shape):
     """A state with no coordinates is refused, naming the argument and the shape received."""
     f = counted(restoring)
@@ -147,8 +150,13 @@ def test_three_dimensional_initial_state_is_refused(argument):
     """States are (n,) or (batch, n); a 3-D array is refused with its shape and the forms."""
     f = counted(restoring)
     name = argument.split()[0]
-    refused(lambda: STATE_ARGUMENTS[argument](np.zeros((2, 2, 2)), f),
-            f"`{name}`", "(2, 2, 2)", "(n,)", "(batch, n)")
+    refused(
+        lambda: STATE_ARGUMENTS[argument](np.zeros((2, 2, 2)), f),
+        f"`{name}`",
+        "(2, 2, 2)",
+        "(n,)",
+        "(batch, n)",
+    )
     assert f.calls == 0
 
 
@@ -157,8 +165,11 @@ def test_velocities_must_have_the_shape_of_positions(from_force):
     """v0 of another shape than q0 is refused with both shapes; the force never runs."""
     f = counted(restoring)
     q0, v0 = [1.0, 0.5], [0.0, 0.0, 0.0]
-    build = (lambda: SecondOrderProblem.from_force(f, 1.0, q0, v0)) if from_force else (
-        lambda: SecondOrderProblem(f, q0, v0))
+    build = (
+        (lambda: SecondOrderProblem.from_force(f, 1.0, q0, v0))
+        if from_force
+        else (lambda: SecondOrderProblem(f, q0, v0))
+    )
     refused(build, "`v0`", "(2,)", "(3,)")
     assert f.calls == 0
 
@@ -182,17 +193,28 @@ def test_function_that_is_not_callable_is_refused(build, name, type_name):
     [
         (lambda: FirstOrderProblem(lambda t: t, [1.0]), "f(t, y)", "f(t)"),
         (lambda: FirstOrderProblem(lambda t, y, z, w: y, [1.0]), "f(t, y)", "f(t, y, z, w)"),
-        (lambda: SecondOrderProblem(lambda t: t, [1.0], [0.0]),
-         "acceleration(t, q, v)", "acceleration(t)"),
-        (lambda: SecondOrderProblem(lambda t, q, v, w: q, [1.0], [0.0]),
-         "acceleration(t, q)", "acceleration(t, q, v, w)"),
-        (lambda: SecondOrderProblem.from_force(lambda t: t, 1.0, [1.0], [0.0]),
-         "force(t, q)", "force(t)"),
-        (lambda: FirstOrderProblem(restoring, [1.0], energy=lambda t: 0.0),
-         "energy(t, y)", "energy(t)"),
+        (
+            lambda: SecondOrderProblem(lambda t: t, [1.0], [0.0]),
+            "acceleration(t, q, v)",
+            "acceleration(t)",
+        ),
+        (
+            lambda: SecondOrderProblem(lambda t, q, v, w: q, [1.0], [0.0]),
+            "acceleration(t, q)",
+            "acceleration(t, q, v, w)",
+        ),
+        (
+            lambda: SecondOrderProblem.from_force(lambda t: t, 1.0, [1.0], [0.0]),
+            "force(t, q)",
+            "force(t)",
+        ),
+        (
+            lambda: FirstOrderProblem(restoring, [1.0], energy=lambda t: 0.0),
+            "energy(t, y)",
+            "energy(t)",
+        ),
     ],
-    ids=["f(t)", "f(t,y,z,w)", "acceleration(t)", "acceleration(t,q,v,w)", "force(t)",
-         "energy(t)"],
+    ids=["f(t)", "f(t,y,z,w)", "acceleration(t)", "acceleration(t,q,v,w)", "force(t)", "energy(t)"],
 )
 def test_function_with_wrong_signature_is_refused(build, accepted, got):
     """The message shows the accepted form and the signature the user wrote."""
@@ -268,8 +290,12 @@ def _numba_acceleration_one_too_long(t, q):
     ("build", "name"),
     [
         (lambda: FirstOrderProblem(_numba_rhs_one_too_long, np.ones((4, 2))), "f"),
-        (lambda: SecondOrderProblem(_numba_acceleration_one_too_long, np.ones((4, 2)),
-                                    np.zeros((4, 2))), "acceleration"),
+        (
+            lambda: SecondOrderProblem(
+                _numba_acceleration_one_too_long, np.ones((4, 2)), np.zeros((4, 2))
+            ),
+            "acceleration",
+        ),
     ],
     ids=["f", "acceleration"],
 )
@@ -283,8 +309,10 @@ def test_numba_function_of_wrong_shape_for_a_batch_is_refused(build, name):
     [
         (lambda f, j: FirstOrderProblem(f, [1.0, 0.5], jacobian=j), "df/dy"),
         (lambda f, j: SecondOrderProblem(f, [1.0, 0.5], [0.0, 0.0], jacobian=j), "dF/dq"),
-        (lambda f, j: SecondOrderProblem.from_force(f, 2.0, [1.0, 0.5], [0.0, 0.0], jacobian=j),
-         "dF/dq"),
+        (
+            lambda f, j: SecondOrderProblem.from_force(f, 2.0, [1.0, 0.5], [0.0, 0.0], jacobian=j),
+            "dF/dq",
+        ),
     ],
     ids=["first-order", "acceleration", "from_force"],
 )
@@ -299,9 +327,15 @@ def test_jacobian_of_wrong_shape_is_refused(build, what):
 def test_jacobian_pair_with_wrong_velocity_block_is_refused():
     """For a damped force, a wrong ∂F/∂v block is named as such."""
     force = counted(lambda t, q, v: -q - 0.1 * v)
-    refused(lambda: SecondOrderProblem(force, [1.0, 0.5], [0.0, 0.0],
-                                       jacobian=lambda t, q, v: (-np.eye(2), np.eye(3))),
-            "`jacobian`", "(3, 3)", "(2, 2)", "dF/dv")
+    refused(
+        lambda: SecondOrderProblem(
+            force, [1.0, 0.5], [0.0, 0.0], jacobian=lambda t, q, v: (-np.eye(2), np.eye(3))
+        ),
+        "`jacobian`",
+        "(3, 3)",
+        "(2, 2)",
+        "dF/dv",
+    )
     assert force.calls == 1
 
 
@@ -313,28 +347,44 @@ def test_jacobian_pair_with_wrong_velocity_block_is_refused():
 def test_velocity_dependent_jacobian_must_return_a_pair(result, type_name):
     """jacobian(t, q, v) of a damped force must return the tuple (dF/dq, dF/dv)."""
     force = counted(lambda t, q, v: -q - 0.1 * v)
-    refused(lambda: SecondOrderProblem(force, [1.0, 0.5], [0.0, 0.0],
-                                       jacobian=lambda t, q, v: result),
-            "`jacobian(t, q, v)`", "pair", "dF/dv", type_name)
+    refused(
+        lambda: SecondOrderProblem(force, [1.0, 0.5], [0.0, 0.0], jacobian=lambda t, q, v: result),
+        "`jacobian(t, q, v)`",
+        "pair",
+        "dF/dv",
+        type_name,
+    )
     assert force.calls == 1
 
 
 def test_position_only_jacobian_for_velocity_dependent_force_is_refused():
     """A damped force needs jacobian(t, q, v); jacobian(t, q) would silently drop ∂F/∂v."""
-    refused(lambda: SecondOrderProblem(lambda t, q, v: -q - 0.1 * v, [1.0], [0.0],
-                                       jacobian=lambda t, q: -np.eye(1)),
-            "`jacobian`", "jacobian(t, q, v)", "jacobian(t, q)")
+    refused(
+        lambda: SecondOrderProblem(
+            lambda t, q, v: -q - 0.1 * v, [1.0], [0.0], jacobian=lambda t, q: -np.eye(1)
+        ),
+        "`jacobian`",
+        "jacobian(t, q, v)",
+        "jacobian(t, q)",
+    )
 
 
 @pytest.mark.parametrize(
     ("build", "shape", "expected"),
     [
-        (lambda: FirstOrderProblem(restoring, [1.0, 0.5], energy=lambda t, y: y),
-         "(2,)", "()"),
-        (lambda: SecondOrderProblem(restoring, [1.0, 0.5], [0.0, 0.0],
-                                    energy=lambda t, q, v: q), "(2,)", "()"),
-        (lambda: SecondOrderProblem(restoring, np.ones((3, 2)), np.zeros((3, 2)),
-                                    energy=lambda t, q, v: np.sum(q)), "()", "(3,)"),
+        (lambda: FirstOrderProblem(restoring, [1.0, 0.5], energy=lambda t, y: y), "(2,)", "()"),
+        (
+            lambda: SecondOrderProblem(restoring, [1.0, 0.5], [0.0, 0.0], energy=lambda t, q, v: q),
+            "(2,)",
+            "()",
+        ),
+        (
+            lambda: SecondOrderProblem(
+                restoring, np.ones((3, 2)), np.zeros((3, 2)), energy=lambda t, q, v: np.sum(q)
+            ),
+            "()",
+            "(3,)",
+        ),
     ],
     ids=["first-order-vector", "second-order-vector", "batch-returns-one-number"],
 )
@@ -358,23 +408,43 @@ def test_energy_of_wrong_shape_is_refused(build, shape, expected):
         (np.ones((2, 2, 2, 2)), ("(2, 2, 2, 2)",)),
         ("heavy", ("'heavy'",)),
     ],
-    ids=["negative", "zero", "nan", "negative-entry", "nan-entry", "non-symmetric",
-         "not-positive-definite", "diagonal-wrong-length", "matrix-wrong-size", "4-d", "string"],
+    ids=[
+        "negative",
+        "zero",
+        "nan",
+        "negative-entry",
+        "nan-entry",
+        "non-symmetric",
+        "not-positive-definite",
+        "diagonal-wrong-length",
+        "matrix-wrong-size",
+        "4-d",
+        "string",
+    ],
 )
 def test_bad_mass_is_refused(mass, fragments):
     """Mass must be finite, positive (definite), symmetric and fit q0; the force never runs."""
     force = counted(restoring)
-    refused(lambda: SecondOrderProblem.from_force(force, mass, [1.0, 0.5], [0.0, 0.0]),
-            "`mass`", *fragments)
+    refused(
+        lambda: SecondOrderProblem.from_force(force, mass, [1.0, 0.5], [0.0, 0.0]),
+        "`mass`",
+        *fragments,
+    )
     assert force.calls == 0
 
 
 def test_sparse_mass_for_a_batch_is_refused():
     """A sparse mass describes one large system; for a batch the message says what to pass."""
     force = counted(restoring)
-    refused(lambda: SecondOrderProblem.from_force(force, sp.identity(2, format="csc"),
-                                                  np.ones((3, 2)), np.zeros((3, 2))),
-            "sparse", "`mass`", "(3, 2)", "(batch, n, n)")
+    refused(
+        lambda: SecondOrderProblem.from_force(
+            force, sp.identity(2, format="csc"), np.ones((3, 2)), np.zeros((3, 2))
+        ),
+        "sparse",
+        "`mass`",
+        "(3, 2)",
+        "(batch, n, n)",
+    )
     assert force.calls == 0
 
 
@@ -387,8 +457,11 @@ def test_sparse_mass_for_a_batch_is_refused():
 def test_bad_initial_time_is_refused(kind, t0, shown):
     """t0 must be a finite real number; even an int too large for a float is a ModelError."""
     f = counted(restoring)
-    build = (lambda: FirstOrderProblem(f, [1.0], t0=t0)) if kind == "first-order" else (
-        lambda: SecondOrderProblem(f, [1.0], [0.0], t0=t0))
+    build = (
+        (lambda: FirstOrderProblem(f, [1.0], t0=t0))
+        if kind == "first-order"
+        else (lambda: SecondOrderProblem(f, [1.0], [0.0], t0=t0))
+    )
     refused(build, "`t0`", shown)
     assert f.calls == 0
 
@@ -400,8 +473,16 @@ def test_bad_initial_time_is_refused(kind, t0, shown):
 @pytest.mark.parametrize("method", ["rk4", "dopri5", "backward_euler"])
 @pytest.mark.parametrize(
     ("dt", "shown"),
-    [(0, "0"), (-1, "-1"), (-0.0, "-0.0"), (math.nan, "nan"), (math.inf, "inf"),
-     ("0.1", "'0.1'"), (True, "True"), (1j, "1j")],
+    [
+        (0, "0"),
+        (-1, "-1"),
+        (-0.0, "-0.0"),
+        (math.nan, "nan"),
+        (math.inf, "inf"),
+        ("0.1", "'0.1'"),
+        (True, "True"),
+        (1j, "1j"),
+    ],
     ids=["zero", "negative", "negative-zero", "nan", "inf", "string", "True", "complex"],
 )
 def test_solve_refuses_bad_dt(decay, method, dt, shown):
@@ -421,8 +502,7 @@ def test_solve_refuses_dt_too_small_to_count_the_steps(decay):
 @pytest.mark.parametrize("method", ["rk4", "dopri5"])
 @pytest.mark.parametrize(
     ("t_end", "fragments"),
-    [(-1.0, ("-1.0", "t0", "0.0")), (math.nan, ("nan",)), ("1", ("'1'",)),
-     (10**400, ())],
+    [(-1.0, ("-1.0", "t0", "0.0")), (math.nan, ("nan",)), ("1", ("'1'",)), (10**400, ())],
     ids=["before-t0", "nan", "string", "int-beyond-float"],
 )
 def test_solve_refuses_bad_t_end(decay, method, t_end, fragments):
@@ -439,8 +519,11 @@ def test_solve_refuses_bad_t_end(decay, method, t_end, fragments):
 def test_unknown_method_lists_valid_names_and_suggests_the_closest(spring, typo, suggestion):
     """A misspelt method gets "Did you mean" plus every valid name; nothing is integrated."""
     problem, acceleration = spring
-    message = refused(lambda: vv.solve(problem, typo, dt=0.1, t_end=1.0),
-                      repr(typo), f"Did you mean {suggestion}?")
+    message = refused(
+        lambda: vv.solve(problem, typo, dt=0.1, t_end=1.0),
+        repr(typo),
+        f"Did you mean {suggestion}?",
+    )
     for name in vv.integrators.names():
         assert name in message
     assert acceleration.calls == 0
@@ -449,14 +532,20 @@ def test_unknown_method_lists_valid_names_and_suggests_the_closest(spring, typo,
 def test_unknown_method_far_from_every_name_lists_the_valid_ones(decay):
     """A name close to nothing gets the list of valid names and no misleading suggestion."""
     problem, f = decay
-    message = refused(lambda: vv.solve(problem, "no_such_method", dt=0.1, t_end=1.0),
-                      "'no_such_method'", "rk4", "velocity_verlet", "dopri5")
+    message = refused(
+        lambda: vv.solve(problem, "no_such_method", dt=0.1, t_end=1.0),
+        "'no_such_method'",
+        "rk4",
+        "velocity_verlet",
+        "dopri5",
+    )
     assert "Did you mean" not in message
     assert f.calls == 0
 
 
-@pytest.mark.parametrize(("method", "type_name"), [(4, "int"), (None, "NoneType"),
-                                                   (["rk4"], "list")])
+@pytest.mark.parametrize(
+    ("method", "type_name"), [(4, "int"), (None, "NoneType"), (["rk4"], "list")]
+)
 def test_method_that_is_not_a_name_is_refused(decay, method, type_name):
     """method must be a name or an Integrator; the type received is named."""
     problem, f = decay
@@ -468,8 +557,12 @@ def test_method_that_is_not_a_name_is_refused(decay, method, type_name):
 def test_split_state_method_on_first_order_problem_is_refused(decay, method):
     """Symplectic (q, v) methods need a SecondOrderProblem; the message says how to build one."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, method, dt=0.1, t_end=1.0),
-            repr(method), "second-order", "SecondOrderProblem")
+    refused(
+        lambda: vv.solve(problem, method, dt=0.1, t_end=1.0),
+        repr(method),
+        "second-order",
+        "SecondOrderProblem",
+    )
     assert f.calls == 0
 
 
@@ -480,8 +573,11 @@ def test_split_state_method_on_first_order_problem_is_refused(decay, method):
 def test_adaptive_options_are_refused_for_fixed_step_methods(decay, option, value):
     """rtol/atol/t_eval/dense_output would be silently ignored by rk4: refused instead."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, "rk4", dt=0.1, t_end=1.0, **{option: value}),
-            f"`{option}`", "adaptive")
+    refused(
+        lambda: vv.solve(problem, "rk4", dt=0.1, t_end=1.0, **{option: value}),
+        f"`{option}`",
+        "adaptive",
+    )
     assert f.calls == 0
 
 
@@ -495,66 +591,92 @@ def test_fixed_step_method_needs_dt(decay):
 def test_adaptive_run_needs_a_method_with_error_control(decay):
     """adaptive=True for rk4 is refused and the adaptive methods are listed."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, "rk4", dt=0.1, t_end=1.0, adaptive=True),
-            "'rk4'", "error control", "dopri5")
+    refused(
+        lambda: vv.solve(problem, "rk4", dt=0.1, t_end=1.0, adaptive=True),
+        "'rk4'",
+        "error control",
+        "dopri5",
+    )
     assert f.calls == 0
 
 
 @pytest.mark.parametrize(
     ("option", "value", "shown"),
-    [("record_every", 0, "0"), ("record_every", 1.5, "1.5"), ("record_every", -2, "-2"),
-     ("substeps", 0, "0"), ("substeps", 2.0, "2.0")],
+    [
+        ("record_every", 0, "0"),
+        ("record_every", 1.5, "1.5"),
+        ("record_every", -2, "-2"),
+        ("substeps", 0, "0"),
+        ("substeps", 2.0, "2.0"),
+    ],
 )
 def test_record_every_and_substeps_must_be_positive_whole_numbers(decay, option, value, shown):
     """Frame and substep counts are whole numbers ≥ 1; a bad one is named with its value."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, "rk4", dt=0.1, t_end=1.0, **{option: value}),
-            f"`{option}`", shown)
+    refused(
+        lambda: vv.solve(problem, "rk4", dt=0.1, t_end=1.0, **{option: value}), f"`{option}`", shown
+    )
     assert f.calls == 0
 
 
 @pytest.mark.parametrize(
     ("t_eval", "fragments"),
-    [([-0.5, 0.5], ("[t0, t_end]", "-0.5")), ([0.5, 2.0], ("[t0, t_end]", "2.0")),
-     ([0.5, 0.2], ("increasing", "0.2")), ([0.5, 0.5, 0.7], ("increasing", "0.5")),
-     ([], ("empty",)), ([0.5, math.nan], ("finite", "nan"))],
+    [
+        ([-0.5, 0.5], ("[t0, t_end]", "-0.5")),
+        ([0.5, 2.0], ("[t0, t_end]", "2.0")),
+        ([0.5, 0.2], ("increasing", "0.2")),
+        ([0.5, 0.5, 0.7], ("increasing", "0.5")),
+        ([], ("empty",)),
+        ([0.5, math.nan], ("finite", "nan")),
+    ],
     ids=["before-t0", "after-t_end", "decreasing", "repeated", "empty", "nan"],
 )
 def test_dopri5_refuses_bad_t_eval(decay, t_eval, fragments):
     """Output times must be finite, strictly increasing and inside [t0, t_end]; the offending
     time is shown."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, "dopri5", t_end=1.0, t_eval=t_eval), "`t_eval`",
-            *fragments)
+    refused(lambda: vv.solve(problem, "dopri5", t_end=1.0, t_eval=t_eval), "`t_eval`", *fragments)
     assert f.calls == 0
 
 
 @pytest.mark.parametrize(
-    ("option", "value"), [("rtol", 0.0), ("rtol", math.nan), ("atol", -1e-9)],
+    ("option", "value"),
+    [("rtol", 0.0), ("rtol", math.nan), ("atol", -1e-9)],
 )
 def test_dopri5_refuses_bad_tolerances(decay, option, value):
     """Tolerances must be finite, rtol > 0 and atol ≥ 0."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, "dopri5", t_end=1.0, **{option: value}), f"`{option}`",
-            repr(value))
+    refused(
+        lambda: vv.solve(problem, "dopri5", t_end=1.0, **{option: value}),
+        f"`{option}`",
+        repr(value),
+    )
     assert f.calls == 0
 
 
-@pytest.mark.parametrize(("method", "fragments"), [("rk4", ("'rk4'", "Numba")),
-                                                  ("dopri5", ("fixed-step",))])
+@pytest.mark.parametrize(
+    ("method", "fragments"), [("rk4", ("'rk4'", "Numba")), ("dopri5", ("fixed-step",))]
+)
 def test_compiled_true_that_cannot_be_honoured_is_refused(decay, method, fragments):
     """compiled=True with a NumPy f, or with an adaptive method, is refused, not ignored."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, method, dt=0.1, t_end=1.0, compiled=True),
-            "compiled=True", *fragments)
+    refused(
+        lambda: vv.solve(problem, method, dt=0.1, t_end=1.0, compiled=True),
+        "compiled=True",
+        *fragments,
+    )
     assert f.calls == 0
 
 
 @pytest.mark.parametrize("run", [vv.solve, vv.simulate], ids=["solve", "simulate"])
 def test_something_that_is_not_a_problem_is_refused(run):
     """Passing the right-hand side itself instead of a problem is a ModelError naming `problem`."""
-    refused(lambda: run(restoring, "rk4", dt=0.1, t_end=1.0), "`problem`", "function",
-            "FirstOrderProblem")
+    refused(
+        lambda: run(restoring, "rk4", dt=0.1, t_end=1.0),
+        "`problem`",
+        "function",
+        "FirstOrderProblem",
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -580,8 +702,9 @@ def test_something_that_is_not_a_problem_is_refused(run):
         ({"compiled": True}, ("compiled=True", "'rk4'")),
         ({"divergence_limit": -1.0}, ("`divergence_limit`", "-1.0")),
     ],
-    ids=lambda value: "-".join(f"{k}={v}" for k, v in value.items())
-    if isinstance(value, dict) else None,
+    ids=lambda value: (
+        "-".join(f"{k}={v}" for k, v in value.items()) if isinstance(value, dict) else None
+    ),
 )
 def test_simulate_refuses_bad_arguments(decay, arguments, fragments):
     """vv.simulate names the bad argument and its value, and never calls f."""
@@ -595,8 +718,11 @@ def test_simulate_refuses_bad_arguments(decay, arguments, fragments):
 def test_simulate_refuses_symplectic_method_on_first_order_problem(decay):
     """velocity_verlet needs the split (q, v) state; simulate says so before stepping."""
     problem, f = decay
-    refused(lambda: vv.simulate(problem, "velocity_verlet", dt=0.1, t_end=1.0),
-            "'velocity_verlet'", "SecondOrderProblem")
+    refused(
+        lambda: vv.simulate(problem, "velocity_verlet", dt=0.1, t_end=1.0),
+        "'velocity_verlet'",
+        "SecondOrderProblem",
+    )
     assert f.calls == 0
 
 
@@ -611,8 +737,12 @@ class _NotAnIntegrator:
 
 @pytest.mark.parametrize(
     ("candidate", "type_name"),
-    [(object(), "object"), ("rk4", "str"), (lambda system, state, dt: state, "function"),
-     (_NotAnIntegrator, "_NotAnIntegrator")],
+    [
+        (object(), "object"),
+        ("rk4", "str"),
+        (lambda system, state, dt: state, "function"),
+        (_NotAnIntegrator, "_NotAnIntegrator"),
+    ],
     ids=["object", "name", "function", "look-alike-class"],
 )
 def test_register_refuses_what_is_not_an_integrator(candidate, type_name):
@@ -626,21 +756,24 @@ def test_register_refuses_what_is_not_an_integrator(candidate, type_name):
     assert vv.integrators.names() == before
 
 
-@pytest.mark.parametrize("candidate", [vv.integrators.RungeKutta4, vv.integrators.RungeKutta4()],
-                         ids=["class", "instance"])
+@pytest.mark.parametrize(
+    "candidate",
+    [vv.integrators.RungeKutta4, vv.integrators.RungeKutta4()],
+    ids=["class", "instance"],
+)
 def test_register_refuses_a_taken_name(candidate):
     """A second 'rk4' needs replace=True; the registered method stays the original."""
     original = vv.integrators.get("rk4")
-    refused(lambda: vv.integrators.register(candidate), "'rk4'", "already registered",
-            "replace=True")
+    refused(
+        lambda: vv.integrators.register(candidate), "'rk4'", "already registered", "replace=True"
+    )
     assert vv.integrators.get("rk4") is original
 
 
 @pytest.mark.parametrize(("typo", "suggestion"), [("rk5", "'rk4'"), ("leap_frog", "'leapfrog'")])
 def test_get_unknown_name_suggests_and_lists(typo, suggestion):
     """vv.integrators.get names the unknown method, suggests the closest, lists all."""
-    message = refused(lambda: vv.integrators.get(typo), repr(typo),
-                      f"Did you mean {suggestion}?")
+    message = refused(lambda: vv.integrators.get(typo), repr(typo), f"Did you mean {suggestion}?")
     for name in vv.integrators.names():
         assert name in message
 
@@ -671,16 +804,24 @@ def test_max_stable_dt_refuses_a_bad_jacobian(jacobian, shown):
 
 def test_max_stable_dt_blames_the_eigenvalues_it_was_given():
     """Non-finite eigenvalues are reported as such, not as a Jacobian the user never passed."""
-    message = refused(lambda: vv.analysis.max_stable_dt("rk4", eigenvalues=[-1.0, math.nan]),
-                      "`eigenvalues`", "nan")
+    message = refused(
+        lambda: vv.analysis.max_stable_dt("rk4", eigenvalues=[-1.0, math.nan]),
+        "`eigenvalues`",
+        "nan",
+    )
     assert "jacobian" not in message.lower()
 
 
 @pytest.mark.parametrize("axis", ["diagonal", "imag", ""])
 def test_stability_interval_names_the_valid_axes(axis):
     """Only the real and imaginary axes have intervals; the message lists both."""
-    refused(lambda: vv.analysis.stability_interval("rk4", axis=axis), "`axis`", repr(axis),
-            "'real'", "'imaginary'")
+    refused(
+        lambda: vv.analysis.stability_interval("rk4", axis=axis),
+        "`axis`",
+        repr(axis),
+        "'real'",
+        "'imaginary'",
+    )
 
 
 def test_stability_interval_of_unknown_method_suggests_the_closest():
@@ -696,10 +837,16 @@ def test_stability_interval_of_unknown_method_suggests_the_closest():
     ("call", "shown"),
     [
         (lambda: FirstOrderProblem(restoring, [1.0, math.nan]), "entry 1 is nan"),
-        (lambda: FirstOrderProblem(lambda t, y: np.array([-y[0], math.inf]), [1.0, 0.5]),
-         "returned inf"),
-        (lambda: vv.solve(FirstOrderProblem(restoring, [1.0]), "dopri5", t_end=1.0,
-                          t_eval=[0.5, 2.0]), "[0.5, 2.0]"),
+        (
+            lambda: FirstOrderProblem(lambda t, y: np.array([-y[0], math.inf]), [1.0, 0.5]),
+            "returned inf",
+        ),
+        (
+            lambda: vv.solve(
+                FirstOrderProblem(restoring, [1.0]), "dopri5", t_end=1.0, t_eval=[0.5, 2.0]
+            ),
+            "[0.5, 2.0]",
+        ),
     ],
     ids=["initial-state", "function-result", "t_eval-range"],
 )

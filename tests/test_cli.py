@@ -62,8 +62,14 @@ def executable() -> str:
 
 def run_executable(executable: str, cwd: Path, *args: str | Path) -> subprocess.CompletedProcess:
     """Run the real ``visviva`` command in ``cwd``."""
-    return subprocess.run([executable, *map(str, args)], cwd=cwd, capture_output=True,
-                          text=True, timeout=120, check=False)
+    return subprocess.run(
+        [executable, *map(str, args)],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
 
 
 def assert_user_error(status: int, stderr: str, *fragments: str) -> str:
@@ -80,8 +86,11 @@ def assert_user_error(status: int, stderr: str, *fragments: str) -> str:
 
 def snapshot(directory: Path) -> dict[str, tuple[int, bytes]]:
     """Modification time (ns) and contents of every file in ``directory``."""
-    return {p.name: (p.stat().st_mtime_ns, p.read_bytes())
-            for p in sorted(directory.iterdir()) if p.is_file()}
+    return {
+        p.name: (p.stat().st_mtime_ns, p.read_bytes())
+        for p in sorted(directory.iterdir())
+        if p.is_file()
+    }
 
 
 # --------------------------------------------------------------------------------------------
@@ -105,7 +114,10 @@ def test_integrators_json_describes_every_registered_method():
         assert {"name", "order", "implicit", "symplectic"} <= set(row)
         method = vv.integrators.get(row["name"])
         assert (row["order"], row["implicit"], row["symplectic"]) == (
-            method.order, method.implicit, method.symplectic)
+            method.order,
+            method.implicit,
+            method.symplectic,
+        )
     rows = {row["name"]: row for row in table}
     assert rows["rk4"]["order"] == 4
     assert rows["rk4"]["implicit"] is False
@@ -123,8 +135,9 @@ def test_stability_json_gives_the_textbook_intervals():
     assert set(intervals) == {"rk4", "explicit_euler"}
     rk4 = intervals["rk4"]
     assert rk4["real"] == pytest.approx([-2.7853, 0.0], abs=1e-3)
-    assert rk4["imaginary"] == pytest.approx([-2.0 * math.sqrt(2.0), 2.0 * math.sqrt(2.0)],
-                                             abs=1e-3)
+    assert rk4["imaginary"] == pytest.approx(
+        [-2.0 * math.sqrt(2.0), 2.0 * math.sqrt(2.0)], abs=1e-3
+    )
     euler = intervals["explicit_euler"]
     assert euler["real"] == pytest.approx([-2.0, 0.0], abs=1e-3)
     assert euler["imaginary"] == pytest.approx([0.0, 0.0], abs=1e-3)
@@ -140,7 +153,8 @@ def test_stability_json_writes_unbounded_ends_as_strings():
 
 
 def test_stability_plot_is_a_png_and_is_not_overwritten_without_force(
-        tmp_path, monkeypatch, capsys):
+    tmp_path, monkeypatch, capsys
+):
     """`-o x.png` writes a PNG; a second run refuses (exit 2) and leaves it untouched."""
     target = tmp_path / "x.png"
     invoke("stability", "rk4", "-o", target)
@@ -159,8 +173,7 @@ def test_stability_plot_is_a_png_and_is_not_overwritten_without_force(
 def test_stability_unknown_method_exits_2_through_the_real_command(executable, tmp_path):
     """`visviva stability rk5`: status 2, one line naming rk5, a suggestion and valid names."""
     completed = run_executable(executable, tmp_path, "stability", "rk5")
-    line = assert_user_error(completed.returncode, completed.stderr, "'rk5'",
-                             "Did you mean 'rk4'?")
+    line = assert_user_error(completed.returncode, completed.stderr, "'rk5'", "Did you mean 'rk4'?")
     assert completed.stdout == ""
     # The fresh process knows the built-in methods only (tests may register more in-process).
     listing = run_executable(executable, tmp_path, "integrators", "--json")
@@ -174,8 +187,7 @@ def test_stability_plot_onto_a_directory_is_a_user_error(executable, tmp_path):
     """`-o DIR --force` with an existing directory is refused with one line, not a traceback."""
     directory = tmp_path / "plots"
     directory.mkdir()
-    completed = run_executable(executable, tmp_path, "stability", "rk4", "-o", directory,
-                               "--force")
+    completed = run_executable(executable, tmp_path, "stability", "rk4", "-o", directory, "--force")
     assert_user_error(completed.returncode, completed.stderr, "plots")
     assert directory.is_dir()
 
@@ -197,10 +209,10 @@ def test_convergence_measures_the_declared_orders():
 
 def test_convergence_unknown_problem_lists_the_available_ones(monkeypatch, capsys):
     """`--problem nosuch` exits 2 naming the problem and listing the reference problems."""
-    status, stdout, stderr = run_main(monkeypatch, capsys, "convergence", "rk4",
-                                      "--problem", "nosuch")
-    assert_user_error(status, stderr, "'nosuch'", "pendulum", "forced", "damped",
-                      "first-order")
+    status, stdout, stderr = run_main(
+        monkeypatch, capsys, "convergence", "rk4", "--problem", "nosuch"
+    )
+    assert_user_error(status, stderr, "'nosuch'", "pendulum", "forced", "damped", "first-order")
     assert stdout == ""
 
 
@@ -278,8 +290,7 @@ def test_demo_outputs_get_ordinary_file_permissions(oscillator_run):
     reference = oscillator_run.parent / "reference.txt"
     reference.write_text("made with open()\n")
     expected = stat.S_IMODE(reference.stat().st_mode)
-    modes = {name: oct(stat.S_IMODE((oscillator_run / name).stat().st_mode))
-             for name in DEMO_FILES}
+    modes = {name: oct(stat.S_IMODE((oscillator_run / name).stat().st_mode)) for name in DEMO_FILES}
     assert modes == dict.fromkeys(DEMO_FILES, oct(expected))
 
 
@@ -289,7 +300,8 @@ def test_stability_plot_gets_ordinary_file_permissions(tmp_path):
     reference.write_text("made with open()\n")
     invoke("stability", "rk4", "-o", tmp_path / "x.png")
     assert oct(stat.S_IMODE((tmp_path / "x.png").stat().st_mode)) == oct(
-        stat.S_IMODE(reference.stat().st_mode))
+        stat.S_IMODE(reference.stat().st_mode)
+    )
 
 
 def test_demo_refuses_to_overwrite_without_force(tmp_path, monkeypatch, capsys):
@@ -299,8 +311,9 @@ def test_demo_refuses_to_overwrite_without_force(tmp_path, monkeypatch, capsys):
     before = snapshot(directory)
     assert set(before) == set(DEMO_FILES)
 
-    status, _, stderr = run_main(monkeypatch, capsys, "demo", "oscillator", "-o", directory,
-                                 "--duration", "0.2")
+    status, _, stderr = run_main(
+        monkeypatch, capsys, "demo", "oscillator", "-o", directory, "--duration", "0.2"
+    )
     assert_user_error(status, stderr, str(directory), "--force")
     assert snapshot(directory) == before
 
@@ -312,8 +325,10 @@ def test_demo_refuses_to_overwrite_without_force(tmp_path, monkeypatch, capsys):
 
 @pytest.mark.parametrize(
     ("name", "fragments"),
-    [("nosuch", ("'nosuch'", "oscillator", "circular", "test-equation")),
-     ("oscilator", ("'oscilator'", "Did you mean 'oscillator'?"))],
+    [
+        ("nosuch", ("'nosuch'", "oscillator", "circular", "test-equation")),
+        ("oscilator", ("'oscilator'", "Did you mean 'oscillator'?")),
+    ],
 )
 def test_demo_unknown_name_exits_2(tmp_path, monkeypatch, capsys, name, fragments):
     """An unknown demo lists the available ones; a near miss gets a suggestion; no output."""
@@ -324,8 +339,9 @@ def test_demo_unknown_name_exits_2(tmp_path, monkeypatch, capsys, name, fragment
 
 def test_demo_negative_duration_exits_2_through_the_real_command(executable, tmp_path):
     """`--duration -1` is refused by the real command with one line naming `duration`."""
-    completed = run_executable(executable, tmp_path, "demo", "circular", "--duration", "-1",
-                               "-o", tmp_path / "out")
+    completed = run_executable(
+        executable, tmp_path, "demo", "circular", "--duration", "-1", "-o", tmp_path / "out"
+    )
     assert_user_error(completed.returncode, completed.stderr, "`duration`", "-1")
     assert not (tmp_path / "out").exists()
 

@@ -19,10 +19,12 @@ OMEGA = 3.0
 
 def _oscillator(compiled=False):
     if compiled:
+
         @numba.njit
         def acceleration(t, q, out):
             out[0] = -(OMEGA**2) * q[0]
     else:
+
         def acceleration(t, q):
             return -(OMEGA**2) * q
 
@@ -32,7 +34,10 @@ def _oscillator(compiled=False):
     # Released from rest: E(0) equals the modified energy a symplectic method conserves, so
     # the bounds below hold from the first step (Hairer, Lubich & Wanner 2006, §I.1).
     return vv.ode.SecondOrderProblem(
-        acceleration, q0=[1.0], v0=[0.0], energy=energy,
+        acceleration,
+        q0=[1.0],
+        v0=[0.0],
+        energy=energy,
         jacobian=lambda t, q: np.full(q.shape + (1,), -(OMEGA**2)),
     )
 
@@ -48,18 +53,22 @@ def test_euler_energy_factor_is_exact(method, sign):
 
 
 def _energy_error(method, dt, steps):
-    solution = vv.solve(_oscillator(compiled=True), method, dt=dt, t_end=steps * dt,
-                        record_every=100)
+    solution = vv.solve(
+        _oscillator(compiled=True), method, dt=dt, t_end=steps * dt, record_every=100
+    )
     assert solution.recording.attrs["compiled"]
     return solution.energy / solution.energy[0] - 1.0
 
 
-@pytest.mark.parametrize(("method", "bound"), [
-    ("symplectic_euler", lambda wh: 0.55 * wh),
-    ("symplectic_euler_position_first", lambda wh: 0.55 * wh),
-    ("velocity_verlet", lambda wh: 0.3 * wh**2),
-    ("leapfrog", lambda wh: 0.3 * wh**2),
-])
+@pytest.mark.parametrize(
+    ("method", "bound"),
+    [
+        ("symplectic_euler", lambda wh: 0.55 * wh),
+        ("symplectic_euler_position_first", lambda wh: 0.55 * wh),
+        ("velocity_verlet", lambda wh: 0.3 * wh**2),
+        ("leapfrog", lambda wh: 0.3 * wh**2),
+    ],
+)
 @pytest.mark.parametrize("omega_h", [0.05, 0.1])
 def test_symplectic_energy_error_is_bounded_without_drift(method, bound, omega_h):
     """Over 1e6 steps |E/E0 − 1| stays below the bound and shows no secular trend: the
@@ -107,15 +116,26 @@ def test_runge_kutta_slowly_loses_energy(method):
 @pytest.mark.parametrize("method", ["velocity_verlet", "leapfrog"])
 def test_verlet_runs_backwards_to_its_start(method):
     """Time reversibility: n steps forward, flip v, n steps, flip v → start to ≤ 1e-13."""
+
     def acceleration(t, q):
         return -np.sin(q) - 0.3 * q**3  # nonlinear, position-only
 
     q0, v0 = np.array([0.8, -0.3]), np.array([0.2, 1.1])
-    forward = vv.solve(vv.ode.SecondOrderProblem(acceleration, q0, v0), method, dt=0.01,
-                       t_end=10.0, record_every=1000)
+    forward = vv.solve(
+        vv.ode.SecondOrderProblem(acceleration, q0, v0),
+        method,
+        dt=0.01,
+        t_end=10.0,
+        record_every=1000,
+    )
     q1, v1 = forward.q[-1], forward.v[-1]
-    back = vv.solve(vv.ode.SecondOrderProblem(acceleration, q1, -v1), method, dt=0.01,
-                    t_end=10.0, record_every=1000)
+    back = vv.solve(
+        vv.ode.SecondOrderProblem(acceleration, q1, -v1),
+        method,
+        dt=0.01,
+        t_end=10.0,
+        record_every=1000,
+    )
     np.testing.assert_allclose(back.q[-1], q0, rtol=0, atol=1e-13)
     np.testing.assert_allclose(-back.v[-1], v0, rtol=0, atol=1e-13)
 

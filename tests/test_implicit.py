@@ -19,8 +19,9 @@ def _without_jacobian(problem):
     energy = None if problem.energy is None else problem.energy.func
     if problem.kind == "first_order":
         return vv.ode.FirstOrderProblem(problem.f.func, problem.y0, problem.t0, energy=energy)
-    return vv.ode.SecondOrderProblem(problem.force.func, problem.q0, problem.v0, problem.t0,
-                                     energy=energy)
+    return vv.ode.SecondOrderProblem(
+        problem.force.func, problem.q0, problem.v0, problem.t0, energy=energy
+    )
 
 
 @pytest.mark.parametrize("method", IMPLICIT)
@@ -32,14 +33,16 @@ def test_finite_difference_newton_agrees_with_analytic(method, name):
     analytic = vv.solve(problem, method, dt=0.05, t_end=3.0)
     numeric = vv.solve(_without_jacobian(problem), method, dt=0.05, t_end=3.0)
     for field in analytic.recording.fields:
-        np.testing.assert_allclose(numeric.recording[field], analytic.recording[field],
-                                   rtol=0, atol=1e-9)
+        np.testing.assert_allclose(
+            numeric.recording[field], analytic.recording[field], rtol=0, atol=1e-9
+        )
     assert numeric.counters["f_evaluations"] > analytic.counters["f_evaluations"]
     assert analytic.counters["newton_iterations"] == analytic.counters["linear_solves"]
 
 
-@pytest.mark.parametrize("name", [n for n in reference_problems()
-                                  if reference_problem(n).problem.jacobian is not None])
+@pytest.mark.parametrize(
+    "name", [n for n in reference_problems() if reference_problem(n).problem.jacobian is not None]
+)
 def test_reference_jacobians_match_finite_differences(name):
     """Every analytic Jacobian shipped with a reference problem equals differences of its f."""
     problem = reference_problem(name).problem
@@ -59,12 +62,18 @@ def test_reference_jacobians_match_finite_differences(name):
             force = system.force(t, q, v)
             stiffness, damping = system.force_jacobian(t, q, v)
             np.testing.assert_allclose(
-                stiffness, _finite_difference(lambda x: system.force(t, x, v), q, force),
-                rtol=1e-6, atol=1e-6)
+                stiffness,
+                _finite_difference(lambda x: system.force(t, x, v), q, force),
+                rtol=1e-6,
+                atol=1e-6,
+            )
             if damping is not None:
                 np.testing.assert_allclose(
-                    damping, _finite_difference(lambda x: system.force(t, q, x), v, force),
-                    rtol=1e-6, atol=1e-6)
+                    damping,
+                    _finite_difference(lambda x: system.force(t, q, x), v, force),
+                    rtol=1e-6,
+                    atol=1e-6,
+                )
 
 
 def test_demo_jacobians_match_finite_differences():
@@ -75,16 +84,16 @@ def test_demo_jacobians_match_finite_differences():
     for problem in (oscillator_problem(), circular_problem()):
         system = problem.system()
         q = np.array([0.37])
-        numeric = _finite_difference(lambda x: system.force(0.0, x, x), q,
-                                     system.force(0.0, q, q))
+        numeric = _finite_difference(lambda x: system.force(0.0, x, x), q, system.force(0.0, q, q))
         np.testing.assert_allclose(system.force_jacobian(0.0, q, q)[0], numeric, rtol=1e-6)
 
 
 def _chain(n, k=50.0, damping=0.3):
     """n unit masses on a line, joined by springs k and dashpots, both ends fixed:
     F = K q + D v with tridiagonal K = k·(−2, 1, 1), D = −damping·I."""
-    stiffness = sp.diags([np.full(n - 1, k), np.full(n, -2 * k), np.full(n - 1, k)], [-1, 0, 1],
-                         format="csr")
+    stiffness = sp.diags(
+        [np.full(n - 1, k), np.full(n, -2 * k), np.full(n - 1, k)], [-1, 0, 1], format="csr"
+    )
 
     def force(t, q, v):
         return stiffness @ q - damping * v
@@ -99,7 +108,7 @@ def _chain(n, k=50.0, damping=0.3):
 @pytest.mark.parametrize("method", IMPLICIT)
 def test_sparse_newton_matches_dense(method):
     """A 200-mass chain with a scipy.sparse Jacobian (SuperLU) gives the dense result."""
-    force, jacobian, q0, stiffness = _chain(200)
+    force, jacobian, q0, _ = _chain(200)
 
     def dense_jacobian(t, q, v):
         k, d = jacobian(t, q, v)
@@ -130,16 +139,18 @@ def test_backward_euler_is_exact_for_the_linear_chain_recurrence():
 
 
 @pytest.mark.parametrize("form", ["diagonal", "dense", "sparse"])
-@pytest.mark.parametrize("method", ["backward_euler", "implicit_midpoint", "rk4",
-                                    "velocity_verlet"])
+@pytest.mark.parametrize(
+    "method", ["backward_euler", "implicit_midpoint", "rk4", "velocity_verlet"]
+)
 def test_mass_matrix_forms_agree(form, method):
     """M q'' = F with M given as a diagonal, a dense or a sparse matrix: the same motion as
     the acceleration M⁻¹F (here M = diag(1, 2, 3) kg on a chain of three springs)."""
     masses = np.array([1.0, 2.0, 3.0])
     force, jacobian, q0, _ = _chain(3, k=5.0)
     mass = {"diagonal": masses, "dense": np.diag(masses), "sparse": sp.diags(masses)}[form]
-    with_mass = vv.ode.SecondOrderProblem.from_force(force, mass, q0, np.zeros(3),
-                                                     jacobian=jacobian)
+    with_mass = vv.ode.SecondOrderProblem.from_force(
+        force, mass, q0, np.zeros(3), jacobian=jacobian
+    )
     scaled = vv.ode.SecondOrderProblem(lambda t, q, v: force(t, q, v) / masses, q0, np.zeros(3))
     a = vv.solve(with_mass, method, dt=0.01, t_end=1.0)
     b = vv.solve(scaled, method, dt=0.01, t_end=1.0)
@@ -150,21 +161,28 @@ def test_batched_newton_equals_separate_solves():
     """One Newton iteration over a batch solves each system's own (n × n) matrix."""
     problem = reference_problem("pendulum").problem
     angles = np.array([[0.3], [1.0], [2.5], [3.0]])
-    batch = vv.ode.SecondOrderProblem(problem.force.func, angles, np.zeros_like(angles),
-                                      jacobian=problem.jacobian.func)
+    batch = vv.ode.SecondOrderProblem(
+        problem.force.func, angles, np.zeros_like(angles), jacobian=problem.jacobian.func
+    )
     together = vv.solve(batch, "trapezoidal", dt=0.1, t_end=5.0)
     for i, angle in enumerate(angles):
-        alone = vv.solve(vv.ode.SecondOrderProblem(problem.force.func, angle, [0.0],
-                                                   jacobian=problem.jacobian.func),
-                         "trapezoidal", dt=0.1, t_end=5.0)
+        alone = vv.solve(
+            vv.ode.SecondOrderProblem(
+                problem.force.func, angle, [0.0], jacobian=problem.jacobian.func
+            ),
+            "trapezoidal",
+            dt=0.1,
+            t_end=5.0,
+        )
         np.testing.assert_allclose(together.q[:, i], alone.q, rtol=0, atol=1e-10)
 
 
 def test_stiff_decay_is_handled_by_backward_euler_not_explicit():
     """Seed 000 on stiffness: λ = −1e4 with dt = 0.01 (hλ = −100). Explicit Euler diverges and
     says why; backward Euler decays like the exact solution."""
-    problem = vv.ode.FirstOrderProblem(lambda t, y: -1e4 * (y - np.cos(t)), [2.0],
-                                       jacobian=lambda t, y: np.full((1, 1), -1e4))
+    problem = vv.ode.FirstOrderProblem(
+        lambda t, y: -1e4 * (y - np.cos(t)), [2.0], jacobian=lambda t, y: np.full((1, 1), -1e4)
+    )
     assert not vv.solve(problem, "explicit_euler", dt=0.01, t_end=10.0).success
     implicit = vv.solve(problem, "backward_euler", dt=0.01, t_end=10.0)
     # After the transient, y follows cos t to O(1/|λ|) plus the O(h) method error.

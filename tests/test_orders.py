@@ -5,6 +5,8 @@ slope of log(error) against log(dt) over the asymptotic range must equal p. Meth
 from the registry at collection time, so a newly registered method is checked automatically.
 """
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -37,7 +39,10 @@ def test_declared_order_is_measured(method, problem):
     """Fitted slope within ±0.1 of the declared order, over at least three step sizes."""
     reference = reference_problem(problem)
     study = vv.analysis.convergence_order(
-        reference.problem, method, t_end=2.0, reference=reference.exact,
+        reference.problem,
+        method,
+        t_end=2.0,
+        reference=reference.exact,
         dt=_steps(problem, vv.integrators.get(method).order),
     )
     assert study.used.sum() >= 3, study
@@ -50,7 +55,10 @@ def test_errors_halve_for_first_order_methods():
     """Seed 000: halving dt halves explicit Euler's error (ratio → 2 as dt → 0)."""
     reference = reference_problem("forced")
     study = vv.analysis.convergence_order(
-        reference.problem, "explicit_euler", t_end=1.0, reference=reference.exact,
+        reference.problem,
+        "explicit_euler",
+        t_end=1.0,
+        reference=reference.exact,
         dt=[1e-2 / 2**k for k in range(5)],
     )
     ratios = study.error[:-1] / study.error[1:]
@@ -60,8 +68,9 @@ def test_errors_halve_for_first_order_methods():
 def test_taylor_update_is_exact_for_constant_force():
     """Seed 002's x + vΔt + ½aΔt² reproduces the thrown rock's parabola to round-off."""
     g = np.array([0.0, -9.81])
-    rock = vv.ode.SecondOrderProblem(lambda t, q: np.broadcast_to(g, q.shape).copy(),
-                                     q0=[0.0, 1.0], v0=[3.0, 4.0])
+    rock = vv.ode.SecondOrderProblem(
+        lambda t, q: np.broadcast_to(g, q.shape).copy(), q0=[0.0, 1.0], v0=[3.0, 4.0]
+    )
     solution = vv.solve(rock, "taylor", dt=0.1, t_end=0.8)
     t = solution.t[:, None]
     expected = np.array([0.0, 1.0]) + np.array([3.0, 4.0]) * t + 0.5 * g * t**2
@@ -79,7 +88,7 @@ def test_adaptive_dopri5_meets_its_tolerance():
         errors.append(max(abs(solution.q[-1, 0] - exact_q[0]), abs(solution.v[-1, 0] - exact_v[0])))
         # Global error of a few times the local tolerance over ~1.6 periods.
         assert errors[-1] < 50 * rtol
-    assert all(a > b for a, b in zip(errors, errors[1:], strict=False))
+    assert all(a > b for a, b in itertools.pairwise(errors))
 
 
 def test_dopri5_dense_output_is_fourth_order_between_steps():
@@ -108,8 +117,9 @@ def test_dopri5_t_eval_interpolates_to_the_requested_times():
     """Recording at t_eval uses the dense output: times exact, values within tolerance."""
     reference = reference_problem("first-order")
     times = np.linspace(0.0, 2.0, 17)
-    solution = vv.solve(reference.problem, "dopri5", t_end=2.0, rtol=1e-10, atol=1e-12,
-                        t_eval=times)
+    solution = vv.solve(
+        reference.problem, "dopri5", t_end=2.0, rtol=1e-10, atol=1e-12, t_eval=times
+    )
     np.testing.assert_array_equal(solution.t, times)
     exact = np.array([reference.exact(t)[0] for t in times])
     np.testing.assert_allclose(solution.y, exact, rtol=0, atol=1e-8)

@@ -12,8 +12,11 @@ from visviva.io.recording import FORMAT, FORMAT_VERSION
 
 def _solution():
     problem = vv.ode.SecondOrderProblem(
-        lambda t, q, v: -q - 0.1 * v, q0=[[1.0, 0.0], [0.5, 0.2]], v0=[[0.0, 1.0], [0.0, 0.0]],
-        energy=lambda t, q, v: 0.5 * (q**2 + v**2).sum(axis=-1), name="damped pair",
+        lambda t, q, v: -q - 0.1 * v,
+        q0=[[1.0, 0.0], [0.5, 0.2]],
+        v0=[[0.0, 1.0], [0.0, 0.0]],
+        energy=lambda t, q, v: 0.5 * (q**2 + v**2).sum(axis=-1),
+        name="damped pair",
     )
     return vv.solve(problem, "velocity_verlet", dt=0.01, t_end=1.0, record_every=10)
 
@@ -30,8 +33,18 @@ def test_round_trip_is_bit_identical(tmp_path):
         np.testing.assert_array_equal(loaded[name], values)
         assert loaded[name].dtype == values.dtype
     assert loaded.units["q"] == "m"
-    for key in ("method", "dt", "substeps", "record_every", "visviva_version", "f_evaluations",
-                "success", "message", "batch_size", "problem"):
+    for key in (
+        "method",
+        "dt",
+        "substeps",
+        "record_every",
+        "visviva_version",
+        "f_evaluations",
+        "success",
+        "message",
+        "batch_size",
+        "problem",
+    ):
         assert loaded.attrs[key] == recording.attrs[key], key
 
 
@@ -52,14 +65,18 @@ def test_documented_layout(tmp_path):
 
 def test_several_runs_in_one_file(tmp_path):
     """A comparison keeps one group per run, in order; load picks one by name."""
-    runs = {name: vv.solve(vv.ode.SecondOrderProblem(lambda t, q: -q, [1.0], [0.0]), name,
-                           dt=0.1, t_end=1.0).recording
-            for name in ("rk4", "leapfrog", "backward_euler")}
+    runs = {
+        name: vv.solve(
+            vv.ode.SecondOrderProblem(lambda t, q: -q, [1.0], [0.0]), name, dt=0.1, t_end=1.0
+        ).recording
+        for name in ("rk4", "leapfrog", "backward_euler")
+    }
     path = vv.io.write_recordings(tmp_path / "all.h5", runs)
     loaded = vv.io.read_recordings(path)
     assert list(loaded) == ["rk4", "leapfrog", "backward_euler"]
-    np.testing.assert_array_equal(vv.Recording.load(path, run="leapfrog")["q"],
-                                  runs["leapfrog"]["q"])
+    np.testing.assert_array_equal(
+        vv.Recording.load(path, run="leapfrog")["q"], runs["leapfrog"]["q"]
+    )
     with pytest.raises(vv.ModelError, match="holds 3 runs"):
         vv.Recording.load(path)
 

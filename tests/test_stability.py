@@ -48,19 +48,21 @@ KNOWN_INTERVALS = [
 ]
 
 
-@pytest.mark.parametrize(("method", "real", "imaginary"), KNOWN_INTERVALS,
-                         ids=[c[0] for c in KNOWN_INTERVALS])
+@pytest.mark.parametrize(
+    ("method", "real", "imaginary"), KNOWN_INTERVALS, ids=[c[0] for c in KNOWN_INTERVALS]
+)
 def test_stability_intervals_match_known_values(method, real, imaginary):
     """Computed intervals agree with the known ones to 1e-3."""
     if real is not None:
-        np.testing.assert_allclose(vv.analysis.stability_interval(method, "real"), real,
-                                   atol=1e-3)
-    np.testing.assert_allclose(vv.analysis.stability_interval(method, "imaginary"), imaginary,
-                               atol=1e-3)
+        np.testing.assert_allclose(vv.analysis.stability_interval(method, "real"), real, atol=1e-3)
+    np.testing.assert_allclose(
+        vv.analysis.stability_interval(method, "imaginary"), imaginary, atol=1e-3
+    )
 
 
-@pytest.mark.parametrize("method", [m for m in vv.integrators.names()
-                                    if not vv.integrators.get(m).second_order_only])
+@pytest.mark.parametrize(
+    "method", [m for m in vv.integrators.names() if not vv.integrators.get(m).second_order_only]
+)
 def test_declared_stability_function_matches_the_method(method):
     """R(z) from the tableau equals one measured step of y' = λy with h = 1, λ = z."""
     rng = np.random.default_rng(0)
@@ -77,22 +79,26 @@ def test_closed_forms_of_the_seed_methods():
     z = np.array([-0.5 + 0.3j, 0.2j, -3.0, 1.5 - 2j])
     np.testing.assert_allclose(vv.analysis.stability_function("explicit_euler", z), 1 + z)
     np.testing.assert_allclose(vv.analysis.stability_function("backward_euler", z), 1 / (1 - z))
-    np.testing.assert_allclose(vv.analysis.stability_function("trapezoidal", z),
-                               (1 + z / 2) / (1 - z / 2))
-    np.testing.assert_allclose(vv.analysis.stability_function("rk4", z),
-                               1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
+    np.testing.assert_allclose(
+        vv.analysis.stability_function("trapezoidal", z), (1 + z / 2) / (1 - z / 2)
+    )
+    np.testing.assert_allclose(
+        vv.analysis.stability_function("rk4", z), 1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24
+    )
 
 
 def test_trapezoidal_keeps_modulus_one_on_the_imaginary_axis():
     """|R(iy)| = 1 for every y: an undamped linear mode keeps its amplitude."""
     y = np.linspace(-1e3, 1e3, 10001)
-    np.testing.assert_allclose(np.abs(vv.analysis.stability_function("trapezoidal", 1j * y)),
-                               1.0, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(
+        np.abs(vv.analysis.stability_function("trapezoidal", 1j * y)), 1.0, rtol=0, atol=1e-14
+    )
 
 
 def _test_equation(lam):
-    return vv.ode.FirstOrderProblem(lambda t, y: lam * y, [1.0],
-                                    jacobian=lambda t, y: np.full((1, 1), lam))
+    return vv.ode.FirstOrderProblem(
+        lambda t, y: lam * y, [1.0], jacobian=lambda t, y: np.full((1, 1), lam)
+    )
 
 
 @pytest.mark.parametrize("lam", [-1.0, -10.0, -250.0])
@@ -100,8 +106,7 @@ def test_explicit_euler_stable_exactly_below_two_over_lambda(lam):
     """y' = λy, λ < 0: bounded for dt < 2/|λ| (|1 + hλ| < 1), growing above (seed 000)."""
     limit = 2.0 / abs(lam)
     stable = vv.solve(_test_equation(lam), "explicit_euler", dt=0.95 * limit, t_end=200 * limit)
-    unstable = vv.solve(_test_equation(lam), "explicit_euler", dt=1.05 * limit,
-                        t_end=210 * limit)
+    unstable = vv.solve(_test_equation(lam), "explicit_euler", dt=1.05 * limit, t_end=210 * limit)
     assert np.abs(stable.y).max() <= 1.0 and abs(stable.y[-1, 0]) < 1e-4
     # 1 + hλ = −1.1: 200 steps multiply y by exactly (−1.1)^200.
     assert len(unstable.t) == 201
@@ -128,9 +133,11 @@ def test_backward_euler_decays_where_the_exact_solution_grows():
 def test_max_stable_dt_for_a_decaying_mode():
     """Explicit Euler on λ = −100: 2/100; RK4: 2.785/100; backward Euler: unlimited."""
     assert vv.analysis.max_stable_dt("explicit_euler", eigenvalues=[-100.0]) == pytest.approx(
-        0.02, rel=1e-9)
+        0.02, rel=1e-9
+    )
     assert vv.analysis.max_stable_dt("rk4", eigenvalues=[-100.0]) == pytest.approx(
-        0.02785293563, rel=1e-6)
+        0.02785293563, rel=1e-6
+    )
     assert vv.analysis.max_stable_dt("backward_euler", eigenvalues=[-100.0]) == INF
 
 
@@ -140,11 +147,14 @@ def test_max_stable_dt_for_an_oscillator_from_its_jacobian():
     omega = 7.0
     jacobian = np.array([[0.0, 1.0], [-(omega**2), 0.0]])
     assert vv.analysis.max_stable_dt("velocity_verlet", jacobian=jacobian) == pytest.approx(
-        2 / omega, rel=1e-6)
+        2 / omega, rel=1e-6
+    )
     assert vv.analysis.max_stable_dt("symplectic_euler", jacobian=jacobian) == pytest.approx(
-        2 / omega, rel=1e-6)
+        2 / omega, rel=1e-6
+    )
     assert vv.analysis.max_stable_dt("rk4", jacobian=jacobian) == pytest.approx(
-        SQRT8 / omega, rel=1e-6)
+        SQRT8 / omega, rel=1e-6
+    )
     assert vv.analysis.max_stable_dt("explicit_euler", jacobian=jacobian) == 0.0
     assert vv.analysis.max_stable_dt("implicit_midpoint", jacobian=jacobian) == INF
 
@@ -157,7 +167,10 @@ def test_max_stable_dt_ignores_growing_and_zero_modes():
 
 
 def _chain_stiffness(n, k=1.0):
-    """Stiffness K of n unit masses joined by springs k, both ends fixed: ω_j² = 4k sin²(jπ/2(n+1))."""
+    """Stiffness K of n unit masses joined by springs k, both ends fixed.
+
+    Its eigenvalues are −ω_j² with ω_j² = 4k sin²(jπ/2(n+1)).
+    """
     main = np.full(n, -2.0 * k)
     off = np.full(n - 1, k)
     return sp.diags([off, main, off], [-1, 0, 1], format="csr")
@@ -180,12 +193,16 @@ def test_state_jacobian_of_a_second_order_problem_with_mass():
     damping = np.array([[-0.1, 0.0], [0.0, -0.2]])
     masses = np.array([1.0, 4.0])
     problem = vv.ode.SecondOrderProblem.from_force(
-        lambda t, q, v: q @ stiffness.T + v @ damping.T, masses, q0=[0.1, 0.0], v0=[0.0, 0.0],
+        lambda t, q, v: q @ stiffness.T + v @ damping.T,
+        masses,
+        q0=[0.1, 0.0],
+        v0=[0.0, 0.0],
         jacobian=lambda t, q, v: (stiffness, damping),
     )
     from visviva.simulation.loop import initial_state
 
     jacobian = vv.analysis.state_jacobian(problem.system(), initial_state(problem))
-    expected = np.block([[np.zeros((2, 2)), np.eye(2)],
-                         [stiffness / masses[:, None], damping / masses[:, None]]])
+    expected = np.block(
+        [[np.zeros((2, 2)), np.eye(2)], [stiffness / masses[:, None], damping / masses[:, None]]]
+    )
     np.testing.assert_allclose(jacobian, expected)

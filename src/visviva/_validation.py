@@ -50,13 +50,15 @@ def real_number(
         unit: Unit appended to the requirement in the message, e.g. ``" s"``.
     """
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ModelError(f"`{name}` must be a real number{unit and ' in' + unit} "
-                         f"(got {describe(value)})")
+        raise ModelError(
+            f"`{name}` must be a real number{unit and ' in' + unit} (got {describe(value)})"
+        )
     try:
         number = float(value)
     except OverflowError:
-        raise ModelError(f"`{name}` must be finite (got {describe(value)}, beyond the range "
-                         "of a float)") from None
+        raise ModelError(
+            f"`{name}` must be finite (got {describe(value)}, beyond the range of a float)"
+        ) from None
     if not math.isfinite(number):
         raise ModelError(f"`{name}` must be finite (got {number!r})")
     if positive and not number > 0.0:

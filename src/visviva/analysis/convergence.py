@@ -61,11 +61,10 @@ class ConvergenceStudy:
 
 
 def _reference_parts(reference: Any, problem: Problem, t_end: float) -> tuple[np.ndarray, ...]:
-    if callable(reference):
-        value = reference(t_end)
-    else:
-        value = reference
-    parts = tuple(np.asarray(v) for v in value) if isinstance(value, tuple) else (np.asarray(value),)
+    value = reference(t_end) if callable(reference) else reference
+    parts = (
+        tuple(np.asarray(v) for v in value) if isinstance(value, tuple) else (np.asarray(value),)
+    )
     expected = 1 if problem.kind == "first_order" else 2
     if len(parts) != expected:
         raise ModelError(
@@ -134,8 +133,9 @@ def convergence_order(
     scale = max(1.0, max(float(np.max(np.abs(p))) for p in exact))
     errors = np.empty(steps.size)
     for i, h in enumerate(steps):
-        solution = solve(problem, integrator, t_end=t_end, dt=float(h), adaptive=False,
-                         record_every=10**9)
+        solution = solve(
+            problem, integrator, t_end=t_end, dt=float(h), adaptive=False, record_every=10**9
+        )
         if not solution.success:
             errors[i] = np.inf
             continue

@@ -36,7 +36,7 @@ def relative_change(values: Any) -> np.ndarray:
 
 
 def _energy(recording: Recording) -> np.ndarray | None:
-    return recording["energy"] if "energy" in recording else None
+    return recording.fields.get("energy")
 
 
 def energy_drift(recording: Recording) -> float | None:

@@ -62,19 +62,26 @@ def _pendulum(theta0: float = 1.0, omega: float = 1.0) -> ReferenceProblem:
         energy=lambda t, q, v: 0.5 * v[..., 0] ** 2 + omega**2 * (1.0 - np.cos(q[..., 0])),
         name=f"pendulum, theta0 = {theta0} rad",
     )
-    return ReferenceProblem("pendulum", "pendulum θ'' = -sin θ from θ0 = 1 rad (elliptic "
-                            "functions)", problem, exact)
+    return ReferenceProblem(
+        "pendulum", "pendulum θ'' = -sin θ from θ0 = 1 rad (elliptic functions)", problem, exact
+    )
 
 
 def _forced() -> ReferenceProblem:
     """``q'' = −q + cos 2t`` from rest at ``q = 1``: ``q = (4/3) cos t − (1/3) cos 2t``."""
 
     def exact(t: float) -> tuple[np.ndarray, ...]:
-        return (np.array([4 / 3 * np.cos(t) - np.cos(2 * t) / 3]),
-                np.array([-4 / 3 * np.sin(t) + 2 / 3 * np.sin(2 * t)]))
+        return (
+            np.array([4 / 3 * np.cos(t) - np.cos(2 * t) / 3]),
+            np.array([-4 / 3 * np.sin(t) + 2 / 3 * np.sin(2 * t)]),
+        )
 
-    problem = SecondOrderProblem(lambda t, q: -q + np.cos(2.0 * t), q0=[1.0], v0=[0.0],
-                                 name="forced oscillator q'' = -q + cos 2t")
+    problem = SecondOrderProblem(
+        lambda t, q: -q + np.cos(2.0 * t),
+        q0=[1.0],
+        v0=[0.0],
+        name="forced oscillator q'' = -q + cos 2t",
+    )
     return ReferenceProblem("forced", "time-dependent force q'' = -q + cos 2t", problem, exact)
 
 
@@ -94,8 +101,10 @@ def _damped(omega: float = 2.0, zeta: float = 0.1) -> ReferenceProblem:
         lambda t, q, v: -(omega**2) * q - 2.0 * zeta * omega * v,
         q0=[1.0],
         v0=[0.0],
-        jacobian=lambda t, q, v: (np.full(q.shape + (1,), -(omega**2)),
-                                  np.full(q.shape + (1,), -2.0 * zeta * omega)),
+        jacobian=lambda t, q, v: (
+            np.full(q.shape + (1,), -(omega**2)),
+            np.full(q.shape + (1,), -2.0 * zeta * omega),
+        ),
         name="damped oscillator",
     )
     return ReferenceProblem("damped", "velocity-dependent force q'' = -4q - 0.4q'", problem, exact)
@@ -125,10 +134,15 @@ def _first_order() -> ReferenceProblem:
         z = 0.5 * (np.cos(t) + np.sin(t)) + 0.5 * np.exp(-t)
         return (np.array([theta, rate, z]),)
 
-    problem = FirstOrderProblem(f, [1.0, 0.0, 1.0], jacobian=jacobian,
-                                name="pendulum as a first-order system, plus z' = -z + cos t")
-    return ReferenceProblem("first-order", "first-order pendulum plus driven decay "
-                            "z' = -z + cos t", problem, exact)
+    problem = FirstOrderProblem(
+        f,
+        [1.0, 0.0, 1.0],
+        jacobian=jacobian,
+        name="pendulum as a first-order system, plus z' = -z + cos t",
+    )
+    return ReferenceProblem(
+        "first-order", "first-order pendulum plus driven decay z' = -z + cos t", problem, exact
+    )
 
 
 _BUILDERS: dict[str, Callable[[], ReferenceProblem]] = {

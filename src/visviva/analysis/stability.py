@@ -151,8 +151,13 @@ def spectrum(jacobian: Any, *, count: int = SPARSE_EIGEN_COUNT) -> np.ndarray:
     from scipy.sparse.linalg import eigs
 
     operator = sp.csr_matrix(jacobian) if dense else jacobian
-    return eigs(operator, k=min(count, m - 2), which="LM", tol=SPARSE_EIGEN_TOLERANCE,
-                return_eigenvectors=False)
+    return eigs(
+        operator,
+        k=min(count, m - 2),
+        which="LM",
+        tol=SPARSE_EIGEN_TOLERANCE,
+        return_eigenvectors=False,
+    )
 
 
 def _to_dense(matrix: Any) -> np.ndarray:
@@ -225,7 +230,7 @@ def _checked_jacobian(jacobian: Any) -> Any:
     """The Jacobian if it is a finite square matrix (dense, sparse or operator)."""
     import scipy.sparse as sp
 
-    shape = getattr(jacobian, "shape", None)
+    shape: Any = getattr(jacobian, "shape", None)
     if shape is None and not sp.issparse(jacobian):
         try:
             jacobian = np.asarray(jacobian, dtype=np.complex128)
@@ -234,8 +239,10 @@ def _checked_jacobian(jacobian: Any) -> Any:
         shape = jacobian.shape
     if len(shape) != 2 or shape[0] != shape[1] or shape[0] == 0:
         raise ModelError(f"`jacobian` must be a square (m, m) matrix (got shape {tuple(shape)})")
-    values = jacobian.data if sp.issparse(jacobian) else (
-        jacobian if isinstance(jacobian, np.ndarray) else None
+    values = (
+        jacobian.data
+        if sp.issparse(jacobian)
+        else (jacobian if isinstance(jacobian, np.ndarray) else None)
     )
     if values is not None and not np.isfinite(values).all():
         raise ModelError("`jacobian` must be finite (it holds nan or inf)")

@@ -52,8 +52,18 @@ def integrators_command(as_json: JsonOption = False) -> None:
     table.add_column("kind", no_wrap=True)
     table.add_column("what it does")
     for m in methods:
-        kind = ", ".join(k for k, on in (("implicit", m.implicit), ("symplectic", m.symplectic),
-                                         ("adaptive", m.adaptive)) if on) or "explicit"
+        kind = (
+            ", ".join(
+                k
+                for k, on in (
+                    ("implicit", m.implicit),
+                    ("symplectic", m.symplectic),
+                    ("adaptive", m.adaptive),
+                )
+                if on
+            )
+            or "explicit"
+        )
         table.add_row(m.name, str(m.order), kind, m.summary)
     console = Console()
     if not console.is_terminal:
@@ -64,8 +74,9 @@ def integrators_command(as_json: JsonOption = False) -> None:
 @app.command("stability")
 def stability_command(
     methods: Annotated[list[str], typer.Argument(help="Method names, e.g. rk4 explicit_euler.")],
-    output: Annotated[Path | None, typer.Option("--output", "-o",
-                                                help="Write the region plot (PNG).")] = None,
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Write the region plot (PNG).")
+    ] = None,
     as_json: JsonOption = False,
     force: ForceOption = False,
 ) -> None:
@@ -89,13 +100,16 @@ def stability_command(
 
         _save_figure(plot_stability_regions(instances), output)
     if as_json:
-        _print_json({name: {axis: list(v) for axis, v in axes.items()}
-                     for name, axes in intervals.items()})
+        _print_json(
+            {name: {axis: list(v) for axis, v in axes.items()} for name, axes in intervals.items()}
+        )
         return
     for name, axes in intervals.items():
         real, imaginary = axes["real"], axes["imaginary"]
-        typer.echo(f"{name:34s} real [{real[0]:.6g}, {real[1]:.6g}]   "
-                   f"imaginary [{imaginary[0]:.6g}, {imaginary[1]:.6g}]")
+        typer.echo(
+            f"{name:34s} real [{real[0]:.6g}, {real[1]:.6g}]   "
+            f"imaginary [{imaginary[0]:.6g}, {imaginary[1]:.6g}]"
+        )
     if output is not None:
         typer.echo(f"wrote {output}")
 
@@ -103,21 +117,22 @@ def stability_command(
 @app.command("convergence")
 def convergence_command(
     methods: Annotated[list[str] | None, typer.Argument(help="Methods (default: all).")] = None,
-    problem: Annotated[str, typer.Option(
-        help="Reference problem: pendulum, forced, damped or first-order.")] = "pendulum",
+    problem: Annotated[
+        str, typer.Option(help="Reference problem: pendulum, forced, damped or first-order.")
+    ] = "pendulum",
     t_end: Annotated[float, typer.Option(help="Time of the error measurement [s].")] = 2.0,
     levels: Annotated[int, typer.Option(help="Number of halved step sizes (at least 3).")] = 8,
-    output: Annotated[Path | None, typer.Option("--output", "-o",
-                                                help="Write the log-log plot (PNG).")] = None,
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Write the log-log plot (PNG).")
+    ] = None,
     as_json: JsonOption = False,
     force: ForceOption = False,
 ) -> None:
     """Measure each method's order of accuracy against an exact solution."""
+    from .._validation import real_number, whole_number
     from ..analysis.convergence import convergence_order
     from ..analysis.reference_problems import reference_problem
     from ..integrators import get, names
-
-    from .._validation import real_number, whole_number
 
     instances = [get(name) for name in (methods or names())]
     levels = whole_number("levels", levels, minimum=3)
@@ -126,8 +141,13 @@ def convergence_command(
         _check_new_file(output, force)
     test = reference_problem(problem)
     studies = [
-        convergence_order(test.problem, m, t_end=t_end, reference=test.exact,
-                          dt=[t_end / (10 * 2**k) for k in range(levels)])
+        convergence_order(
+            test.problem,
+            m,
+            t_end=t_end,
+            reference=test.exact,
+            dt=[t_end / (10 * 2**k) for k in range(levels)],
+        )
         for m in instances
     ]
     if output is not None:
@@ -135,8 +155,14 @@ def convergence_command(
 
         _save_figure(plot_convergence(studies), output)
     rows = [
-        {"method": s.method, "declared_order": s.declared_order, "measured_order": s.order,
-         "points_fitted": int(s.used.sum()), "dt": s.dt.tolist(), "error": s.error.tolist()}
+        {
+            "method": s.method,
+            "declared_order": s.declared_order,
+            "measured_order": s.order,
+            "points_fitted": int(s.used.sum()),
+            "dt": s.dt.tolist(),
+            "error": s.error.tolist(),
+        }
         for s in studies
     ]
     if as_json:
@@ -144,8 +170,10 @@ def convergence_command(
         return
     typer.echo(f"problem: {test.description}, error at t = {t_end:g} s")
     for row in rows:
-        typer.echo(f"{row['method']:34s} declared {row['declared_order']}  measured "
-                   f"{row['measured_order']:.3f}  ({row['points_fitted']} points)")
+        typer.echo(
+            f"{row['method']:34s} declared {row['declared_order']}  measured "
+            f"{row['measured_order']:.3f}  ({row['points_fitted']} points)"
+        )
     if output is not None:
         typer.echo(f"wrote {output}")
 
@@ -153,8 +181,7 @@ def convergence_command(
 @app.command("demo")
 def demo_command(
     name: Annotated[str | None, typer.Argument(help="Demo to run; omit to list them.")] = None,
-    output: Annotated[Path | None, typer.Option("--output", "-o",
-                                                help="Output directory.")] = None,
+    output: Annotated[Path | None, typer.Option("--output", "-o", help="Output directory.")] = None,
     duration: Annotated[float | None, typer.Option(help="Simulated duration [s].")] = None,
     force: ForceOption = False,
 ) -> None:

@@ -76,8 +76,10 @@ def run_demo(
             f"Available: {', '.join(available)}"
         )
     demo = available[name]
-    seconds = demo.duration if duration is None else real_number(
-        "duration", duration, positive=True, unit=" s"
+    seconds = (
+        demo.duration
+        if duration is None
+        else real_number("duration", duration, positive=True, unit=" s")
     )
     output = JobOutput(directory, force=force)
     output.check_target()

@@ -50,8 +50,9 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     figure = Figure(figsize=(12, 5.5), layout="constrained")
     plane, radius = figure.subplots(1, 2)
     angle = np.linspace(0, 2 * np.pi, 400)
-    plane.plot(RADIUS * np.sin(angle), RADIUS * np.cos(angle), color="0.6", linewidth=3,
-               label="exact")
+    plane.plot(
+        RADIUS * np.sin(angle), RADIUS * np.cos(angle), color="0.6", linewidth=3, label="exact"
+    )
     for name, recording in output.recordings.items():
         x, y = recording["q"][:, 0], recording["v"][:, 0]
         plane.plot(x, y, linewidth=1.1, label=name)
@@ -79,9 +80,11 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     }
 
 
-register_demo(Demo(
-    "circular",
-    "seed 004's circular motion: explicit Euler spirals out, implicit in, symplectic stays",
-    20.0,
-    run,
-))
+register_demo(
+    Demo(
+        "circular",
+        "seed 004's circular motion: explicit Euler spirals out, implicit in, symplectic stays",
+        20.0,
+        run,
+    )
+)

@@ -29,7 +29,9 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     from matplotlib.figure import Figure
 
     problem = FirstOrderProblem(
-        lambda t, y: LAMBDA * y, [1.0], jacobian=lambda t, y: np.full((1, 1), LAMBDA),
+        lambda t, y: LAMBDA * y,
+        [1.0],
+        jacobian=lambda t, y: np.full((1, 1), LAMBDA),
         name="test equation y' = -y",
     )
     figure = Figure(figsize=(3.0 * len(STEPS), 2.6 * len(METHODS)), layout="constrained")
@@ -56,16 +58,17 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 
     regions = plot_stability_regions(METHODS, bounds=(-4.0, 3.0, -2.5, 2.5))
     for ax in regions.axes[: len(METHODS)]:
-        ax.plot([h * LAMBDA for h in STEPS], [0.0] * len(STEPS), "o", color="#e6550d",
-                markersize=4)
+        ax.plot([h * LAMBDA for h in STEPS], [0.0] * len(STEPS), "o", color="#e6550d", markersize=4)
     regions.suptitle("Stability regions with the points hλ of the runs (orange)")
     output.figures["stability"] = regions
     return {"lambda_per_s": LAMBDA, "steps_s": list(STEPS), "amplification": amplification}
 
 
-register_demo(Demo(
-    "test-equation",
-    "y' = -y at steps on both sides of h = 2: who decays, who oscillates, who blows up",
-    12.0,
-    run,
-))
+register_demo(
+    Demo(
+        "test-equation",
+        "y' = -y at steps on both sides of h = 2: who decays, who oscillates, who blows up",
+        12.0,
+        run,
+    )
+)

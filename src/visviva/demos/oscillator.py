@@ -35,8 +35,14 @@ def oscillator_problem() -> SecondOrderProblem:
     def energy(t: float, q: np.ndarray, v: np.ndarray) -> Any:
         return 0.5 * v[..., 0] ** 2 + 0.5 * OMEGA**2 * q[..., 0] ** 2
 
-    return SecondOrderProblem(acceleration, q0=[1.0], v0=[0.0], jacobian=jacobian,
-                              energy=energy, name="harmonic oscillator, omega = 2 pi rad/s")
+    return SecondOrderProblem(
+        acceleration,
+        q0=[1.0],
+        v0=[0.0],
+        jacobian=jacobian,
+        energy=energy,
+        name="harmonic oscillator, omega = 2 pi rad/s",
+    )
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
@@ -54,14 +60,17 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     )
     phase_time = np.linspace(0.0, 2 * np.pi, 200)
     output.figures["phase"] = plot_phase(
-        output.recordings, exact=(np.cos(phase_time), -OMEGA * np.sin(phase_time)),
+        output.recordings,
+        exact=(np.cos(phase_time), -OMEGA * np.sin(phase_time)),
     )
     return {"omega_rad_per_s": OMEGA, "dt_s": DT, "omega_h": OMEGA * DT}
 
 
-register_demo(Demo(
-    "oscillator",
-    "every integrator on an undamped spring: energy growth, decay or conservation side by side",
-    10.0,
-    run,
-))
+register_demo(
+    Demo(
+        "oscillator",
+        "every integrator on an undamped spring: energy growth, decay or conservation side by side",
+        10.0,
+        run,
+    )
+)

@@ -31,9 +31,20 @@ __all__ = ["JobOutput", "run_summary"]
 def run_summary(recording: Recording) -> dict[str, Any]:
     """The per-run entry of ``summary.json``: method, step, work, energy drift, outcome."""
     attrs = recording.attrs
-    keys = ("method", "dt", "substeps", "steps", "f_evaluations", "jacobian_evaluations",
-            "linear_solves", "newton_iterations", "rejected_steps", "wall_time_s", "success",
-            "message")
+    keys = (
+        "method",
+        "dt",
+        "substeps",
+        "steps",
+        "f_evaluations",
+        "jacobian_evaluations",
+        "linear_solves",
+        "newton_iterations",
+        "rejected_steps",
+        "wall_time_s",
+        "success",
+        "message",
+    )
     entry = {k: attrs[k] for k in keys if k in attrs}
     entry["energy_drift"] = energy_drift(recording)
     entry["max_energy_error"] = max_energy_error(recording)
@@ -65,11 +76,14 @@ class JobOutput:
     def check_target(self, names: list[str] | None = None) -> None:
         """Refuse to overwrite existing outputs without ``force`` (call before the work)."""
         if self.directory.exists() and not self.directory.is_dir():
-            raise ModelError(f"output path {os.fspath(self.directory)!r} is a file, not a directory")
+            raise ModelError(
+                f"output path {os.fspath(self.directory)!r} is a file, not a directory"
+            )
         if self.force:
             return
-        existing = [n for n in (names or ["recording.h5", "summary.json"])
-                    if (self.directory / n).exists()]
+        existing = [
+            n for n in (names or ["recording.h5", "summary.json"]) if (self.directory / n).exists()
+        ]
         if existing:
             raise ModelError(
                 f"{os.fspath(self.directory)} already holds {', '.join(existing)}; "

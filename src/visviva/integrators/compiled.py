@@ -67,8 +67,14 @@ def problem_key(problem: Problem) -> tuple[Any, ...] | None:
         mass_key = tuple(float(x) for x in diagonal)
     else:
         return None
-    return ("second_order", force.func, force.writes_out, force.state_arguments, problem.size,
-            mass_key)
+    return (
+        "second_order",
+        force.func,
+        force.writes_out,
+        force.state_arguments,
+        problem.size,
+        mass_key,
+    )
 
 
 def acceleration_adapter(problem: Problem) -> Callable[..., None] | None:
@@ -86,24 +92,28 @@ def acceleration_adapter(problem: Problem) -> Callable[..., None] | None:
         inverse_mass = 1.0 / np.array(mass_key if has_mass else (1.0,) * n)
 
         if state_arguments == 2 and writes_out:
+
             @numba.njit
             def raw(t, q, v, out):  # pragma: no cover - compiled
                 func(t, q, v, out)
         elif state_arguments == 2:
+
             @numba.njit
             def raw(t, q, v, out):  # pragma: no cover - compiled
                 out[:] = func(t, q, v)
         elif writes_out:
+
             @numba.njit
             def raw(t, q, v, out):  # pragma: no cover - compiled
                 func(t, q, out)
         else:
+
             @numba.njit
             def raw(t, q, v, out):  # pragma: no cover - compiled
                 out[:] = func(t, q)
 
         if not has_mass:
-            return raw  # type: ignore[no-any-return]
+            return raw
 
         @numba.njit
         def with_mass(t, q, v, out):  # pragma: no cover - compiled
@@ -111,9 +121,9 @@ def acceleration_adapter(problem: Problem) -> Callable[..., None] | None:
             for k in range(n):
                 out[k] *= inverse_mass[k]
 
-        return with_mass  # type: ignore[no-any-return]
+        return with_mass
 
-    return _memoized(("acceleration", *key), build)  # type: ignore[no-any-return]
+    return _memoized(("acceleration", *key), build)
 
 
 def derivative_adapter(problem: Problem) -> Callable[..., None] | None:
@@ -132,13 +142,13 @@ def derivative_adapter(problem: Problem) -> Callable[..., None] | None:
         if key[0] == "first_order":
             func = problem.f.func  # type: ignore[union-attr]
             if key[2]:
-                return func  # type: ignore[no-any-return]
+                return func
 
             @numba.njit
             def first(t, y, out):  # pragma: no cover - compiled
                 out[:] = func(t, y)
 
-            return first  # type: ignore[no-any-return]
+            return first
 
         accel = acceleration_adapter(problem)
         n = problem.size
@@ -148,9 +158,9 @@ def derivative_adapter(problem: Problem) -> Callable[..., None] | None:
             out[:n] = y[n:]
             accel(t, y[:n], y[n:], out[n:])
 
-        return second  # type: ignore[no-any-return]
+        return second
 
-    return _memoized(("derivative", *key), build)  # type: ignore[no-any-return]
+    return _memoized(("derivative", *key), build)
 
 
 def stacked_size(problem: Problem) -> int:
@@ -193,7 +203,7 @@ def runge_kutta_step(tableau: ButcherTableau, problem: Problem) -> CompiledStep 
 
         return CompiledStep(step, s + 1)
 
-    return _memoized(("runge_kutta", tableau.a.tobytes(), tableau.b.tobytes(), *key), build)  # type: ignore[no-any-return]
+    return _memoized(("runge_kutta", tableau.a.tobytes(), tableau.b.tobytes(), *key), build)
 
 
 #: Batches at least this large run on all cores; smaller ones on one (a parallel loop costs
@@ -219,8 +229,9 @@ def make_runner(step: CompiledStep, systems: int) -> Callable[..., None]:
         kernel = step.kernel
 
         @numba.njit(parallel=parallel)
-        def run(y, work, fresh, t0, h, first, count, record_every, frames, limit, status,
-                evaluations):  # pragma: no cover - compiled
+        def run(
+            y, work, fresh, t0, h, first, count, record_every, frames, limit, status, evaluations
+        ):  # pragma: no cover - compiled
             batch, m = y.shape
             for i in numba.prange(batch):
                 if status[i] >= 0:
@@ -252,4 +263,4 @@ def make_runner(step: CompiledStep, systems: int) -> Callable[..., None]:
         return run
 
     parallel = systems >= PARALLEL_MIN_SYSTEMS
-    return _memoized(("runner", step, parallel), build)  # type: ignore[no-any-return]
+    return _memoized(("runner", step, parallel), build)

@@ -81,7 +81,8 @@ class Step:
         self.start = start
         self.end = end
         self.dt = dt
-        self.error = combine(tuple(np.zeros_like(p) for p in start.parts), dt, _ERROR_WEIGHTS, rates)
+        zeros = tuple(np.zeros_like(p) for p in start.parts)
+        self.error = combine(zeros, dt, _ERROR_WEIGHTS, rates)
         self._rates = rates
 
     def interpolate(self, theta: Any) -> tuple[np.ndarray, ...]:
@@ -137,4 +138,3 @@ class DormandPrince5(Integrator):
 
     def stability_function(self, z: Any) -> np.ndarray:
         return self.tableau.stability_function(z)
-

@@ -70,7 +70,8 @@ class ImplicitOneStage(Integrator):
     def step(self, system: System, state: State, dt: float) -> State:
         theta_h = self.theta * dt
         base = self.stage_base(system, state, dt)
-        stage, rate = solve_stage(system, state.t + self.stage_time * dt, base, theta_h, self.newton)
+        t_stage = state.t + self.stage_time * dt
+        stage, rate = solve_stage(system, t_stage, base, theta_h, self.newton)
         return self.assemble(state, dt, stage, rate)
 
     def assemble(

@@ -87,7 +87,7 @@ def measured_stability_function(method: Integrator, z: Any) -> np.ndarray:
         state = method.step(system, FirstOrderState(0.0, y0), 1.0)  # type: ignore[arg-type]
         return np.asarray(state.parts[0][:, 0]).reshape(z.shape)
 
-    alpha = -np.abs(flat) ** 2
+    alpha = -(np.abs(flat) ** 2)
     beta = 2.0 * flat.real
     system2 = _TestOscillator(np.tile(alpha, 2), np.tile(beta, 2))
     ones = np.ones(flat.size, dtype=np.complex128)

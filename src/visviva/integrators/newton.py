@@ -87,7 +87,9 @@ def _solve_first_order(
     system: FirstOrderSystem, t: float, y_base: np.ndarray, theta_h: float, options: NewtonOptions
 ) -> tuple[tuple[np.ndarray, ...], np.ndarray]:
     y = y_base.copy()
-    for iteration in range(1, options.max_iterations + 1):
+    iteration, norm = 0, np.inf
+    while iteration < options.max_iterations:
+        iteration += 1
         rate = system.rhs(t, y)
         residual = y - y_base - theta_h * rate
         jacobian = system.jacobian(t, y, rate)
@@ -112,7 +114,9 @@ def _solve_second_order(
     q_base, v_base = base
     mass = system.mass
     v = v_base.copy()
-    for iteration in range(1, options.max_iterations + 1):
+    iteration, norm = 0, np.inf
+    while iteration < options.max_iterations:
+        iteration += 1
         q = q_base + theta_h * v
         force = system.force(t, q, v)
         momentum_change = v - v_base if mass is None else mass.apply(v - v_base)

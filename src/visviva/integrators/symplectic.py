@@ -34,7 +34,7 @@ if TYPE_CHECKING:
 __all__ = ["Leapfrog", "SymplecticEuler", "SymplecticEulerPositionFirst", "VelocityVerlet"]
 
 
-def start_acceleration(system: SecondOrderSystem, state: SecondOrderState):  # noqa: ANN201
+def start_acceleration(system: SecondOrderSystem, state: SecondOrderState):
     """``q''`` at the state, reusing what the previous step left in the state."""
     if state.acceleration is not None:
         return state.acceleration
@@ -52,9 +52,11 @@ class _Split(Integrator):
         if key is None or key[0] != "second_order":
             return None
         accel = acceleration_adapter(problem)
+        if accel is None:
+            return None
         n = problem.size
         velocity_dependent = problem.velocity_dependent  # type: ignore[union-attr]
-        return _memoized((self.name, *key), lambda: make(accel, n, velocity_dependent))  # type: ignore[no-any-return]
+        return _memoized((self.name, *key), lambda: make(accel, n, velocity_dependent))
 
 
 class SymplecticEuler(_Split):

@@ -51,7 +51,9 @@ class Taylor(Integrator):
         if key is None or key[0] != "second_order":
             return None
         accel = acceleration_adapter(problem)
-        return _memoized(("taylor", *key), lambda: _kernel(accel, problem.size))  # type: ignore[no-any-return]
+        if accel is None:
+            return None
+        return _memoized(("taylor", *key), lambda: _kernel(accel, problem.size))
 
 
 def _kernel(accel: Callable[..., None], n: int) -> CompiledStep:

@@ -38,8 +38,9 @@ def atomic_path(target: str | os.PathLike[str]) -> Iterator[Path]:
         'complete'
     """
     destination = Path(target)
-    handle, name = tempfile.mkstemp(dir=destination.parent, prefix=f".{destination.name}.",
-                                    suffix=destination.suffix)
+    handle, name = tempfile.mkstemp(
+        dir=destination.parent, prefix=f".{destination.name}.", suffix=destination.suffix
+    )
     os.close(handle)
     temporary = Path(name)
     try:

@@ -42,28 +42,36 @@ def batched(function: UserFunction, result: str) -> Callable[..., Any]:
     if result == "array":
         if writes_out:
             if two:
+
                 @numba.njit(parallel=True)
                 def loop_out2(t, a, b, out):  # pragma: no cover - compiled
                     for i in numba.prange(a.shape[0]):
                         func(t, a[i], b[i], out[i])
+
                 kernel: Any = loop_out2
             else:
+
                 @numba.njit(parallel=True)
                 def loop_out1(t, a, out):  # pragma: no cover - compiled
                     for i in numba.prange(a.shape[0]):
                         func(t, a[i], out[i])
+
                 kernel = loop_out1
         elif two:
+
             @numba.njit(parallel=True)
             def loop_ret2(t, a, b, out):  # pragma: no cover - compiled
                 for i in numba.prange(a.shape[0]):
                     out[i, :] = func(t, a[i], b[i])
+
             kernel = loop_ret2
         else:
+
             @numba.njit(parallel=True)
             def loop_ret1(t, a, out):  # pragma: no cover - compiled
                 for i in numba.prange(a.shape[0]):
                     out[i, :] = func(t, a[i])
+
             kernel = loop_ret1
 
         def call_array(t: float, *states: np.ndarray) -> np.ndarray:
@@ -74,6 +82,7 @@ def batched(function: UserFunction, result: str) -> Callable[..., Any]:
         return call_array
 
     if result == "matrix":
+
         @numba.njit(parallel=True)
         def loop_matrix(t, a, out):  # pragma: no cover - compiled
             for i in numba.prange(a.shape[0]):
@@ -87,6 +96,7 @@ def batched(function: UserFunction, result: str) -> Callable[..., Any]:
         return call_matrix
 
     if result == "pair":
+
         @numba.njit(parallel=True)
         def loop_pair(t, a, b, out_q, out_v):  # pragma: no cover - compiled
             for i in numba.prange(a.shape[0]):
@@ -104,16 +114,20 @@ def batched(function: UserFunction, result: str) -> Callable[..., Any]:
 
     if result == "scalar":
         if two:
+
             @numba.njit(parallel=True)
             def loop_scalar2(t, a, b, out):  # pragma: no cover - compiled
                 for i in numba.prange(a.shape[0]):
                     out[i] = func(t, a[i], b[i])
+
             scalar_kernel: Any = loop_scalar2
         else:
+
             @numba.njit(parallel=True)
             def loop_scalar1(t, a, out):  # pragma: no cover - compiled
                 for i in numba.prange(a.shape[0]):
                     out[i] = func(t, a[i])
+
             scalar_kernel = loop_scalar1
 
         def call_scalar(t: float, *states: np.ndarray) -> np.ndarray:

@@ -85,4 +85,3 @@ class UserFunction:
                 f"to write into); got {name}({got})"
             )
         return cls(func, name, state_arguments, writes_out, compiled)
-

@@ -307,9 +307,7 @@ def _check_first_order(problem: FirstOrderProblem) -> None:
     _check_result("f", _call(problem.f, t0, y), y.shape, "dy/dt with the shape of y")
     if problem.jacobian is not None:
         (y,) = _probe_states(problem.jacobian, problem.y0)
-        _check_result(
-            "jacobian", _call(problem.jacobian, t0, y), y.shape + y.shape[-1:], "df/dy"
-        )
+        _check_result("jacobian", _call(problem.jacobian, t0, y), y.shape + y.shape[-1:], "df/dy")
     if problem.energy is not None:
         (y,) = _probe_states(problem.energy, problem.y0)
         expected = () if problem.energy.compiled or y.ndim == 1 else y.shape[:1]

@@ -66,10 +66,12 @@ def evaluator(function: UserFunction, batch: bool, result: str = "array") -> Cal
     if function.compiled and batch:
         return batched(function, result)
     if function.writes_out:
+
         def call_out(t: float, *states: np.ndarray) -> np.ndarray:
             out = np.empty_like(states[0])
             func(t, *states, out)
             return out
+
         return call_out
     return func
 
@@ -92,7 +94,9 @@ class FirstOrderSystem:
         self._jacobian = (
             None if problem.jacobian is None else evaluator(problem.jacobian, batch, "matrix")
         )
-        self._energy = None if problem.energy is None else evaluator(problem.energy, batch, "scalar")
+        self._energy = (
+            None if problem.energy is None else evaluator(problem.energy, batch, "scalar")
+        )
 
     @property
     def has_energy(self) -> bool:
@@ -157,7 +161,9 @@ class SecondOrderSystem:
         else:
             kind = "pair" if jacobian.state_arguments == 2 else "matrix"
             self._jacobian = evaluator(jacobian, batch, kind)
-        self._energy = None if problem.energy is None else evaluator(problem.energy, batch, "scalar")
+        self._energy = (
+            None if problem.energy is None else evaluator(problem.energy, batch, "scalar")
+        )
 
     @property
     def has_energy(self) -> bool:

@@ -57,8 +57,13 @@ class DenseOutput:
         return step.interpolate((t - step.start.t) / step.dt)
 
 
-def _error_norm(error: tuple[np.ndarray, ...], before: tuple[np.ndarray, ...],
-                after: tuple[np.ndarray, ...], rtol: float, atol: float) -> float:
+def _error_norm(
+    error: tuple[np.ndarray, ...],
+    before: tuple[np.ndarray, ...],
+    after: tuple[np.ndarray, ...],
+    rtol: float,
+    atol: float,
+) -> float:
     """Worst system's RMS of ``error / (atol + rtol·max(|before|, |after|))``."""
     squares = []
     for e, y0, y1 in zip(error, before, after, strict=True):
@@ -69,8 +74,9 @@ def _error_norm(error: tuple[np.ndarray, ...], before: tuple[np.ndarray, ...],
     return worst if np.isfinite(worst) else np.inf
 
 
-def _initial_step(method: DormandPrince5, system: Any, state: State, t_end: float,
-                  rtol: float, atol: float) -> float:
+def _initial_step(
+    method: DormandPrince5, system: Any, state: State, t_end: float, rtol: float, atol: float
+) -> float:
     """Starting step from the sizes of y, f and a finite-difference estimate of f'.
 
     ``state`` must carry its derivative (see :meth:`FirstOrderState.with_derivative`).
@@ -101,7 +107,8 @@ def _check_step_size(h: float, t: float, t_end: float, step: int) -> None:
             f"the step size became too small ({h:.3g} s) at t={t:.6g} s: the problem is too "
             "stiff for an explicit method at this tolerance, or has a singularity; try "
             "'backward_euler' or 'trapezoidal'",
-            t=t, step=step,
+            t=t,
+            step=step,
         )
 
 
@@ -134,8 +141,10 @@ def integrate_adaptive(
     starts_at_t0 = t_eval is None or t_eval[0] == t0
     recorder = FrameRecorder(state, include=starts_at_t0)
     eval_index = 1 if t_eval is not None and starts_at_t0 else 0
-    h = first_step if first_step is not None else (
-        _initial_step(method, system, state, t_end, rtol, atol) if t_end > t0 else 0.0
+    h = (
+        first_step
+        if first_step is not None
+        else (_initial_step(method, system, state, t_end, rtol, atol) if t_end > t0 else 0.0)
     )
     watch = DivergenceWatch(system, method, h or 1.0, state, divergence_limit)
     steps: list[Step] = []
@@ -151,7 +160,8 @@ def integrate_adaptive(
                         f"reached max_steps={max_steps} at t={state.t:.6g} s before t_end="
                         f"{t_end:.6g} s; raise max_steps, loosen rtol/atol, or use an implicit "
                         "method if the problem is stiff",
-                        t=state.t, step=step_index,
+                        t=state.t,
+                        step=step_index,
                     )
                 h = min(h, t_end - state.t)
                 _check_step_size(h, state.t, t_end, step_index)
@@ -211,4 +221,3 @@ def integrate_adaptive(
         error.recording = recording  # type: ignore[attr-defined]
         raise error
     return recording, (DenseOutput(steps) if dense_output else None)
-

@@ -238,8 +238,17 @@ def simulate(
             if compiled_step is None:
                 _run_numpy(integrator, system, state, schedule, record_every, recorder, watch, bar)
             else:
-                _run_compiled(compiled_step, problem, system, state, schedule, record_every,
-                              recorder, watch, bar)
+                _run_compiled(
+                    compiled_step,
+                    problem,
+                    system,
+                    state,
+                    schedule,
+                    record_every,
+                    recorder,
+                    watch,
+                    bar,
+                )
         except SimulationError as failure:
             error = failure
     attrs["wall_time_s"] = time.perf_counter() - started
@@ -346,16 +355,25 @@ def _run_compiled(
     evaluations = np.zeros(systems, dtype=np.int64)
     substeps = schedule.substeps
 
-    def advance(origin: float, h: float, first: int, count: int, every: int, frames: int,
-                offset: int, fresh: bool) -> None:
+    def advance(
+        origin: float,
+        h: float,
+        first: int,
+        count: int,
+        every: int,
+        frames: int,
+        offset: int,
+        fresh: bool,
+    ) -> None:
         """Run substeps ``first … first + count − 1`` of size ``h`` timed from ``origin``.
 
         A frame is recorded after every ``every``-th substep; ``offset`` is the index of the
         first substep in the whole run (for messages).
         """
         buffer = np.empty((frames, systems, m), dtype=y.dtype)
-        run(y, work, fresh, origin, h, first, count, every, buffer, watch.limit, status,
-            evaluations)
+        run(
+            y, work, fresh, origin, h, first, count, every, buffer, watch.limit, status, evaluations
+        )
         system.counters.f_evaluations = int(evaluations.max())
         failed = status >= 0
         done = count if not failed.any() else int(status[failed].min()) - first
@@ -389,8 +407,16 @@ def _run_compiled(
         bar.advance(steps)
     if schedule.last_dt > 0.0:
         start = schedule.t0 + schedule.full_steps * substeps * h
-        advance(start, schedule.last_dt / substeps, 0, substeps, substeps, 1,
-                schedule.full_steps * substeps, schedule.full_steps == 0)
+        advance(
+            start,
+            schedule.last_dt / substeps,
+            0,
+            substeps,
+            substeps,
+            1,
+            schedule.full_steps * substeps,
+            schedule.full_steps == 0,
+        )
         bar.advance(1)
 
 

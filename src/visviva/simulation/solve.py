@@ -79,8 +79,14 @@ class Solution:
     @property
     def counters(self) -> dict[str, int]:
         """Work done: f-evaluations, Jacobians, linear solves, Newton iterations, steps."""
-        keys = ("f_evaluations", "jacobian_evaluations", "linear_solves", "newton_iterations",
-                "accepted_steps", "rejected_steps")
+        keys = (
+            "f_evaluations",
+            "jacobian_evaluations",
+            "linear_solves",
+            "newton_iterations",
+            "accepted_steps",
+            "rejected_steps",
+        )
         return {k: int(self.recording.attrs[k]) for k in keys}
 
     def _field(self, name: str) -> np.ndarray:
@@ -161,9 +167,22 @@ def solve(
     t_end = check_end_time(problem, t_end)
     try:
         if use_adaptive:
-            return _solve_adaptive(problem, integrator, t_end, dt, rtol, atol, t_eval,
-                                   dense_output, max_steps, progress, divergence_limit,
-                                   record_every, substeps, compiled)
+            return _solve_adaptive(
+                problem,
+                integrator,
+                t_end,
+                dt,
+                rtol,
+                atol,
+                t_eval,
+                dense_output,
+                max_steps,
+                progress,
+                divergence_limit,
+                record_every,
+                substeps,
+                compiled,
+            )
         for name, value in (("rtol", rtol), ("atol", atol), ("t_eval", t_eval)):
             if value is not None:
                 raise ModelError(
@@ -174,9 +193,17 @@ def solve(
             raise ModelError("`dense_output` applies to adaptive methods only")
         if dt is None:
             raise ModelError(f"`dt` is required for the fixed-step method {integrator.name!r}")
-        recording = simulate(problem, integrator, dt=dt, t_end=t_end, substeps=substeps,
-                             record_every=record_every, progress=progress,
-                             divergence_limit=divergence_limit, compiled=compiled)
+        recording = simulate(
+            problem,
+            integrator,
+            dt=dt,
+            t_end=t_end,
+            substeps=substeps,
+            record_every=record_every,
+            progress=progress,
+            divergence_limit=divergence_limit,
+            compiled=compiled,
+        )
         return Solution(recording, True, "completed")
     except SimulationError as failure:
         return Solution(failure.recording, False, str(failure), failure)  # type: ignore[attr-defined]
@@ -213,9 +240,16 @@ def _solve_adaptive(
         divergence_limit = real_number("divergence_limit", divergence_limit, positive=True)
     times = None if t_eval is None else _check_times(t_eval, problem.t0, t_end)
     recording, dense = integrate_adaptive(
-        problem, integrator,  # type: ignore[arg-type]
-        t_end=t_end, rtol=rtol, atol=atol, first_step=first_step, t_eval=times,
-        dense_output=dense_output, max_steps=max_steps, progress=progress,
+        problem,
+        integrator,  # type: ignore[arg-type]
+        t_end=t_end,
+        rtol=rtol,
+        atol=atol,
+        first_step=first_step,
+        t_eval=times,
+        dense_output=dense_output,
+        max_steps=max_steps,
+        progress=progress,
         divergence_limit=divergence_limit,
     )
     return Solution(recording, True, "completed", sol=dense)

@@ -65,13 +65,19 @@ class DivergenceWatch:
         """The exception describing why ``state`` (reached by step ``step``) is not healthy."""
         component, value, system_index = self._first_offender(state)
         suggestion = self._advice(last_good, system_index)
+        problem = (
+            "is not finite" if not np.isfinite(value) else (f"exceeds the limit {self.limit:.3g}")
+        )
         message = (
             f"simulation diverged at t={state.t:.6g} s (step {step}): {component} = {value!r} "
-            f"{'is not finite' if not np.isfinite(value) else f'exceeds the limit {self.limit:.3g}'}. "
-            f"{self._explain(suggestion)}"
+            f"{problem}. {self._explain(suggestion)}"
         )
         return SimulationDiverged(
-            message, t=state.t, step=step, component=component, value=value,
+            message,
+            t=state.t,
+            step=step,
+            component=component,
+            value=value,
             suggested_dt=suggestion,
         )
 
@@ -97,7 +103,7 @@ class DivergenceWatch:
             if system_index is not None:
                 jacobian = jacobian[system_index]
             return max_stable_dt(self.method, jacobian=jacobian)
-        except Exception:  # noqa: BLE001 - advice is best effort; the divergence is the news
+        except Exception:
             return None
 
     def _explain(self, suggestion: float | None) -> str:

@@ -65,8 +65,14 @@ def plot_stability_regions(
         re, im, modulus = stability_region(method, bounds, resolution)
         stable = np.where(np.isfinite(modulus), modulus, np.inf) <= 1.0 + 1e-12
         ax.contourf(re, im, stable.astype(float), levels=[0.5, 1.5], colors=[STABLE_COLOR])
-        ax.contour(re, im, np.nan_to_num(modulus, nan=np.inf, posinf=1e300), levels=[1.0],
-                   colors=[BOUNDARY_COLOR], linewidths=1.2)
+        ax.contour(
+            re,
+            im,
+            np.nan_to_num(modulus, nan=np.inf, posinf=1e300),
+            levels=[1.0],
+            colors=[BOUNDARY_COLOR],
+            linewidths=1.2,
+        )
         ax.axhline(0.0, color="0.3", linewidth=0.6)
         ax.axvline(0.0, color="0.3", linewidth=0.6)
         ax.set_xlim(bounds[0], bounds[1])
@@ -83,10 +89,13 @@ def _styles(count: int) -> list[dict[str, Any]]:
     """Distinct colour/line-style pairs for up to 40 curves on one axis."""
     from matplotlib import colormaps
 
-    colors = colormaps["tab20"].colors
+    palette = colormaps["tab20"]
+    colors = [palette(i) for i in range(20)]
     dashes = ("-", "--")
-    return [{"color": colors[(2 * i) % 20 + (i // 10) % 2], "linestyle": dashes[(i // 20) % 2]}
-            for i in range(count)]
+    return [
+        {"color": colors[(2 * i) % 20 + (i // 10) % 2], "linestyle": dashes[(i // 20) % 2]}
+        for i in range(count)
+    ]
 
 
 def plot_energy(
@@ -112,8 +121,12 @@ def plot_energy(
             ratio = energy / energy[0]
         ratio_ax.plot(recording.time, ratio, label=name, linewidth=1.3, **style)
         # Exact zeros would vanish from a log axis; floor them at the double-precision epsilon.
-        error_ax.plot(recording.time, np.maximum(np.abs(ratio - 1.0), np.finfo(float).eps),
-                      linewidth=1.1, **style)
+        error_ax.plot(
+            recording.time,
+            np.maximum(np.abs(ratio - 1.0), np.finfo(float).eps),
+            linewidth=1.1,
+            **style,
+        )
     ratio_ax.set_yscale("log")
     ratio_ax.set_ylabel("E(t) / E(0)")
     ratio_ax.legend(fontsize=8, ncol=3)
@@ -163,11 +176,22 @@ def plot_convergence(studies: Sequence[ConvergenceStudy]) -> Figure:
     ax = figure.axes[0]
     for study, style in zip(studies, _styles(len(studies)), strict=True):
         finite = np.isfinite(study.error) & (study.error > 0)
-        ax.loglog(study.dt[finite], study.error[finite], marker="o", markersize=3,
-                  label=f"{study.method}: {study.order:.2f} (declared {study.declared_order})",
-                  **style)
-        ax.loglog(study.dt[study.used], study.error[study.used], "o", markersize=6,
-                  color=style["color"], markerfacecolor="none")
+        ax.loglog(
+            study.dt[finite],
+            study.error[finite],
+            marker="o",
+            markersize=3,
+            label=f"{study.method}: {study.order:.2f} (declared {study.declared_order})",
+            **style,
+        )
+        ax.loglog(
+            study.dt[study.used],
+            study.error[study.used],
+            "o",
+            markersize=6,
+            color=style["color"],
+            markerfacecolor="none",
+        )
     ax.set_xlabel("dt [s]")
     ax.set_ylabel("error at t_end (max norm)")
     ax.grid(True, which="both", alpha=0.3)
