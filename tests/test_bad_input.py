@@ -237,6 +237,26 @@ def test_function_returning_wrong_shape_is_refused(build, name):
     assert f.calls == 1
 
 
+@pytest.mark.parametrize(
+    "build",
+    [
+        lambda: vv.ode.FirstOrderProblem(lambda t, y: 1j * y, y0=[1.0]),
+        lambda: vv.ode.SecondOrderProblem(lambda t, q: 1j * q, q0=[1.0], v0=[0.0]),
+    ],
+)
+def test_complex_rate_for_a_real_state_is_refused(build):
+    """A real state would silently drop the imaginary part of the rate; say how to keep it."""
+    with pytest.raises(vv.ModelError, match=r"complex values for a real state.*y0 \+ 0j"):
+        build()
+
+
+def test_complex_state_with_complex_rate_is_accepted():
+    rotation = vv.ode.FirstOrderProblem(lambda t, y: 1j * y, y0=[1.0 + 0j])
+    sol = vv.solve(rotation, method="rk4", dt=1e-3, t_end=1.0)
+    # y(t) = exp(i t); RK4's global error is O(h^4) = 1e-12 here.
+    np.testing.assert_allclose(sol.y[-1, 0], np.exp(1j), atol=1e-11)
+
+
 def test_numpy_function_not_vectorised_over_the_batch_is_refused():
     """A NumPy f sees the whole (batch, n) state; returning one system's row is refused."""
     f = counted(lambda t, y: -y[0])

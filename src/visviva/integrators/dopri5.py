@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .base import Integrator
-from .runge_kutta import ButcherTableau, combine, initial_rate
+from .runge_kutta import ButcherTableau, Stages, initial_rate
 
 if TYPE_CHECKING:
     from ..ode.state import State
@@ -71,26 +71,18 @@ class Step:
         dt: Step size [s].
     """
 
-    def __init__(
-        self,
-        start: State,
-        end: State,
-        rates: list[tuple[np.ndarray, ...]],
-        dt: float,
-    ) -> None:
+    def __init__(self, start: State, end: State, stages: Stages, dt: float) -> None:
         self.start = start
         self.end = end
         self.dt = dt
-        zeros = tuple(np.zeros_like(p) for p in start.parts)
-        self.error = combine(zeros, dt, _ERROR_WEIGHTS, rates)
-        self._rates = rates
+        self.error = stages.weighted(dt, _ERROR_WEIGHTS)
+        self._stages = stages
 
-    def interpolate(self, theta: Any) -> tuple[np.ndarray, ...]:
-        """State parts at ``start.t + theta·dt`` for ``0 ≤ theta ≤ 1`` (scalar ``theta``)."""
+    def interpolate(self, theta: float) -> tuple[np.ndarray, ...]:
+        """State parts at ``start.t + theta·dt`` for ``0 ≤ theta ≤ 1``."""
         h = self.dt
-        first, last = self._rates[0], self._rates[-1]
-        zeros = tuple(np.zeros_like(p) for p in self.start.parts)
-        highest = combine(zeros, h, _DENSE_WEIGHTS, self._rates)
+        first, last = self._stages[0], self._stages[-1]
+        highest = self._stages.weighted(h, _DENSE_WEIGHTS)
         parts = []
         for p, (y0, y1) in enumerate(zip(self.start.parts, self.end.parts, strict=True)):
             difference = y1 - y0
@@ -122,16 +114,18 @@ class DormandPrince5(Integrator):
         """One step of size ``dt`` with its error estimate (the adaptive driver decides)."""
         tableau = self.tableau
         y0 = state.parts
-        rates = [initial_rate(system, state)]
+        stages = Stages(y0, tableau.stages)
+        stages.append(initial_rate(system, state))
         for i in range(1, tableau.stages - 1):
-            stage = combine(y0, dt, tableau.a[i, :i], rates)
-            rates.append(system.derivative(state.t + tableau.c[i] * dt, stage))
-        y1 = combine(y0, dt, tableau.b, rates)
+            stage = stages.combine(y0, dt, tableau.a[i, :i])
+            stages.append(system.derivative(state.t + tableau.c[i] * dt, stage))
+        # b_7 = 0: the seventh stage (the rate at the new state) only serves the next step.
+        y1 = stages.combine(y0, dt, tableau.b[:-1])
         t1 = state.t + dt
         last = system.derivative(t1, y1)
-        rates.append(last)
+        stages.append(last)
         end = state.from_parts(t1, y1).with_derivative(last)
-        return Step(state, end, rates, dt)
+        return Step(state, end, stages, dt)
 
     def step(self, system: System, state: State, dt: float) -> State:
         return self.attempt(system, state, dt).end

@@ -33,6 +33,7 @@ __all__ = [
     "Heun",
     "Midpoint",
     "RungeKutta4",
+    "Stages",
 ]
 
 #: Tolerance of the tableau consistency checks (row sums of A equal c, weights sum to 1).
@@ -101,21 +102,47 @@ class ButcherTableau:
             return np.asarray(numerator / denominator, dtype=np.complex128)
 
 
-def combine(
-    base: tuple[np.ndarray, ...],
-    h: float,
-    weights: np.ndarray,
-    rates: list[tuple[np.ndarray, ...]],
-) -> tuple[np.ndarray, ...]:
-    """``base + h Σ_j weights[j] · rates[j]``, part by part, skipping zero weights."""
-    result = []
-    for p, start in enumerate(base):
-        total = start.copy()
-        for weight, rate in zip(weights, rates, strict=False):
-            if weight != 0.0:
-                total += (h * weight) * rate[p]
-        result.append(total)
-    return tuple(result)
+class Stages:
+    """The stage derivatives ``k_1 … k_s`` of one Runge–Kutta step.
+
+    Each state part keeps its stages as the rows of one ``(s, size)`` array, so a weighted sum
+    ``Σ_j w_j k_j`` is a single matrix–vector product instead of a Python loop of array updates
+    (which dominated the cost of small systems).
+    """
+
+    def __init__(self, parts: tuple[np.ndarray, ...], count: int) -> None:
+        self._rows = [np.empty((count, p.size), dtype=p.dtype) for p in parts]
+        self._layout = [(rows, p.shape) for rows, p in zip(self._rows, parts)]
+        self.count = 0
+
+    def append(self, rate: tuple[np.ndarray, ...]) -> None:
+        """Store the next stage's derivative, one array per state part."""
+        for rows, part in zip(self._rows, rate, strict=True):
+            rows[self.count] = part.reshape(-1)
+        self.count += 1
+
+    def __getitem__(self, j: int) -> tuple[np.ndarray, ...]:
+        """Stage ``j``'s derivative as state-shaped views."""
+        return tuple([rows[j].reshape(shape) for rows, shape in self._layout])
+
+    def _filled(self, weights: np.ndarray) -> int:
+        """Number of stages ``weights`` spans, which must all be stored (rows start empty)."""
+        n = len(weights)
+        if n > self.count:
+            raise IndexError(f"{n} weights but only {self.count} stages stored")
+        return n
+
+    def weighted(self, h: float, weights: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``h Σ_j weights[j] k_j`` over the first ``len(weights)`` stages, part by part."""
+        scaled = h * weights
+        n = self._filled(weights)
+        return tuple([(scaled @ rows[:n]).reshape(shape) for rows, shape in self._layout])
+
+    def combine(
+        self, base: tuple[np.ndarray, ...], h: float, weights: np.ndarray
+    ) -> tuple[np.ndarray, ...]:
+        """``base + h Σ_j weights[j] k_j``, part by part."""
+        return tuple([b + d for b, d in zip(base, self.weighted(h, weights), strict=True)])
 
 
 def initial_rate(system: System, state: State) -> tuple[np.ndarray, ...]:
@@ -141,11 +168,12 @@ class ExplicitRungeKutta(Integrator):
     def step(self, system: System, state: State, dt: float) -> State:
         tableau = self.tableau
         y0 = state.parts
-        rates = [initial_rate(system, state)]
+        stages = Stages(y0, tableau.stages)
+        stages.append(initial_rate(system, state))
         for i in range(1, tableau.stages):
-            stage = combine(y0, dt, tableau.a[i, :i], rates)
-            rates.append(system.derivative(state.t + tableau.c[i] * dt, stage))
-        return state.from_parts(state.t + dt, combine(y0, dt, tableau.b, rates))
+            stage = stages.combine(y0, dt, tableau.a[i, :i])
+            stages.append(system.derivative(state.t + tableau.c[i] * dt, stage))
+        return state.from_parts(state.t + dt, stages.combine(y0, dt, tableau.b))
 
     def stability_function(self, z: Any) -> np.ndarray:
         return self.tableau.stability_function(z)

@@ -272,7 +272,9 @@ def _probe_states(function: UserFunction, *states: np.ndarray) -> tuple[np.ndarr
     return tuple(np.array(s) for s in states)
 
 
-def _check_result(name: str, value: Any, shape: tuple[int, ...], what: str) -> np.ndarray:
+def _check_result(
+    name: str, value: Any, shape: tuple[int, ...], what: str, complex_state: bool = True
+) -> np.ndarray:
     if value is None:
         raise ModelError(
             f"`{name}` returned None; return {what}, or write it into a last argument named `out`"
@@ -291,6 +293,11 @@ def _check_result(name: str, value: Any, shape: tuple[int, ...], what: str) -> n
         raise ModelError(f"`{name}` returned shape {array.shape}; expected {shape} ({what})")
     if not np.issubdtype(array.dtype, np.number):
         raise ModelError(f"`{name}` returned dtype {array.dtype}; expected numbers ({what})")
+    if np.iscomplexobj(array) and not complex_state:
+        raise ModelError(
+            f"`{name}` returned complex values for a real state; give the initial state as "
+            "complex (for example y0 + 0j) to integrate in the complex plane"
+        )
     bad = ~np.isfinite(array)
     if bad.any():
         index = tuple(int(i) for i in np.argwhere(bad)[0])
@@ -304,7 +311,8 @@ def _check_result(name: str, value: Any, shape: tuple[int, ...], what: str) -> n
 def _check_first_order(problem: FirstOrderProblem) -> None:
     t0 = problem.t0
     (y,) = _probe_states(problem.f, problem.y0)
-    _check_result("f", _call(problem.f, t0, y), y.shape, "dy/dt with the shape of y")
+    f_y = _call(problem.f, t0, y)
+    _check_result("f", f_y, y.shape, "dy/dt with the shape of y", np.iscomplexobj(y))
     if problem.jacobian is not None:
         (y,) = _probe_states(problem.jacobian, problem.y0)
         _check_result("jacobian", _call(problem.jacobian, t0, y), y.shape + y.shape[-1:], "df/dy")
@@ -319,7 +327,13 @@ def _check_second_order(problem: SecondOrderProblem) -> None:
     q, v = _probe_states(force, problem.q0, problem.v0)
     states = (q, v) if force.state_arguments == 2 else (q,)
     what = "the force" if problem.mass is not None else "the acceleration"
-    _check_result(force.name, _call(force, t0, *states), q.shape, f"{what} with the shape of q")
+    _check_result(
+        force.name,
+        _call(force, t0, *states),
+        q.shape,
+        f"{what} with the shape of q",
+        np.iscomplexobj(q),
+    )
     jacobian = problem.jacobian
     if jacobian is not None:
         q, v = _probe_states(jacobian, problem.q0, problem.v0)
