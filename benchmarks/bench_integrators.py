@@ -225,7 +225,7 @@ class Timing:
     times: list[float]
     result: Any
     others: float | None = None  # share of the machine used by other processes meanwhile
-    attempts: int = 1  # measurements made to find an uncontended one
+    attempts: int = 1  # measurements made (re-measured when contended); this is the fastest
 
     @property
     def median(self) -> float:
@@ -245,7 +245,7 @@ class Timing:
         """Other processes' share of the machine during the timed repeats, for the tables."""
         if self.others is None:
             return "?"
-        retried = f" (try {self.attempts})" if self.attempts > 1 else ""
+        retried = f" (best of {self.attempts})" if self.attempts > 1 else ""
         return f"{100.0 * self.others:.0f}%{retried}"
 
 
@@ -293,8 +293,8 @@ def measure(call: Callable[[], Any], repeats: int, label: str = "") -> Timing:
     """Run ``call`` once as warm-up, then ``repeats`` times; keep the last result.
 
     If other processes were busy meanwhile, wait for a quiet moment and measure again (at most
-    ``PATIENCE["retries"]`` times); the least contended attempt is kept. ``first`` is always
-    the very first call (the one that compiles).
+    ``PATIENCE["retries"]`` times); the fastest attempt is kept (contention only ever adds
+    time). ``first`` is always the very first call (the one that compiles).
     """
     attempts = [measure_once(call, repeats)]
     while (attempts[-1].others or 0.0) > CONTENTION_WARNING and (
@@ -302,12 +302,14 @@ def measure(call: Callable[[], Any], repeats: int, label: str = "") -> Timing:
     ):
         wait_for_quiet(PATIENCE["quiet_wait"])
         attempts.append(measure_once(call, repeats))
-    timing = min(attempts, key=lambda t: t.others or 0.0)
+    timing = min(attempts, key=lambda t: t.median)
     timing.first = attempts[0].first
     timing.attempts = len(attempts)
-    if label and timing.others is not None and timing.others > CONTENTION_WARNING:
-        CONTENDED.append(f"{label}: other processes used {timing.busy} of the machine "
-                         f"(least contended of {len(attempts)} attempts)")
+    if label and all((a.others or 0.0) > CONTENTION_WARNING for a in attempts):
+        CONTENDED.append(
+            f"{label}: other processes used {100.0 * timing.others:.0f}% of the "
+            f"machine (fastest of {len(attempts)} attempts)"
+        )
     return timing
 
 
@@ -403,8 +405,13 @@ def source_state() -> str:
 
     def git(*arguments: str) -> str | None:
         try:
-            completed = subprocess.run(["git", "-C", str(package), *arguments],
-                                       capture_output=True, text=True, check=False, timeout=10)
+            completed = subprocess.run(
+                ["git", "-C", str(package), *arguments],
+                capture_output=True,
+                text=True,
+                check=False,
+                timeout=10,
+            )
         except (OSError, subprocess.SubprocessError):
             return None
         return completed.stdout.strip() if completed.returncode == 0 else None
@@ -414,8 +421,9 @@ def source_state() -> str:
         return f"installed at {package} (not a git checkout)"
     changed = git("status", "--porcelain", "--", str(package))
     count = len(changed.splitlines()) if changed else 0
-    return f"git {commit}" + (f", {count} changed/untracked path(s) under src/visviva"
-                              if count else ", clean")
+    return f"git {commit}" + (
+        f", {count} changed/untracked path(s) under src/visviva" if count else ", clean"
+    )
 
 
 def load_average() -> str:
@@ -431,8 +439,10 @@ def print_header(args: argparse.Namespace) -> None:
     except AttributeError:
         usable = os.cpu_count() or 0
     env_threads = os.environ.get("NUMBA_NUM_THREADS")
-    print("visviva time-integration benchmark" + ("  [--quick: smoke run, figures not "
-                                                  "representative]" if args.quick else ""))
+    print(
+        "visviva time-integration benchmark"
+        + ("  [--quick: smoke run, figures not representative]" if args.quick else "")
+    )
     now = datetime.datetime.now().astimezone()
     print(f"date:              {now.isoformat(timespec='seconds')}")
     print(f"CPU:               {cpu_description()}")
@@ -441,11 +451,15 @@ def print_header(args: argparse.Namespace) -> None:
     print(f"numpy / scipy:     {np.__version__} / {scipy.__version__}")
     print(f"numba:             {numba.__version__}")
     print(f"visviva:           {vv.__version__} ({source_state()})")
-    print(f"NUMBA_NUM_THREADS: {numba.config.NUMBA_NUM_THREADS} "
-          f"({'set in the environment' if env_threads else 'default'})")
-    print(f"timing:            median of {args.repeats} runs after one warm-up run (more runs "
-          f"for calls under {MIN_WINDOW / args.repeats:.2g} s, to fill {MIN_WINDOW:g} s); up to "
-          f"{args.retries} re-measurements if other processes were busy")
+    print(
+        f"NUMBA_NUM_THREADS: {numba.config.NUMBA_NUM_THREADS} "
+        f"({'set in the environment' if env_threads else 'default'})"
+    )
+    print(
+        f"timing:            median of {args.repeats} runs after one warm-up run (more runs "
+        f"for calls under {MIN_WINDOW / args.repeats:.2g} s, to fill {MIN_WINDOW:g} s); up to "
+        f"{args.retries} re-measurements if other processes were busy"
+    )
     print(f"load average:      {load_average()} at start")
 
 
@@ -472,28 +486,34 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
     system_steps = systems * steps
     y0 = random_pendulums(systems, seed=20261122)
 
-    heading(f"(a) Batch throughput: {systems:,} double pendulums, RK4, dt = {dt:g} s, "
-            f"{steps} steps")
-    print("  timed: building vv.ode.FirstOrderProblem + vv.solve(..., record_every=1000), or the "
-          "peer's whole call")
+    heading(
+        f"(a) Batch throughput: {systems:,} double pendulums, RK4, dt = {dt:g} s, {steps} steps"
+    )
+    print(
+        "  timed: building vv.ode.FirstOrderProblem + vv.solve(..., record_every=1000), or the "
+        "peer's whole call"
+    )
 
     def visviva_run(f: Callable[..., Any]) -> Any:
         problem = vv.ode.FirstOrderProblem(f, y0)
         return vv.solve(problem, "rk4", dt=dt, t_end=t_end, record_every=steps)
 
     vv_numba = measure(lambda: visviva_run(pendulum_numba), args.repeats, "(a) visviva Numba f")
-    peer_numba = measure(lambda: handwritten_numba_rk4(y0, 0.0, dt, steps), args.repeats,
-                         "(a) hand-written Numba")
+    peer_numba = measure(
+        lambda: handwritten_numba_rk4(y0, 0.0, dt, steps), args.repeats, "(a) hand-written Numba"
+    )
     vv_numpy = measure(lambda: visviva_run(pendulum_numpy), args.repeats, "(a) visviva NumPy f")
-    peer_numpy = measure(lambda: handwritten_numpy_rk4(y0, 0.0, dt, steps), args.repeats,
-                         "(a) hand-written NumPy")
+    peer_numpy = measure(
+        lambda: handwritten_numpy_rk4(y0, 0.0, dt, steps), args.repeats, "(a) hand-written NumPy"
+    )
 
     def scipy_batch() -> tuple[np.ndarray, int]:
         final = np.empty((scipy_systems, 4))
         evaluations = 0
         for i in range(scipy_systems):
-            solution = solve_ivp(pendulum_numba_returning, (0.0, t_end), y0[i], method="RK45",
-                                 rtol=1e-6, atol=1e-9)
+            solution = solve_ivp(
+                pendulum_numba_returning, (0.0, t_end), y0[i], method="RK45", rtol=1e-6, atol=1e-9
+            )
             if not solution.success:
                 raise RuntimeError(f"solve_ivp failed on system {i}: {solution.message}")
             final[i] = solution.y[:, -1]
@@ -516,48 +536,104 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
         return "yes" if value >= target else f"no ({value / target:.2f}×)"
 
     rows = [
-        ["visviva, Numba f (compiled loop)", sci(rate["vv_numba"]), sci(TARGET_NUMBA_F),
-         meets(rate["vv_numba"], TARGET_NUMBA_F),
-         f"{rate['vv_numba'] / rate['peer_numba']:.2f}× hand Numba",
-         fmt_time(vv_numba.median), vv_numba.spread, fmt_time(vv_numba.first),
-         vv_numba.busy],
-        ["visviva, NumPy f", sci(rate["vv_numpy"]), sci(TARGET_NUMPY_F),
-         meets(rate["vv_numpy"], TARGET_NUMPY_F),
-         f"{rate['vv_numpy'] / rate['peer_numpy']:.2f}× hand NumPy",
-         fmt_time(vv_numpy.median), vv_numpy.spread, fmt_time(vv_numpy.first),
-         vv_numpy.busy],
-        ["hand-written Numba RK4 (prange)", sci(rate["peer_numba"]), "", "", "1.00 (peer)",
-         fmt_time(peer_numba.median), peer_numba.spread, fmt_time(peer_numba.first),
-         peer_numba.busy],
-        ["hand-written NumPy RK4", sci(rate["peer_numpy"]), "", "", "1.00 (peer)",
-         fmt_time(peer_numpy.median), peer_numpy.spread, fmt_time(peer_numpy.first),
-         peer_numpy.busy],
-        [f"solve_ivp RK45, {scipy_systems} systems one by one *", sci(scipy_equivalent), "", "",
-         f"{scipy_equivalent / rate['peer_numba']:.4f}× hand Numba",
-         fmt_time(peer_scipy.median), peer_scipy.spread, fmt_time(peer_scipy.first),
-         peer_scipy.busy],
+        [
+            "visviva, Numba f (compiled loop)",
+            sci(rate["vv_numba"]),
+            sci(TARGET_NUMBA_F),
+            meets(rate["vv_numba"], TARGET_NUMBA_F),
+            f"{rate['vv_numba'] / rate['peer_numba']:.2f}× hand Numba",
+            fmt_time(vv_numba.median),
+            vv_numba.spread,
+            fmt_time(vv_numba.first),
+            vv_numba.busy,
+        ],
+        [
+            "visviva, NumPy f",
+            sci(rate["vv_numpy"]),
+            sci(TARGET_NUMPY_F),
+            meets(rate["vv_numpy"], TARGET_NUMPY_F),
+            f"{rate['vv_numpy'] / rate['peer_numpy']:.2f}× hand NumPy",
+            fmt_time(vv_numpy.median),
+            vv_numpy.spread,
+            fmt_time(vv_numpy.first),
+            vv_numpy.busy,
+        ],
+        [
+            "hand-written Numba RK4 (prange)",
+            sci(rate["peer_numba"]),
+            "",
+            "",
+            "1.00 (peer)",
+            fmt_time(peer_numba.median),
+            peer_numba.spread,
+            fmt_time(peer_numba.first),
+            peer_numba.busy,
+        ],
+        [
+            "hand-written NumPy RK4",
+            sci(rate["peer_numpy"]),
+            "",
+            "",
+            "1.00 (peer)",
+            fmt_time(peer_numpy.median),
+            peer_numpy.spread,
+            fmt_time(peer_numpy.first),
+            peer_numpy.busy,
+        ],
+        [
+            f"solve_ivp RK45, {scipy_systems} systems one by one *",
+            sci(scipy_equivalent),
+            "",
+            "",
+            f"{scipy_equivalent / rate['peer_numba']:.4f}× hand Numba",
+            fmt_time(peer_scipy.median),
+            peer_scipy.spread,
+            fmt_time(peer_scipy.first),
+            peer_scipy.busy,
+        ],
     ]
     print()
     print_table(
-        ["path", "system-steps/s", "target", "meets target", "vs same-kind peer",
-         "median wall", "min–max (runs)", "first call", "others' CPU"],
+        [
+            "path",
+            "system-steps/s",
+            "target",
+            "meets target",
+            "vs same-kind peer",
+            "median wall",
+            "min–max (runs)",
+            "first call",
+            "others' CPU",
+        ],
         rows,
     )
     print()
-    print(f"  * solve_ivp: RK45, rtol=1e-6, atol=1e-9, over {t_end:g} s per system, f = the same "
-          "equations as a Numba function returning the derivative.")
-    print(f"    It simulates {sci(system_seconds_per_s)} system-seconds per wall-second; the "
-          f"system-steps/s shown is that × {1 / dt:g} (the RK4 steps per simulated second at "
-          f"dt = {dt:g}),")
-    print(f"    an equivalent for comparison only, not the same work or accuracy "
-          f"({scipy_f_per_system:.0f} f-evaluations per system-second vs {4 / dt:.0f} for RK4).")
-    print("  others' CPU: share of the machine's CPU time used by other processes during the "
-          "timed repeats (0% = quiet machine).")
-    print("  targets are the issue's, for the reference machine (Zen-5-class, AVX-512); "
-          "'vs same-kind peer' is the throughput ratio, below 1 = visviva slower.")
-    print(f"  compile/one-off cost of the first call (first − median): visviva Numba f "
-          f"{fmt_time(vv_numba.compile_estimate)} (includes compiling the user's f), "
-          f"hand-written Numba kernel {fmt_time(peer_numba.compile_estimate)}")
+    print(
+        f"  * solve_ivp: RK45, rtol=1e-6, atol=1e-9, over {t_end:g} s per system, f = the same "
+        "equations as a Numba function returning the derivative."
+    )
+    print(
+        f"    It simulates {sci(system_seconds_per_s)} system-seconds per wall-second; the "
+        f"system-steps/s shown is that × {1 / dt:g} (the RK4 steps per simulated second at "
+        f"dt = {dt:g}),"
+    )
+    print(
+        f"    an equivalent for comparison only, not the same work or accuracy "
+        f"({scipy_f_per_system:.0f} f-evaluations per system-second vs {4 / dt:.0f} for RK4)."
+    )
+    print(
+        "  others' CPU: share of the machine's CPU time used by other processes during the "
+        "timed repeats (0% = quiet machine)."
+    )
+    print(
+        "  targets are the issue's, for the reference machine (Zen-5-class, AVX-512); "
+        "'vs same-kind peer' is the throughput ratio, below 1 = visviva slower."
+    )
+    print(
+        f"  compile/one-off cost of the first call (first − median): visviva Numba f "
+        f"{fmt_time(vv_numba.compile_estimate)} (includes compiling the user's f), "
+        f"hand-written Numba kernel {fmt_time(peer_numba.compile_estimate)}"
+    )
     try:
         layer = numba.threading_layer()
     except ValueError:
@@ -575,27 +651,41 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
     for name, timing in (("Numba f", vv_numba), ("NumPy f", vv_numpy)):
         sol = timing.result
         checks.check(bool(sol.success), f"visviva {name}: success ({sol.message})")
-        checks.check(sol.y.shape == (2, systems, 4),
-                     f"visviva {name}: record_every={steps} kept first and last frame only "
-                     f"(y shape {sol.y.shape})")
-        checks.check(abs(float(sol.t[-1]) - t_end) < 1e-12,
-                     f"visviva {name}: last frame at t = {float(sol.t[-1])!r}")
+        checks.check(
+            sol.y.shape == (2, systems, 4),
+            f"visviva {name}: record_every={steps} kept first and last frame only "
+            f"(y shape {sol.y.shape})",
+        )
+        checks.check(
+            abs(float(sol.t[-1]) - t_end) < 1e-12,
+            f"visviva {name}: last frame at t = {float(sol.t[-1])!r}",
+        )
         print(f"       visviva {name}: counters {sol.counters}")
-    checks.check(vv_numba.result.recording.attrs["compiled"] is True,
-                 "visviva Numba f: recording.attrs['compiled'] is True")
-    checks.check(vv_numpy.result.recording.attrs["compiled"] is False,
-                 "visviva NumPy f: recording.attrs['compiled'] is False (NumPy path)")
+    checks.check(
+        vv_numba.result.recording.attrs["compiled"] is True,
+        "visviva Numba f: recording.attrs['compiled'] is True",
+    )
+    checks.check(
+        vv_numpy.result.recording.attrs["compiled"] is False,
+        "visviva NumPy f: recording.attrs['compiled'] is False (NumPy path)",
+    )
     difference = float(np.max(np.abs(final["vv_numba"] - final["peer_numba"])))
-    checks.check(difference <= 1e-12,
-                 f"final states, visviva Numba path vs hand-written Numba kernel: max |Δ| = "
-                 f"{sci(difference)} (≤ 1e-12)")
-    for a, b, label in (("vv_numpy", "peer_numpy", "visviva NumPy path vs hand-written NumPy"),
-                        ("vv_numba", "vv_numpy", "visviva Numba path vs visviva NumPy path")):
+    checks.check(
+        difference <= 1e-12,
+        f"final states, visviva Numba path vs hand-written Numba kernel: max |Δ| = "
+        f"{sci(difference)} (≤ 1e-12)",
+    )
+    for a, b, label in (
+        ("vv_numpy", "peer_numpy", "visviva NumPy path vs hand-written NumPy"),
+        ("vv_numba", "vv_numpy", "visviva Numba path vs visviva NumPy path"),
+    ):
         d = float(np.max(np.abs(final[a] - final[b])))
         print(f"       (info) final states, {label}: max |Δ| = {sci(d)}")
     d = float(np.max(np.abs(final["peer_numba"][:scipy_systems] - peer_scipy.result[0])))
-    print(f"       (info) final states, hand-written RK4 vs solve_ivp RK45 (rtol 1e-6): max |Δ| "
-          f"= {sci(d)}")
+    print(
+        f"       (info) final states, hand-written RK4 vs solve_ivp RK45 (rtol 1e-6): max |Δ| "
+        f"= {sci(d)}"
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -603,8 +693,32 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
 # --------------------------------------------------------------------------------------------
 
 #: Steps per run on an E24-like ladder (two significant digits), from 100 to 91 million.
-E24 = (10, 11, 12, 13, 15, 16, 18, 20, 22, 24, 27, 30, 33, 36, 39, 43, 47, 51, 56, 62, 68, 75,
-       82, 91)
+E24 = (
+    10,
+    11,
+    12,
+    13,
+    15,
+    16,
+    18,
+    20,
+    22,
+    24,
+    27,
+    30,
+    33,
+    36,
+    39,
+    43,
+    47,
+    51,
+    56,
+    62,
+    68,
+    75,
+    82,
+    91,
+)
 STEP_LADDER = tuple(m * 10**k for k in range(1, 7) for m in E24)
 #: Tolerances rtol = 10^(-k/4) from 1e-5 to 1e-13 (atol = 1e-3 rtol, the ratio of the SciPy runs).
 RTOL_LADDER = tuple(10.0 ** (-k / 4.0) for k in range(20, 53))
@@ -644,16 +758,23 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
     y0 = np.array([theta, theta, 0.0, 0.0])
     span = (0.0, t_end)
 
-    heading(f"(b) Accuracy-matched single system: double pendulum, θ1 = θ2 = {theta} rad, "
-            f"rates 0, t_end = {t_end:g} s")
-    print("  error = max over the 4 components of |y(t_end) − reference|; reference = solve_ivp "
-          "DOP853, rtol = atol = 1e-13")
-    print("  solve_ivp gets the same equations as a Numba function returning dy/dt; visviva "
-          "gets the in-place Numba f(t, y, out)")
+    heading(
+        f"(b) Accuracy-matched single system: double pendulum, θ1 = θ2 = {theta} rad, "
+        f"rates 0, t_end = {t_end:g} s"
+    )
+    print(
+        "  error = max over the 4 components of |y(t_end) − reference|; reference = solve_ivp "
+        "DOP853, rtol = atol = 1e-13"
+    )
+    print(
+        "  solve_ivp gets the same equations as a Numba function returning dy/dt; visviva "
+        "gets the in-place Numba f(t, y, out)"
+    )
 
     def scipy_run(method: str, rtol: float, atol: float, y_start: np.ndarray = y0) -> Any:
-        solution = solve_ivp(pendulum_numba_returning, span, y_start, method=method, rtol=rtol,
-                             atol=atol)
+        solution = solve_ivp(
+            pendulum_numba_returning, span, y_start, method=method, rtol=rtol, atol=atol
+        )
         if not solution.success:
             raise RuntimeError(f"solve_ivp {method} failed: {solution.message}")
         return solution
@@ -667,17 +788,20 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
     def error_of(final: np.ndarray) -> float:
         return float(np.max(np.abs(np.asarray(final) - reference)))
 
-    print(f"  reference check: |DOP853(1e-13) − DOP853(3e-14)| = {sci(reference_uncertainty)}; a "
-          f"1e-10 change of θ1(0) changes y(t_end) by {growth:.3g}× as much (regular, not "
-          "chaotic, motion)")
+    print(
+        f"  reference check: |DOP853(1e-13) − DOP853(3e-14)| = {sci(reference_uncertainty)}; a "
+        f"1e-10 change of θ1(0) changes y(t_end) by {growth:.3g}× as much (regular, not "
+        "chaotic, motion)"
+    )
 
     rk45 = measure(lambda: scipy_run("RK45", 1e-9, 1e-12), args.repeats, "(b) solve_ivp RK45")
-    dop853 = measure(lambda: scipy_run("DOP853", 1e-9, 1e-12), args.repeats,
-                     "(b) solve_ivp DOP853")
+    dop853 = measure(lambda: scipy_run("DOP853", 1e-9, 1e-12), args.repeats, "(b) solve_ivp DOP853")
     targets = {"RK45": error_of(rk45.result.y[:, -1]), "DOP853": error_of(dop853.result.y[:, -1])}
     for name, value in targets.items():
-        checks.check(value > 100.0 * reference_uncertainty,
-                     f"solve_ivp {name} error {sci(value)} is ≥ 100× the reference's uncertainty")
+        checks.check(
+            value > 100.0 * reference_uncertainty,
+            f"solve_ivp {name} error {sci(value)} is ≥ 100× the reference's uncertainty",
+        )
 
     def visviva_rk4(steps: int) -> Any:
         problem = vv.ode.FirstOrderProblem(pendulum_numba, y0)
@@ -695,8 +819,10 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
     # RK4: the error goes as dt^4, so one probe run predicts where on the ladder to start.
     probe_steps = STEP_LADDER.index(1000 if args.quick else 10_000)
     probe = visviva_rk4(STEP_LADDER[probe_steps])
-    checks.check(probe.recording.attrs["compiled"] is True,
-                 "visviva rk4 single system: recording.attrs['compiled'] is True")
+    checks.check(
+        probe.recording.attrs["compiled"] is True,
+        "visviva rk4 single system: recording.attrs['compiled'] is True",
+    )
     probe_error = solution_error(probe)
     rk4_choice: dict[str, int] = {}
     dopri5_choice: dict[str, int] = {}
@@ -706,69 +832,121 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
     for name, target in targets.items():
         wanted = STEP_LADDER[probe_steps] * (probe_error / target) ** 0.25
         start = next(i for i, s in enumerate(STEP_LADDER) if s >= wanted)
-        index, tried = ladder_search(STEP_LADDER, start,
-                                     lambda s: solution_error(visviva_rk4(s)), target)
+        index, tried = ladder_search(
+            STEP_LADDER, start, lambda s: solution_error(visviva_rk4(s)), target
+        )
         rk4_choice[name] = index
-        trail = ", ".join(f"dt={sci(t_end / STEP_LADDER[i])}→{sci(e, 2)}"
-                          for i, e in sorted(tried.items()))
+        trail = ", ".join(
+            f"dt={sci(t_end / STEP_LADDER[i])}→{sci(e, 2)}" for i, e in sorted(tried.items())
+        )
         print(f"    rk4    to {name:6s} ({sci(target)}): {trail}")
-        index, tried = ladder_search(RTOL_LADDER, same_tolerance,
-                                     lambda r: solution_error(visviva_dopri5(r)), target)
+        index, tried = ladder_search(
+            RTOL_LADDER, same_tolerance, lambda r: solution_error(visviva_dopri5(r)), target
+        )
         dopri5_choice[name] = index
-        trail = ", ".join(f"rtol={sci(RTOL_LADDER[i], 2)}→{sci(e, 2)}"
-                          for i, e in sorted(tried.items()))
+        trail = ", ".join(
+            f"rtol={sci(RTOL_LADDER[i], 2)}→{sci(e, 2)}" for i, e in sorted(tried.items())
+        )
         print(f"    dopri5 to {name:6s} ({sci(target)}): {trail}")
 
     rows: list[list[str]] = []
 
-    def add_row(label: str, setting: str, timing: Timing, final: np.ndarray, evaluations: int,
-                steps: str) -> None:
-        rows.append([
-            label, setting, sci(error_of(final)), f"{evaluations:,}", steps,
-            fmt_time(timing.median), timing.spread,
-            f"{timing.median / rk45.median:.2f}", f"{timing.median / dop853.median:.2f}",
-            timing.busy,
-        ])
+    def add_row(
+        label: str, setting: str, timing: Timing, final: np.ndarray, evaluations: int, steps: str
+    ) -> None:
+        rows.append(
+            [
+                label,
+                setting,
+                sci(error_of(final)),
+                f"{evaluations:,}",
+                steps,
+                fmt_time(timing.median),
+                timing.spread,
+                f"{timing.median / rk45.median:.2f}",
+                f"{timing.median / dop853.median:.2f}",
+                timing.busy,
+            ]
+        )
 
     for name, timing in (("RK45", rk45), ("DOP853", dop853)):
         result = timing.result
-        add_row(f"solve_ivp {name}", "rtol 1e-9, atol 1e-12", timing, result.y[:, -1],
-                result.nfev, f"{result.t.size - 1:,} (–)")
+        add_row(
+            f"solve_ivp {name}",
+            "rtol 1e-9, atol 1e-12",
+            timing,
+            result.y[:, -1],
+            result.nfev,
+            f"{result.t.size - 1:,} (–)",
+        )
 
     def add_visviva(label: str, timing: Timing, setting: str) -> None:
         solution = timing.result
         counters = solution.counters
-        add_row(label, setting, timing, solution.y[-1], counters["f_evaluations"],
-                f"{counters['accepted_steps']:,} ({counters['rejected_steps']:,})")
+        add_row(
+            label,
+            setting,
+            timing,
+            solution.y[-1],
+            counters["f_evaluations"],
+            f"{counters['accepted_steps']:,} ({counters['rejected_steps']:,})",
+        )
 
-    same = measure(lambda: visviva_dopri5(RTOL_LADDER[same_tolerance]), args.repeats,
-                   "(b) visviva dopri5, same tolerances")
+    same = measure(
+        lambda: visviva_dopri5(RTOL_LADDER[same_tolerance]),
+        args.repeats,
+        "(b) visviva dopri5, same tolerances",
+    )
     add_visviva("visviva dopri5, same tolerances", same, "rtol 1e-9, atol 1e-12")
     for name in targets:
         steps = STEP_LADDER[rk4_choice[name]]
-        timing = measure(lambda steps=steps: visviva_rk4(steps), args.repeats,
-                         f"(b) visviva rk4 matched to {name}")
-        add_visviva(f"visviva rk4, matched to {name}", timing,
-                    f"dt {sci(t_end / steps)} ({steps:,} steps)")
+        timing = measure(
+            lambda steps=steps: visviva_rk4(steps),
+            args.repeats,
+            f"(b) visviva rk4 matched to {name}",
+        )
+        add_visviva(
+            f"visviva rk4, matched to {name}", timing, f"dt {sci(t_end / steps)} ({steps:,} steps)"
+        )
         rtol = RTOL_LADDER[dopri5_choice[name]]
-        timing = measure(lambda rtol=rtol: visviva_dopri5(rtol), args.repeats,
-                         f"(b) visviva dopri5 matched to {name}")
-        add_visviva(f"visviva dopri5, matched to {name}", timing,
-                    f"rtol {sci(rtol, 2)}, atol {sci(1e-3 * rtol, 2)}")
+        timing = measure(
+            lambda rtol=rtol: visviva_dopri5(rtol),
+            args.repeats,
+            f"(b) visviva dopri5 matched to {name}",
+        )
+        add_visviva(
+            f"visviva dopri5, matched to {name}",
+            timing,
+            f"rtol {sci(rtol, 2)}, atol {sci(1e-3 * rtol, 2)}",
+        )
     print()
     print_table(
-        ["run", "setting", "final error", "f-evals", "steps (rejected)", "median wall",
-         "min–max (runs)", "÷ RK45", "÷ DOP853", "others' CPU"],
+        [
+            "run",
+            "setting",
+            "final error",
+            "f-evals",
+            "steps (rejected)",
+            "median wall",
+            "min–max (runs)",
+            "÷ RK45",
+            "÷ DOP853",
+            "others' CPU",
+        ],
         rows,
     )
     print()
-    print("  f-evals: solve_ivp nfev; visviva solution.counters['f_evaluations']. steps: "
-          "accepted (rejected; solve_ivp does not report them). '÷ RK45', '÷ DOP853': wall-time "
-          "ratio to that solve_ivp run "
-          "(below 1 = visviva faster);")
+    print(
+        "  f-evals: solve_ivp nfev; visviva solution.counters['f_evaluations']. steps: "
+        "accepted (rejected; solve_ivp does not report them). '÷ RK45', '÷ DOP853': wall-time "
+        "ratio to that solve_ivp run "
+        "(below 1 = visviva faster);"
+    )
     print("  others' CPU: share of the machine used by other processes during the timed repeats.")
-    print("  visviva rk4 runs the compiled Numba loop (record_every = all steps: first and last "
-          "frame); dopri5 runs the Python adaptive driver recording every step, as solve_ivp does.")
+    print(
+        "  visviva rk4 runs the compiled Numba loop (record_every = all steps: first and last "
+        "frame); dopri5 runs the Python adaptive driver recording every step, as solve_ivp does."
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -793,8 +971,10 @@ def cli_commands() -> list[tuple[str, list[str]]]:
         commands.append((f"{on_path} (on PATH)", [on_path, "--help"]))
     if not commands:
         # No console script installed: call the entry point the way the script would.
-        code = ("import sys; from visviva.cli.main import main; sys.argv = ['visviva', '--help']; "
-                "sys.exit(main())")
+        code = (
+            "import sys; from visviva.cli.main import main; sys.argv = ['visviva', '--help']; "
+            "sys.exit(main())"
+        )
         commands.append(("python -c 'visviva.cli.main:main()'", [sys.executable, "-c", code]))
     return commands
 
@@ -805,8 +985,14 @@ def bench_cli(args: argparse.Namespace) -> None:
 
     def run(command: list[str]) -> tuple[float, subprocess.CompletedProcess[str]]:
         start = time.perf_counter()
-        completed = subprocess.run(command, capture_output=True, text=True, check=False,
-                                   stdin=subprocess.DEVNULL, timeout=120)
+        completed = subprocess.run(
+            command,
+            capture_output=True,
+            text=True,
+            check=False,
+            stdin=subprocess.DEVNULL,
+            timeout=120,
+        )
         return time.perf_counter() - start, completed
 
     rows = []
@@ -815,15 +1001,24 @@ def bench_cli(args: argparse.Namespace) -> None:
         first, completed = run(command)
         if completed.returncode != 0:
             reason = (completed.stderr.strip().splitlines() or ["no output"])[-1]
-            print(f"  CLI not available: {label} exited with status {completed.returncode} "
-                  f"({reason})")
+            print(
+                f"  CLI not available: {label} exited with status {completed.returncode} ({reason})"
+            )
             continue
         available = True
         timing = measure(lambda command=command: run(command)[0], repeats, f"(c) {label}")
         median = timing.median
-        rows.append([label, fmt_time(median), timing.spread, fmt_time(first), f"≤ {TARGET_CLI:g} s",
-                     "yes" if median <= TARGET_CLI else f"no ({median / TARGET_CLI:.1f}×)",
-                     timing.busy])
+        rows.append(
+            [
+                label,
+                fmt_time(median),
+                timing.spread,
+                fmt_time(first),
+                f"≤ {TARGET_CLI:g} s",
+                "yes" if median <= TARGET_CLI else f"no ({median / TARGET_CLI:.1f}×)",
+                timing.busy,
+            ]
+        )
     baselines = [
         ("python -c pass", [sys.executable, "-c", "pass"]),
         ("python -c 'import visviva'", [sys.executable, "-c", "import visviva"]),
@@ -833,11 +1028,21 @@ def bench_cli(args: argparse.Namespace) -> None:
         if completed.returncode != 0:
             continue
         timing = measure(lambda command=command: run(command)[0], repeats)
-        rows.append([f"(context) {label}", fmt_time(timing.median), timing.spread,
-                     fmt_time(first), "", "", timing.busy])
+        rows.append(
+            [
+                f"(context) {label}",
+                fmt_time(timing.median),
+                timing.spread,
+                fmt_time(first),
+                "",
+                "",
+                timing.busy,
+            ]
+        )
     print()
-    print_table(["command", "median", "min–max (runs)", "first", "target", "meets",
-                 "others' CPU"], rows)
+    print_table(
+        ["command", "median", "min–max (runs)", "first", "target", "meets", "others' CPU"], rows
+    )
     if not available:
         print("  (the entry point visviva.cli.main:main does not exist yet; rerun once it does)")
 
@@ -847,16 +1052,30 @@ def bench_cli(args: argparse.Namespace) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true",
-                        help="short smoke run (1,000 systems, 10 s single-system run)")
-    parser.add_argument("--repeats", type=int, default=None,
-                        help="timed runs per figure after the warm-up (default 5, --quick 3)")
-    parser.add_argument("--retries", type=int, default=None,
-                        help="re-measure a figure taken while other processes were busy up to "
-                             "this many times (default 2, --quick 0)")
-    parser.add_argument("--quiet-wait", type=float, default=30.0,
-                        help="before a retry, wait up to this many seconds for the machine to "
-                             "be idle (default 30)")
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help="short smoke run (1,000 systems, 10 s single-system run)",
+    )
+    parser.add_argument(
+        "--repeats",
+        type=int,
+        default=None,
+        help="timed runs per figure after the warm-up (default 5, --quick 3)",
+    )
+    parser.add_argument(
+        "--retries",
+        type=int,
+        default=None,
+        help="re-measure a figure taken while other processes were busy up to "
+        "this many times (default 2, --quick 0)",
+    )
+    parser.add_argument(
+        "--quiet-wait",
+        type=float,
+        default=30.0,
+        help="before a retry, wait up to this many seconds for the machine to be idle (default 30)",
+    )
     args = parser.parse_args(argv)
     if args.repeats is None:
         args.repeats = 3 if args.quick else 5
@@ -874,16 +1093,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     bench_accuracy(args, checks)
     bench_cli(args)
     print()
-    print(f"total benchmark time: {time.perf_counter() - started:.0f} s; load average at the end: "
-          f"{load_average()}")
+    print(
+        f"total benchmark time: {time.perf_counter() - started:.0f} s; load average at the end: "
+        f"{load_average()}"
+    )
     if CONTENDED:
-        print(f"WARNING: other processes were busy during {len(CONTENDED)} measurement(s); "
-              "those figures understate this machine:")
+        print(
+            f"WARNING: other processes were busy during {len(CONTENDED)} measurement(s); "
+            "those figures understate this machine:"
+        )
         for line in CONTENDED:
             print(f"  - {line}")
     else:
-        print(f"no measurement saw other processes use more than {CONTENTION_WARNING:.0%} of "
-              "the machine")
+        print(
+            f"no measurement saw other processes use more than {CONTENTION_WARNING:.0%} of "
+            "the machine"
+        )
     if checks.failures:
         print(f"{len(checks.failures)} sanity check(s) FAILED:")
         for failure in checks.failures:

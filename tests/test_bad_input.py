@@ -55,6 +55,18 @@ def restoring(t: float, x: np.ndarray) -> np.ndarray:
     return -x
 
 
+#: Builds a problem of each kind around a two-component right-hand side ``f``, with its name.
+each_right_hand_side = pytest.mark.parametrize(
+    ("build", "name"),
+    [
+        (lambda f: FirstOrderProblem(f, [1.0, 0.5]), "f"),
+        (lambda f: SecondOrderProblem(f, [1.0, 0.5], [0.0, 0.0]), "acceleration"),
+        (lambda f: SecondOrderProblem.from_force(f, 2.0, [1.0, 0.5], [0.0, 0.0]), "force"),
+    ],
+    ids=["f", "acceleration", "force"],
+)
+
+
 @pytest.fixture
 def decay() -> tuple[FirstOrderProblem, Any]:
     """``y' = -y`` from ``y = (1, 0.5)``, with its f counting calls (reset after construction)."""
@@ -221,15 +233,7 @@ def test_function_with_wrong_signature_is_refused(build, accepted, got):
     refused(build, accepted, got)
 
 
-@pytest.mark.parametrize(
-    ("build", "name"),
-    [
-        (lambda f: FirstOrderProblem(f, [1.0, 0.5]), "f"),
-        (lambda f: SecondOrderProblem(f, [1.0, 0.5], [0.0, 0.0]), "acceleration"),
-        (lambda f: SecondOrderProblem.from_force(f, 2.0, [1.0, 0.5], [0.0, 0.0]), "force"),
-    ],
-    ids=["f", "acceleration", "force"],
-)
+@each_right_hand_side
 def test_function_returning_wrong_shape_is_refused(build, name):
     """A right-hand side of 3 components for 2 coordinates is refused after its one check call."""
     f = counted(lambda t, x: np.zeros(3))
@@ -264,15 +268,7 @@ def test_numpy_function_not_vectorised_over_the_batch_is_refused():
     assert f.calls == 1
 
 
-@pytest.mark.parametrize(
-    ("build", "name"),
-    [
-        (lambda f: FirstOrderProblem(f, [1.0, 0.5]), "f"),
-        (lambda f: SecondOrderProblem(f, [1.0, 0.5], [0.0, 0.0]), "acceleration"),
-        (lambda f: SecondOrderProblem.from_force(f, 2.0, [1.0, 0.5], [0.0, 0.0]), "force"),
-    ],
-    ids=["f", "acceleration", "force"],
-)
+@each_right_hand_side
 def test_function_returning_none_is_refused(build, name):
     """Forgetting `return` is reported as such, with the `out` alternative."""
     f = counted(lambda t, x: None)
@@ -280,15 +276,7 @@ def test_function_returning_none_is_refused(build, name):
     assert f.calls == 1
 
 
-@pytest.mark.parametrize(
-    ("build", "name"),
-    [
-        (lambda f: FirstOrderProblem(f, [1.0, 0.5]), "f"),
-        (lambda f: SecondOrderProblem(f, [1.0, 0.5], [0.0, 0.0]), "acceleration"),
-        (lambda f: SecondOrderProblem.from_force(f, 2.0, [1.0, 0.5], [0.0, 0.0]), "force"),
-    ],
-    ids=["f", "acceleration", "force"],
-)
+@each_right_hand_side
 def test_function_returning_nan_at_initial_state_is_refused(build, name):
     """A right-hand side that is already nan at t0 is caught before any step, with the entry."""
     f = counted(lambda t, x: np.array([-x[0], np.nan]))

@@ -112,7 +112,7 @@ class Stages:
 
     def __init__(self, parts: tuple[np.ndarray, ...], count: int) -> None:
         self._rows = [np.empty((count, p.size), dtype=p.dtype) for p in parts]
-        self._layout = [(rows, p.shape) for rows, p in zip(self._rows, parts)]
+        self._layout = [(rows, p.shape) for rows, p in zip(self._rows, parts, strict=True)]
         self.count = 0
 
     def append(self, rate: tuple[np.ndarray, ...]) -> None:
