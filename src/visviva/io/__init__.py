@@ -1,5 +1,19 @@
 """Files in and out: recordings (HDF5)."""
 
-from .recording import FORMAT, FORMAT_VERSION, Recording, read_recordings, write_recordings
+from .recording import (
+    FORMAT,
+    FORMAT_VERSION,
+    Geometry,
+    Recording,
+    read_recordings,
+    write_recordings,
+)
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "Recording", "read_recordings", "write_recordings"]
+__all__ = [
+    "FORMAT",
+    "FORMAT_VERSION",
+    "Geometry",
+    "Recording",
+    "read_recordings",
+    "write_recordings",
+]

@@ -14,6 +14,16 @@ comparison of several methods fits in one file::
                                    strings under the key prefixed with "json:"
     /<run>/time             float64 (frames,), attr units = "s"
     /<run>/fields/<name>    (frames, ...) float64 or complex128, attr units, chunked per frame
+    /<run>/static/<name>    arrays without a frame axis (topology, radii), attr units
+
+Drawable geometry (what the video, the web viewer and the exporters show) follows one
+convention, read back by :meth:`Recording.geometry`:
+
+    fields/points           float64 (frames, P, 3) [m]: point positions, world frame, Y up
+    static/radius           float64 (P,) [m]: point radii (optional)
+    static/edges            int64 (E, 2): pairs of point indices drawn as lines (optional)
+    static/faces            int64 (F, 3): triangles of point indices, counter-clockwise seen
+                            from outside (optional)
 
 Files are written to a temporary name next to the target and renamed when complete, so a
 crash never leaves a truncated file under the real name.
@@ -24,6 +34,7 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Mapping
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -34,10 +45,48 @@ from .._version import __version__
 from ..errors import ModelError
 from .files import atomic_path
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "Recording", "read_recordings", "write_recordings"]
+__all__ = [
+    "FORMAT",
+    "FORMAT_VERSION",
+    "Geometry",
+    "Recording",
+    "read_recordings",
+    "write_recordings",
+]
 
 FORMAT = "visviva.recording"
 FORMAT_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """What a recording shows: moving points, optionally with radii, edges and triangles.
+
+    Attributes:
+        points: Positions [m], shape ``(frames, P, 3)``, world frame, Y up.
+        radius: Radii [m], shape ``(P,)``, or ``None`` (draw as small dots).
+        edges: Point-index pairs drawn as lines, shape ``(E, 2)``, or ``None``.
+        faces: Point-index triangles, shape ``(F, 3)``, or ``None``.
+    """
+
+    points: np.ndarray
+    radius: np.ndarray | None = None
+    edges: np.ndarray | None = None
+    faces: np.ndarray | None = None
+
+    @property
+    def frames(self) -> int:
+        """Number of frames."""
+        return self.points.shape[0]
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper corners [m] of the box holding every point of every frame (radii
+        included)."""
+        pad = 0.0 if self.radius is None or self.radius.size == 0 else float(self.radius.max())
+        flat = self.points.reshape(-1, 3)
+        if flat.size == 0:
+            return np.zeros(3), np.zeros(3)
+        return flat.min(axis=0) - pad, flat.max(axis=0) + pad
 
 
 class Recording:
@@ -46,8 +95,9 @@ class Recording:
     Args:
         time: Frame times [s], shape ``(frames,)``.
         fields: Arrays with a leading frame axis, e.g. ``{"q": (frames, n), "v": ...}``.
-        units: Unit of each field (``""`` for dimensionless or unknown).
+        units: Unit of each field or static array (``""`` for dimensionless or unknown).
         attrs: Run attributes: strings, numbers, booleans, or JSON-serialisable values.
+        static: Arrays that do not change over the run (radii, edges, faces).
 
     Example:
         >>> import numpy as np
@@ -63,6 +113,7 @@ class Recording:
         *,
         units: Mapping[str, str] | None = None,
         attrs: Mapping[str, Any] | None = None,
+        static: Mapping[str, np.ndarray] | None = None,
     ) -> None:
         self.time = np.asarray(time, dtype=np.float64)
         self.fields = {name: np.asarray(value) for name, value in fields.items()}
@@ -71,7 +122,8 @@ class Recording:
                 raise ModelError(
                     f"field {name!r} has {value.shape[:1]} frames but time has {self.time.shape}"
                 )
-        self.units = {name: "" for name in self.fields} | dict(units or {})
+        self.static = {name: np.asarray(value) for name, value in (static or {}).items()}
+        self.units = {name: "" for name in (*self.fields, *self.static)} | dict(units or {})
         self.attrs: dict[str, Any] = dict(attrs or {})
 
     @property
@@ -89,6 +141,36 @@ class Recording:
 
     def __contains__(self, name: object) -> bool:
         return name in self.fields
+
+    def geometry(self) -> Geometry:
+        """The drawable geometry (see the module docstring), checked for consistent shapes.
+
+        Raises:
+            ModelError: If the recording has no ``points`` field or its static arrays do not
+                fit the points.
+        """
+        if "points" not in self.fields:
+            raise ModelError(
+                "this recording has no geometry to show (no `points` field): it comes from a "
+                "run of an abstract system; record a scene with particles or bodies instead"
+            )
+        points = self.fields["points"]
+        if points.ndim != 3 or points.shape[2] != 3:
+            raise ModelError(f"`points` must have shape (frames, P, 3) (got {points.shape})")
+        count = points.shape[1]
+        radius = self.static.get("radius")
+        if radius is not None and radius.shape != (count,):
+            raise ModelError(f"`radius` must have shape ({count},) (got {radius.shape})")
+        topology = {}
+        for name, width in (("edges", 2), ("faces", 3)):
+            value = self.static.get(name)
+            if value is not None:
+                if value.ndim != 2 or value.shape[1] != width:
+                    raise ModelError(f"`{name}` must have shape (n, {width}) (got {value.shape})")
+                if value.size and (value.min() < 0 or value.max() >= count):
+                    raise ModelError(f"`{name}` refers to points outside 0..{count - 1}")
+            topology[name] = value
+        return Geometry(points, radius, **topology)
 
     def save(self, path: str | os.PathLike[str], *, run: str = "run") -> Path:
         """Write this recording as the only run of an HDF5 file (see the module docstring)."""
@@ -158,6 +240,10 @@ def _write_run(group: Any, recording: Recording) -> None:
         chunks = (1, *value.shape[1:]) if value.ndim > 1 and value.size else None
         dataset = fields.create_dataset(name, data=value, chunks=chunks)
         dataset.attrs["units"] = recording.units.get(name, "")
+    if recording.static:
+        static = group.create_group("static")
+        for name, value in recording.static.items():
+            static.create_dataset(name, data=value).attrs["units"] = recording.units.get(name, "")
 
 
 def read_recordings(path: str | os.PathLike[str]) -> dict[str, Recording]:
@@ -190,6 +276,14 @@ def read_recordings(path: str | os.PathLike[str]) -> dict[str, Recording]:
                 else:
                     attrs[key] = value.item() if isinstance(value, np.generic) else value
             fields = {k: d[()] for k, d in group["fields"].items()}
-            units = {k: str(d.attrs.get("units", "")) for k, d in group["fields"].items()}
-            runs[name] = Recording(group["time"][()], fields, units=units, attrs=attrs)
+            static = {k: d[()] for k, d in group["static"].items()} if "static" in group else {}
+            units = {
+                k: str(d.attrs.get("units", ""))
+                for part in ("fields", "static")
+                if part in group
+                for k, d in group[part].items()
+            }
+            runs[name] = Recording(
+                group["time"][()], fields, units=units, attrs=attrs, static=static
+            )
     return runs
