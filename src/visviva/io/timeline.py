@@ -1,0 +1,50 @@
+"""Resampling recorded frames to a fixed output rate (video, viewer, USD/glTF time codes).
+
+A recording's frames need not be evenly spaced (adaptive runs, a shortened last step). Output
+frame ``k`` shows time ``t0 + k/fps``, computed from the integer ``k`` (never by adding ``1/fps``
+repeatedly), and uses the recorded frame nearest that time; on a tie, the earlier one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._validation import real_number
+from ..errors import ModelError
+
+__all__ = ["frames_at_rate"]
+
+#: Output frames closer than this fraction of a frame to the end still count as inside the run.
+_END_SLACK = 1e-9
+
+
+def frames_at_rate(time: np.ndarray, fps: float) -> np.ndarray:
+    """Indices into ``time`` of the recorded frame to show at each output frame.
+
+    Args:
+        time: Recorded frame times [s], non-decreasing, shape ``(frames,)``.
+        fps: Output frames per second [1/s].
+
+    Returns:
+        ``int64`` array of length ``floor((t_end − t0)·fps) + 1``: for output frame ``k``, the
+        index of the recorded frame nearest ``t0 + k/fps``.
+
+    Example:
+        >>> frames_at_rate(np.array([0.0, 0.1, 0.2, 0.3, 0.4]), fps=5.0)
+        array([0, 2, 4])
+    """
+    fps = real_number("fps", fps, positive=True, unit=" frames/s")
+    time = np.asarray(time, dtype=np.float64)
+    if time.ndim != 1 or time.size == 0:
+        raise ModelError(f"a recording needs at least one frame to resample (got {time.shape})")
+    t0, span = time[0], time[-1] - time[0]
+    count = math.floor(span * fps + _END_SLACK) + 1
+    wanted = t0 + np.arange(count) / fps
+    after = np.clip(np.searchsorted(time, wanted, side="left"), 1, max(1, time.size - 1))
+    before = after - 1
+    if time.size == 1:
+        return np.zeros(count, dtype=np.int64)
+    closer_after = (time[after] - wanted) < (wanted - time[before])
+    return np.where(closer_after, after, before).astype(np.int64)

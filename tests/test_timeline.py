@@ -1,0 +1,34 @@
+"""Resampling recorded frames to an output rate."""
+
+import numpy as np
+import pytest
+
+import visviva as vv
+from visviva.io.timeline import frames_at_rate
+
+
+def test_uniform_recording_at_a_lower_rate_picks_every_kth_frame():
+    # 1000 steps of 1 ms shown at 50 fps: output frame k is recorded frame 20k, exactly.
+    time = np.arange(1001) * 1e-3
+    np.testing.assert_array_equal(frames_at_rate(time, 50.0), np.arange(51) * 20)
+
+
+def test_frame_times_come_from_integers_not_accumulation():
+    # 3 fps over 1000 s: accumulating 1/3 would drift; k/3 lands on the nearest recorded frame.
+    time = np.arange(3_000_001) / 3000.0
+    chosen = frames_at_rate(time, 3.0)
+    assert chosen.size == 3001
+    np.testing.assert_array_equal(chosen, np.arange(3001) * 1000)
+
+
+def test_uneven_frames_take_the_nearest_and_the_earlier_on_a_tie():
+    time = np.array([0.0, 0.05, 0.5, 0.9, 1.0])
+    # wanted 0, 0.25 (nearer 0.05), 0.5, 0.75 (tie 0.5/1.0? no: 0.9 is nearer), 1.0
+    np.testing.assert_array_equal(frames_at_rate(time, 4.0), [0, 1, 2, 3, 4])
+    np.testing.assert_array_equal(frames_at_rate(np.array([0.0, 0.5, 1.0]), 4.0), [0, 0, 1, 1, 2])
+
+
+def test_single_frame_and_bad_rate():
+    np.testing.assert_array_equal(frames_at_rate(np.array([2.0]), 30.0), [0])
+    with pytest.raises(vv.ModelError, match="fps"):
+        frames_at_rate(np.array([0.0, 1.0]), 0.0)
