@@ -23,7 +23,7 @@ def test_frame_times_come_from_integers_not_accumulation():
 
 def test_uneven_frames_take_the_nearest_and_the_earlier_on_a_tie():
     time = np.array([0.0, 0.05, 0.5, 0.9, 1.0])
-    # wanted 0, 0.25 (nearer 0.05), 0.5, 0.75 (tie 0.5/1.0? no: 0.9 is nearer), 1.0
+    # Wanted times 0, 0.25, 0.5, 0.75, 1.0; nearest recorded: 0, 0.05, 0.5, 0.9, 1.0.
     np.testing.assert_array_equal(frames_at_rate(time, 4.0), [0, 1, 2, 3, 4])
     np.testing.assert_array_equal(frames_at_rate(np.array([0.0, 0.5, 1.0]), 4.0), [0, 0, 1, 1, 2])
 
