@@ -23,20 +23,26 @@ from ._version import __version__
 from .errors import (
     ModelError,
     NewtonConvergenceError,
+    SceneError,
     SimulationDiverged,
     SimulationError,
     VisvivaError,
 )
 
 if TYPE_CHECKING:
-    from . import analysis, demos, integrators, io, ode, simulation, viz
+    from . import analysis, demos, forces, integrators, io, model, ode, simulation, viz
     from .io import Recording
+    from .model import Model, SceneBuilder
+    from .scenes import load_model, run_scene
     from .simulation import Solution, simulate, solve
 
 __all__ = [
+    "Model",
     "ModelError",
     "NewtonConvergenceError",
     "Recording",
+    "SceneBuilder",
+    "SceneError",
     "SimulationDiverged",
     "SimulationError",
     "Solution",
@@ -44,17 +50,35 @@ __all__ = [
     "__version__",
     "analysis",
     "demos",
+    "forces",
     "integrators",
     "io",
+    "load_model",
+    "model",
     "ode",
+    "run_scene",
     "simulate",
     "simulation",
     "solve",
     "viz",
 ]
 
-_SUBPACKAGES = {"analysis", "demos", "integrators", "io", "ode", "simulation", "viz"}
+_SUBPACKAGES = {
+    "analysis",
+    "demos",
+    "forces",
+    "integrators",
+    "io",
+    "model",
+    "ode",
+    "simulation",
+    "viz",
+}
 _FUNCTIONS = {
+    "Model": "model",
+    "SceneBuilder": "model",
+    "load_model": "scenes",
+    "run_scene": "scenes",
     "Recording": "io",
     "Solution": "simulation",
     "simulate": "simulation",

@@ -12,9 +12,13 @@ says when, where and what to do":
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 __all__ = [
     "ModelError",
     "NewtonConvergenceError",
+    "SceneError",
+    "SceneProblem",
     "SimulationDiverged",
     "SimulationError",
     "VisvivaError",
@@ -27,6 +31,48 @@ class VisvivaError(Exception):
 
 class ModelError(VisvivaError, ValueError):
     """Invalid input: the message names the field, the value received and the fix."""
+
+
+@dataclass(frozen=True)
+class SceneProblem:
+    """One thing wrong with a scene.
+
+    Attributes:
+        path: Where, as in the file: ``entities[2].mass`` (empty for the whole scene).
+        message: What is wrong and how to fix it.
+        got: The offending value as written in the message, or ``None``.
+        line: Line of the scene file where it can be found (1-based), when known.
+    """
+
+    path: str
+    message: str
+    got: str | None = None
+    line: int | None = None
+
+    def describe(self, source: str | None = None) -> str:
+        """``file:line: path: message (got X)``."""
+        where = ":".join(str(x) for x in (source, self.line) if x is not None)
+        text = f"{self.path}: {self.message}" if self.path else self.message
+        if self.got is not None:
+            text += f" (got {self.got})"
+        return f"{where}: {text}" if where else text
+
+
+class SceneError(ModelError):
+    """A scene that cannot be built; ``problems`` lists every problem found, not just the first.
+
+    Attributes:
+        problems: Each problem with its path, message, value and line.
+        source: The scene file's name, when it came from a file.
+    """
+
+    def __init__(self, problems: list[SceneProblem], source: str | None = None) -> None:
+        self.problems = problems
+        self.source = source
+        count = len(problems)
+        heading = f"{count} problem{'s' if count != 1 else ''} in the scene"
+        lines = [p.describe(source) for p in problems]
+        super().__init__("\n".join([heading + ":", *("  " + line for line in lines)]))
 
 
 class SimulationError(VisvivaError, RuntimeError):

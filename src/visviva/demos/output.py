@@ -65,13 +65,33 @@ class JobOutput:
         self.recordings: dict[str, Recording] = {}
         self.figures: dict[str, Figure] = {}
         self.summary: dict[str, Any] = {}
+        self.staged: list[str] = []
+        self._staging: Path | None = None
 
     def planned(self) -> list[str]:
         """File names this job will write."""
         names = ["summary.json"]
         if self.recordings:
             names.insert(0, "recording.h5")
-        return names + [f"{name}.png" for name in self.figures]
+        return names + [f"{name}.png" for name in self.figures] + self.staged
+
+    def stage(self, name: str) -> Path:
+        """Where to write output file ``name`` now; it moves into place with the others.
+
+        The staging directory is a hidden directory inside the target, so if the process dies
+        the files written so far (a flushed recording) survive there.
+        """
+        if self._staging is None:
+            self.directory.mkdir(parents=True, exist_ok=True)
+            self._staging = Path(tempfile.mkdtemp(prefix=".visviva-", dir=self.directory))
+        self.staged.append(name)
+        return self._staging / name
+
+    def discard(self) -> None:
+        """Remove everything staged (the job failed before writing its outputs)."""
+        if self._staging is not None:
+            shutil.rmtree(self._staging, ignore_errors=True)
+            self._staging = None
 
     def check_target(self, names: list[str] | None = None) -> None:
         """Refuse to overwrite existing outputs without ``force`` (call before the work)."""
@@ -94,7 +114,9 @@ class JobOutput:
         """Write everything collected plus ``summary.json``; return the paths written."""
         self.check_target(self.planned())
         self.directory.mkdir(parents=True, exist_ok=True)
-        staging = Path(tempfile.mkdtemp(prefix=".visviva-", dir=self.directory))
+        if self._staging is None:
+            self._staging = Path(tempfile.mkdtemp(prefix=".visviva-", dir=self.directory))
+        staging = self._staging
         try:
             if self.recordings:
                 write_recordings(staging / "recording.h5", self.recordings)
@@ -110,7 +132,7 @@ class JobOutput:
                 written.append(target)
             return written
         finally:
-            shutil.rmtree(staging, ignore_errors=True)
+            self.discard()
 
 
 def _plain(value: Any) -> Any:

@@ -225,14 +225,22 @@ def write_recordings(path: str | os.PathLike[str], runs: Mapping[str, Recording]
     return target
 
 
-def _write_run(group: Any, recording: Recording) -> None:
-    for key, value in recording.attrs.items():
+def write_attrs(group: Any, attrs: Mapping[str, Any]) -> None:
+    """Store run attributes on an HDF5 group: plain values as they are, others as JSON."""
+    for key, value in attrs.items():
+        for stale in (key, f"json:{key}"):
+            if stale in group.attrs:
+                del group.attrs[stale]
         if isinstance(value, (str, bool, int, float, np.integer, np.floating)):
             group.attrs[key] = value
         elif value is None:
             group.attrs[f"json:{key}"] = "null"
         else:
             group.attrs[f"json:{key}"] = json.dumps(value)
+
+
+def _write_run(group: Any, recording: Recording) -> None:
+    write_attrs(group, recording.attrs)
     time = group.create_dataset("time", data=recording.time)
     time.attrs["units"] = "s"
     fields = group.create_group("fields")

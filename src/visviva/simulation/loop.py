@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -40,7 +41,10 @@ if TYPE_CHECKING:
     from ..ode.state import State
     from ..ode.system import System
 
-__all__ = ["Schedule", "initial_state", "simulate"]
+__all__ = ["FrameCallback", "Schedule", "initial_state", "simulate"]
+
+#: ``on_frame(t, parts)``: a recorded frame's time [s] and state arrays.
+FrameCallback = Callable[[float, tuple[np.ndarray, ...]], None]
 
 #: A fixed-step run may take at most this many steps; more is a mistake in dt, not a plan.
 MAX_STEPS = 10**10
@@ -117,10 +121,15 @@ class FrameRecorder:
         template: A state of the run (its kind and shapes); recorded as the first frame unless
             ``include`` is false.
         include: Record ``template`` as the first frame.
+        on_frame: Called with ``(t, parts)`` for every frame as it is recorded (streaming
+            writers); ``parts`` are the state arrays, to be copied if kept.
     """
 
-    def __init__(self, template: State, include: bool = True) -> None:
+    def __init__(
+        self, template: State, include: bool = True, on_frame: FrameCallback | None = None
+    ) -> None:
         self.template = template
+        self.on_frame = on_frame
         self.names = ("y",) if isinstance(template, FirstOrderState) else ("q", "v")
         self.times: list[float] = []
         self.parts: list[list[np.ndarray]] = [[] for _ in self.names]
@@ -132,14 +141,19 @@ class FrameRecorder:
         self.times.append(state.t)
         for store, part in zip(self.parts, state.parts, strict=True):
             store.append(np.array(part))
+        if self.on_frame is not None:
+            self.on_frame(state.t, state.parts)
 
     def extend(self, times: np.ndarray, stacked: np.ndarray, n: int, batch: bool) -> None:
         """Append frames from the compiled path: ``stacked`` is ``(frames, batch, m)``."""
         for t, frame in zip(times, stacked, strict=True):
             self.times.append(float(t))
             pieces = (frame,) if len(self.names) == 1 else (frame[:, :n], frame[:, n:])
-            for store, piece in zip(self.parts, pieces, strict=True):
-                store.append(np.array(piece if batch else piece[0]))
+            kept = [np.array(piece if batch else piece[0]) for piece in pieces]
+            for store, piece in zip(self.parts, kept, strict=True):
+                store.append(piece)
+            if self.on_frame is not None:
+                self.on_frame(float(t), tuple(kept))
 
     def last(self) -> State:
         """The most recent frame as a state."""
@@ -165,6 +179,7 @@ def simulate(
     progress: bool | None = None,
     divergence_limit: float | None = None,
     compiled: bool | None = None,
+    on_frame: FrameCallback | None = None,
 ) -> Recording:
     """Run ``problem`` with fixed steps and return the recorded frames.
 
@@ -181,6 +196,8 @@ def simulate(
             (default ``1e10 × max(1, max |initial state|)``).
         compiled: ``None`` to run compiled when possible, ``False`` to force the NumPy path,
             ``True`` to require the compiled path.
+        on_frame: Called with ``(t, parts)`` as each frame is recorded, for example to stream
+            frames to a file while the run goes on.
 
     Returns:
         The :class:`~visviva.io.Recording`, with fields ``y`` (first-order) or ``q`` and ``v``,
@@ -216,7 +233,7 @@ def simulate(
 
     schedule = Schedule.build(problem.t0, t_end, dt, substeps)
     state = initial_state(problem)
-    recorder = FrameRecorder(state)
+    recorder = FrameRecorder(state, on_frame=on_frame)
     watch = DivergenceWatch(system, integrator, dt, state, divergence_limit)
     attrs: dict[str, Any] = {
         "method": integrator.name,

@@ -1,0 +1,217 @@
+"""Reading and writing scene files (TOML or JSON), with every problem reported at once.
+
+:func:`load_scene` reads a file, refuses what is not a scene (too large, not UTF-8, a syntax
+error with its line and column), validates it against :mod:`~visviva.io.scene_schema` and
+reports each validation problem as ``path: message (got X)`` with the line where it can be
+found and a did-you-mean for misspelt keys. :func:`dump_scene` writes a scene back; floats are
+written with ``repr`` (the shortest text that reads back to the same double), so a
+dump → load round trip is bit-identical.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ValidationError
+
+from .._validation import describe, did_you_mean
+from ..errors import SceneError, SceneProblem
+from .scene_locate import locate_json, locate_toml
+from .scene_schema import Integration, Output, ParticleCloud, Particles, Scene, SceneInfo, System
+from .scene_schema import World as WorldSettings
+
+__all__ = ["MAX_SCENE_BYTES", "dump_scene", "load_scene", "parse_scene"]
+
+#: Largest scene file read [bytes]: scenes are descriptions, not data dumps.
+MAX_SCENE_BYTES = 16 * 2**20
+
+#: Names pydantic gives the branches of a union in error locations (never scene keys).
+_UNION_BRANCH = re.compile(r"^(float|int|str|list|tuple|dict|[a-z]+(-[a-z]+)+)$|\[")
+_TABLES: dict[str, type[BaseModel]] = {
+    "scene": SceneInfo,
+    "world": WorldSettings,
+    "integration": Integration,
+    "output": Output,
+}
+_ENTITIES: dict[str, type[BaseModel]] = {
+    "particles": Particles,
+    "particle_cloud": ParticleCloud,
+    "system": System,
+}
+
+
+def load_scene(path: str | os.PathLike[str]) -> tuple[Scene, str]:
+    """Read and validate a scene file (``.toml`` or ``.json``).
+
+    Returns:
+        The scene and the file's text.
+
+    Raises:
+        SceneError: Listing every problem, each with its path and line.
+    """
+    source = os.fspath(path)
+    file = Path(path)
+    if file.suffix.lower() not in (".toml", ".json"):
+        raise SceneError(
+            [SceneProblem("", "scene files end in .toml or .json", repr(file.suffix))], source
+        )
+    try:
+        size = file.stat().st_size
+    except OSError as exc:
+        raise SceneError(
+            [SceneProblem("", f"cannot read the file: {exc.strerror}")], source
+        ) from None
+    if size > MAX_SCENE_BYTES:
+        raise SceneError(
+            [
+                SceneProblem(
+                    "",
+                    f"the file is {size} bytes; scene files may be at most {MAX_SCENE_BYTES} "
+                    '(generate large particle sets with type = "particle_cloud")',
+                )
+            ],
+            source,
+        )
+    data = file.read_bytes()
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise SceneError(
+            [
+                SceneProblem(
+                    "",
+                    f"the file is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
+                    f"{exc.start}); save it as UTF-8",
+                    line=line,
+                )
+            ],
+            source,
+        ) from None
+    return parse_scene(text, "json" if file.suffix.lower() == ".json" else "toml", source), text
+
+
+def parse_scene(text: str, format: str = "toml", source: str | None = None) -> Scene:
+    """Parse and validate scene text; ``format`` is ``"toml"`` or ``"json"``."""
+    try:
+        raw = json.loads(text) if format == "json" else tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(
+            [SceneProblem("", f"TOML syntax error: {exc}", line=exc.lineno)], source
+        ) from None
+    except json.JSONDecodeError as exc:
+        problem = f"JSON syntax error: {exc.msg} (at line {exc.lineno}, column {exc.colno})"
+        raise SceneError([SceneProblem("", problem, line=exc.lineno)], source) from None
+    if not isinstance(raw, dict):
+        raise SceneError(
+            [SceneProblem("", "a scene is a table of settings", describe(raw))], source
+        )
+    try:
+        return Scene.model_validate(raw)
+    except ValidationError as exc:
+        locate = locate_json if format == "json" else locate_toml
+        raise SceneError(_problems(exc, raw, lambda path: locate(text, path)), source) from None
+
+
+def _problems(exc: ValidationError, raw: dict[str, Any], line_of: Any) -> list[SceneProblem]:
+    """One problem per field: pydantic reports each branch of a union; keep the telling one."""
+    chosen: dict[tuple[Any, ...], dict[str, Any]] = {}
+    for error in exc.errors(include_url=False):
+        path = _field_path(error["loc"], raw)
+        previous = chosen.get(path)
+        if previous is None or (
+            previous["type"].endswith("_type") and not error["type"].endswith("_type")
+        ):
+            chosen[path] = error
+    problems = []
+    for path, error in chosen.items():
+        message = error["msg"].replace("Input should be", "must be", 1)
+        got: str | None = describe(error["input"])
+        if error["type"] == "extra_forbidden":
+            key = str(path[-1])
+            allowed = _allowed_keys(path[:-1], raw)
+            message = f"unknown key.{did_you_mean(key, allowed)} Allowed: {', '.join(allowed)}"
+            got = None
+        elif error["type"] == "missing":
+            got = None
+        elif error["type"] == "union_tag_invalid":
+            message = f"unknown entity type; valid types: {', '.join(_ENTITIES)}"
+            got = describe(error["input"].get("type") if isinstance(error["input"], dict) else None)
+        elif error["type"] == "finite_number":
+            message = "must be a finite number (numbers beyond ±1.8e308 overflow to inf)"
+        problems.append(SceneProblem(_dotted(path), message, got, line_of(path)))
+    return problems
+
+
+def _field_path(loc: tuple[Any, ...], raw: dict[str, Any]) -> tuple[Any, ...]:
+    """The error's location as the user wrote it: no union-branch or entity-tag segments."""
+    path: list[Any] = []
+    for segment in loc:
+        if isinstance(segment, str) and _UNION_BRANCH.search(segment):
+            continue  # a union branch name such as "constrained-float", not a key
+        if (
+            len(path) == 2
+            and path[0] == "entities"
+            and isinstance(path[1], int)
+            and segment in _ENTITIES
+        ):
+            continue  # the discriminator's branch, not a key
+        path.append(segment)
+    return tuple(path)
+
+
+def _allowed_keys(path: tuple[Any, ...], raw: dict[str, Any]) -> list[str]:
+    model: type[BaseModel] | None = Scene
+    if len(path) == 1:
+        model = _TABLES.get(str(path[0]))
+    elif len(path) == 2 and path[0] == "entities":
+        entities = raw.get("entities")
+        entity = entities[path[1]] if isinstance(entities, list) else None
+        model = _ENTITIES.get(entity.get("type")) if isinstance(entity, dict) else None
+    elif path:
+        model = None
+    return list(model.model_fields) if model is not None else []
+
+
+def _dotted(path: tuple[Any, ...]) -> str:
+    text = ""
+    for segment in path:
+        text += f"[{segment}]" if isinstance(segment, int) else f".{segment}" if text else segment
+    return text
+
+
+def dump_scene(scene: Scene, format: str = "toml") -> str:
+    """The scene as TOML (or JSON) text that :func:`parse_scene` reads back identically."""
+    data = scene.model_dump(mode="python", exclude_none=True)
+    if format == "json":
+        return json.dumps(data, indent=2, allow_nan=False) + "\n"
+    lines: list[str] = []
+    for table in ("scene", "world", "integration", "output"):
+        lines.append(f"[{table}]")
+        lines += [f"{key} = {_toml_value(value)}" for key, value in data[table].items()]
+        lines.append("")
+    for entity in data["entities"]:
+        lines.append("[[entities]]")
+        lines += [f"{key} = {_toml_value(value)}" for key, value in entity.items()]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)  # shortest round-trip text of the double (or the exact integer)
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)  # JSON escapes are valid TOML basic strings
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        items = ", ".join(f"{json.dumps(k)} = {_toml_value(v)}" for k, v in value.items())
+        return "{" + (f" {items} " if items else "") + "}"
+    raise TypeError(f"cannot write {type(value).__name__} to TOML")
