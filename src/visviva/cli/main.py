@@ -3,35 +3,19 @@
 Thin by design: each command parses its options and calls the library. Heavy modules (NumPy,
 SciPy, Numba, matplotlib) are imported inside the commands, so ``visviva --help`` stays fast.
 User errors (:class:`~visviva.errors.ModelError`) print one line and exit with status 2;
-numerical failures exit with status 1.
+numerical failures exit with status 1. The scene and output commands live in
+:mod:`visviva.cli.scenes`.
 """
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
-app = typer.Typer(
-    name="visviva",
-    help="Physically based animation: time integration, mechanics and simulation.",
-    no_args_is_help=True,
-    add_completion=False,
-    pretty_exceptions_enable=False,
-)
-
-OutputOption = Annotated[Path, typer.Option("--output", "-o", help="Output file or directory.")]
-JsonOption = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON.")]
-ForceOption = Annotated[bool, typer.Option("--force", help="Replace existing output files.")]
-
-
-def _print_json(data: Any) -> None:
-    from ..demos.output import _plain
-
-    typer.echo(json.dumps(_plain(data), indent=2, allow_nan=False))
+from .common import ForceOption, JsonOption, app, check_new_file, print_json, save_figure
 
 
 @app.command("integrators")
@@ -41,7 +25,7 @@ def integrators_command(as_json: JsonOption = False) -> None:
 
     methods = [integrators.get(name) for name in integrators.names()]
     if as_json:
-        _print_json([m.describe() for m in methods])
+        print_json([m.describe() for m in methods])
         return
     from rich.console import Console
     from rich.table import Table
@@ -86,7 +70,7 @@ def stability_command(
 
     instances = [get(name) for name in methods]
     if output is not None:
-        _check_new_file(output, force)
+        check_new_file(output, force)
     intervals = {
         m.name: {
             # `+ 0.0` turns a computed -0.0 into 0.0.
@@ -98,9 +82,9 @@ def stability_command(
     if output is not None:
         from ..viz.plots import plot_stability_regions
 
-        _save_figure(plot_stability_regions(instances), output)
+        save_figure(plot_stability_regions(instances), output)
     if as_json:
-        _print_json(
+        print_json(
             {name: {axis: list(v) for axis, v in axes.items()} for name, axes in intervals.items()}
         )
         return
@@ -138,7 +122,7 @@ def convergence_command(
     levels = whole_number("levels", levels, minimum=3)
     t_end = real_number("t_end", t_end, positive=True, unit=" s")
     if output is not None:
-        _check_new_file(output, force)
+        check_new_file(output, force)
     test = reference_problem(problem)
     studies = [
         convergence_order(
@@ -153,7 +137,7 @@ def convergence_command(
     if output is not None:
         from ..viz.plots import plot_convergence
 
-        _save_figure(plot_convergence(studies), output)
+        save_figure(plot_convergence(studies), output)
     rows = [
         {
             "method": s.method,
@@ -166,7 +150,7 @@ def convergence_command(
         for s in studies
     ]
     if as_json:
-        _print_json({"problem": problem, "t_end": t_end, "methods": rows})
+        print_json({"problem": problem, "t_end": t_end, "methods": rows})
         return
     typer.echo(f"problem: {test.description}, error at t = {t_end:g} s")
     for row in rows:
@@ -198,23 +182,8 @@ def demo_command(
         typer.echo(f"wrote {path}")
 
 
-def _check_new_file(path: Path, force: bool) -> None:
-    from ..errors import ModelError
-
-    if path.is_dir():
-        raise ModelError(f"output {path} is a directory; give a file name such as {path}/plot.png")
-    if path.exists() and not force:
-        raise ModelError(f"{path} already exists; pass --force to replace it")
-    if not path.parent.exists():
-        raise ModelError(f"directory {path.parent} does not exist")
-
-
-def _save_figure(figure: Any, path: Path) -> None:
-    """Save so that the file appears complete or not at all."""
-    from ..io.files import atomic_path
-
-    with atomic_path(path) as temporary:
-        figure.savefig(temporary, dpi=110, format=path.suffix.lstrip(".") or "png")
+# After the commands above, so that `visviva --help` lists them first.
+from . import scenes as _scene_commands  # noqa: E402, F401 - registers run, validate, plot, ...
 
 
 def main() -> None:

@@ -101,8 +101,11 @@ def parse_scene(text: str, format: str = "toml", source: str | None = None) -> S
     try:
         raw = json.loads(text) if format == "json" else tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
+        # Python 3.11's TOMLDecodeError has no lineno attribute; its message ends with it.
+        match = re.search(r"at line (\d+)", str(exc))
+        line = int(match.group(1)) if match else None
         raise SceneError(
-            [SceneProblem("", f"TOML syntax error: {exc}", line=exc.lineno)], source
+            [SceneProblem("", f"TOML syntax error: {exc}", line=line)], source
         ) from None
     except json.JSONDecodeError as exc:
         problem = f"JSON syntax error: {exc.msg} (at line {exc.lineno}, column {exc.colno})"
@@ -120,7 +123,7 @@ def parse_scene(text: str, format: str = "toml", source: str | None = None) -> S
 
 def _problems(exc: ValidationError, raw: dict[str, Any], line_of: Any) -> list[SceneProblem]:
     """One problem per field: pydantic reports each branch of a union; keep the telling one."""
-    chosen: dict[tuple[Any, ...], dict[str, Any]] = {}
+    chosen: dict[tuple[Any, ...], Any] = {}
     for error in exc.errors(include_url=False):
         path = _field_path(error["loc"], raw)
         previous = chosen.get(path)
@@ -172,7 +175,7 @@ def _allowed_keys(path: tuple[Any, ...], raw: dict[str, Any]) -> list[str]:
     elif len(path) == 2 and path[0] == "entities":
         entities = raw.get("entities")
         entity = entities[path[1]] if isinstance(entities, list) else None
-        model = _ENTITIES.get(entity.get("type")) if isinstance(entity, dict) else None
+        model = _ENTITIES.get(str(entity.get("type"))) if isinstance(entity, dict) else None
     elif path:
         model = None
     return list(model.model_fields) if model is not None else []

@@ -21,7 +21,6 @@ from ..io.scene_schema import (
     ParticleCloud,
     Particles,
     Scene,
-    SceneInfo,
     System,
     World,
 )

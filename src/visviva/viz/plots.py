@@ -198,3 +198,36 @@ def plot_convergence(studies: Sequence[ConvergenceStudy]) -> Figure:
     ax.legend(fontsize=8)
     ax.set_title("Convergence: circled points are in the fitted asymptotic range")
     return figure
+
+
+def plot_momentum(recording: Recording, *, title: str = "Momenta") -> Figure:
+    """Linear momentum ``P = Σ m v`` and angular momentum ``L = Σ m x × v`` over time.
+
+    Needs a particle recording: fields ``points`` [m] and ``velocities`` [m/s] and the static
+    ``mass`` [kg]. Each component is drawn against time [s].
+    """
+    from ..analysis.invariants import angular_momentum, linear_momentum
+    from ..errors import ModelError
+
+    missing = [n for n in ("points", "velocities") if n not in recording]
+    if missing or "mass" not in recording.static:
+        raise ModelError(
+            "momentum plots need a particle recording (points, velocities and mass); "
+            f"this one has fields {', '.join(recording.fields)}"
+        )
+    mass = recording.static["mass"]
+    series = {
+        "linear momentum P [kg·m/s]": linear_momentum(mass, recording["velocities"]),
+        "angular momentum L [kg·m²/s]": angular_momentum(
+            mass, recording["points"], recording["velocities"]
+        ),
+    }
+    figure = _figure(2, width=6.0, height=3.6, columns=2)
+    for ax, (label, values) in zip(figure.axes, series.items(), strict=True):
+        for axis, name in enumerate("xyz"):
+            ax.plot(recording.time, values[:, axis], label=f"{label.split()[-2]}{name}")
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel(label)
+        ax.legend(fontsize="small")
+    figure.suptitle(title)
+    return figure

@@ -1,0 +1,174 @@
+"""Scene and output commands: ``run``, ``validate``, ``schema``, ``plot``, ``view``, ``export``."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .common import ForceOption, app, check_new_file, print_json, save_figure
+
+SceneArgument = Annotated[Path, typer.Argument(help="Scene file (.toml or .json).")]
+RecordingArgument = Annotated[Path, typer.Argument(help="Recording file (recording.h5).")]
+RunOption = Annotated[
+    str | None, typer.Option("--run", help="Run to use when the file holds several.")
+]
+FpsOption = Annotated[
+    float | None, typer.Option("--fps", help="Frames per second of the output [1/s].")
+]
+
+
+@app.command("run")
+def run_command(
+    scene: SceneArgument,
+    output: Annotated[Path, typer.Option("--output", "-o", help="Output directory.")] = Path("out"),
+    duration: Annotated[
+        float | None, typer.Option(help="Simulated time [s] instead of the scene's.")
+    ] = None,
+    formats: Annotated[
+        list[str] | None,
+        typer.Option("--format", "-f", help="Extra output: mp4, gif, html, usd, glb, obj, pc2."),
+    ] = None,
+    dry_run: Annotated[
+        bool, typer.Option("--dry-run", help="Validate and print counts; write nothing.")
+    ] = False,
+    force: ForceOption = False,
+) -> None:
+    """Run a scene: recording.h5, summary.json and the requested outputs into a directory."""
+    from ..scenes import dry_run as plan
+    from ..scenes import load_model, run_scene
+
+    model = load_model(scene)
+    if dry_run:
+        report = plan(model, duration=duration, formats=formats or ())
+        what = f"system {report.system}" if report.system else f"{report.particles} particles"
+        limit = report.max_stable_dt
+        advice = (
+            "no step limit from the linearization"
+            if math.isinf(limit)
+            else f"largest stable dt for {model.integration.method} ≈ {limit:.4g} s"
+            + (" (dt is above it!)" if model.integration.dt > limit else "")
+        )
+        typer.echo(f"{scene}: {what}, {report.steps} steps of dt = {model.integration.dt} s")
+        typer.echo(f"recording: {report.frames} frames; {advice}")
+        typer.echo(f"would write: {', '.join(report.outputs)} into {output}")
+        return
+    for path in run_scene(model, output, duration=duration, formats=formats or (), force=force):
+        typer.echo(f"wrote {path}")
+
+
+@app.command("validate")
+def validate_command(scene: SceneArgument) -> None:
+    """Check a scene file and report every problem at once (exit status 2 if any)."""
+    from ..scenes import load_model
+
+    model = load_model(scene)
+    what = f"system {model.system.system}" if model.system else f"{model.particle_count} particles"
+    typer.echo(f"{scene}: valid ({what}, method {model.integration.method})")
+
+
+@app.command("schema")
+def schema_command() -> None:
+    """Print the JSON Schema of scene files (for editor completion)."""
+    from ..io.scene_schema import Scene
+
+    print_json(Scene.model_json_schema())
+
+
+@app.command("plot")
+def plot_command(
+    recording: RecordingArgument,
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Image file (default: next to it).")
+    ] = None,
+    energy: Annotated[bool, typer.Option("--energy", help="Energy over time.")] = False,
+    momentum: Annotated[bool, typer.Option("--momentum", help="Momenta over time.")] = False,
+    run: RunOption = None,
+    force: ForceOption = False,
+) -> None:
+    """Plot a recording: energy (default) or momenta over time."""
+    from ..errors import ModelError
+    from ..io.recording import Recording, read_recordings
+    from ..viz.plots import plot_energy, plot_momentum
+
+    if energy and momentum:
+        raise ModelError("choose one of --energy and --momentum per plot")
+    kind = "momentum" if momentum else "energy"
+    target = output or recording.with_name(f"{kind}.png")
+    check_new_file(target, force)
+    if kind == "momentum":
+        figure = plot_momentum(Recording.load(recording, run))
+    else:
+        runs = read_recordings(recording)
+        chosen = runs if run is None else {run: Recording.load(recording, run)}
+        figure = plot_energy(chosen)
+    save_figure(figure, target)
+    typer.echo(f"wrote {target}")
+
+
+@app.command("view")
+def view_command(
+    recording: RecordingArgument,
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", "-o", help="HTML file (default: viewer.html next to it)."),
+    ] = None,
+    fps: FpsOption = None,
+    run: RunOption = None,
+    force: ForceOption = False,
+) -> None:
+    """Write the single-file web viewer of a recording (open it in any browser)."""
+    from ..io.recording import Recording
+    from ..viz.viewer import write_viewer
+
+    target = output or recording.with_name("viewer.html")
+    check_new_file(target, force)
+    written = write_viewer(Recording.load(recording, run), target, fps=fps)
+    typer.echo(f"wrote {written}; open it in a browser (file://{written.resolve()})")
+
+
+@app.command("export")
+def export_command(
+    recording: RecordingArgument,
+    to: Annotated[str, typer.Option("--to", help="usd, glb, obj, pc2, mp4 or gif.")],
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Output file (default: next to it).")
+    ] = None,
+    fps: FpsOption = None,
+    run: RunOption = None,
+    force: ForceOption = False,
+) -> None:
+    """Export a recording for Blender/Houdini (USD, glTF, OBJ, PC2) or as a video."""
+    from .._validation import did_you_mean
+    from ..errors import ModelError
+    from ..io.recording import Recording
+
+    suffixes = {
+        "usd": ".usdc",
+        "glb": ".glb",
+        "obj": "",
+        "pc2": ".pc2",
+        "mp4": ".mp4",
+        "gif": ".gif",
+    }
+    if to not in suffixes:
+        raise ModelError(
+            f"unknown export format {to!r}.{did_you_mean(to, suffixes)} "
+            f"Valid: {', '.join(suffixes)}"
+        )
+    default = recording.with_name("obj" if to == "obj" else f"animation{suffixes[to]}")
+    target = output or default
+    check_new_file(target, force)
+    source = Recording.load(recording, run)
+    if to in ("mp4", "gif"):
+        from ..viz.video import render_video
+
+        written = [render_video(source, target, fps=fps or 30.0)]
+    else:
+        from ..io.export import export_recording
+
+        written = export_recording(source, target, to=to, fps=fps)
+    for path in written:
+        typer.echo(f"wrote {path}")
