@@ -154,15 +154,10 @@ def _problems(exc: ValidationError, raw: dict[str, Any], line_of: Any) -> list[S
 def _field_path(loc: tuple[Any, ...], raw: dict[str, Any]) -> tuple[Any, ...]:
     """The error's location as the user wrote it: no union-branch or entity-tag segments."""
     path: list[Any] = []
-    for segment in loc:
+    for position, segment in enumerate(loc):
         if isinstance(segment, str) and _UNION_BRANCH.search(segment):
             continue  # a union branch name such as "constrained-float", not a key
-        if (
-            len(path) == 2
-            and path[0] == "entities"
-            and isinstance(path[1], int)
-            and segment in _ENTITIES
-        ):
+        if position == 2 and loc[0] == "entities" and segment in _ENTITIES:
             continue  # the discriminator's branch, not a key
         path.append(segment)
     return tuple(path)

@@ -1,0 +1,259 @@
+"""Bad scenes: every case exits 2 from ``visviva run``, names the path and value, writes nothing."""
+
+from __future__ import annotations
+
+import copy
+import sys
+import tomllib
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import visviva as vv
+from visviva.cli.main import main
+from visviva.io.scene_files import MAX_SCENE_BYTES, dump_scene, parse_scene
+from visviva.model import build_model
+
+VALID = """\
+[scene]
+name = "valid"
+
+[integration]
+method = "symplectic_euler"
+dt = 0.01
+duration = 0.1
+
+[[entities]]
+type = "particles"
+name = "ball"
+positions = [[0.0, 1.0, 0.0]]
+mass = 1.0
+
+[[entities]]
+type = "particle_cloud"
+name = "cloud"
+count = 10
+"""
+
+
+def run_cli(monkeypatch, capsys, tmp_path, text: str | bytes, suffix: str = ".toml"):
+    """``visviva run`` on the scene ``text``; returns (status, stderr, output directory)."""
+    scene = tmp_path / f"scene{suffix}"
+    if isinstance(text, bytes):
+        scene.write_bytes(text)
+    else:
+        scene.write_text(text)
+    output = tmp_path / "out"
+    monkeypatch.setattr(sys, "argv", ["visviva", "run", str(scene), "-o", str(output)])
+    try:
+        main()
+        status = 0
+    except SystemExit as exit_:
+        status = exit_.code
+    return status, capsys.readouterr().err, output
+
+
+def refused(monkeypatch, capsys, tmp_path, text, *fragments: str, suffix: str = ".toml") -> str:
+    status, err, output = run_cli(monkeypatch, capsys, tmp_path, text, suffix)
+    assert status == 2, err
+    assert "Traceback" not in err
+    missing = [f for f in fragments if f not in err]
+    assert not missing, f"{err!r} does not mention {missing}"
+    assert not output.exists() or not any(output.rglob("*")), "a refused scene wrote files"
+    return err
+
+
+def replaced(old: str, new: str) -> str:
+    assert old in VALID
+    return VALID.replace(old, new, 1)
+
+
+@pytest.mark.parametrize(
+    ("text", "fragments"),
+    [
+        (
+            replaced("mass = 1.0", "mass = -2.0"),
+            ["entities[0].mass", "greater than 0", "-2.0", ":13:"],
+        ),
+        (replaced("mass = 1.0", "mass = 0.0"), ["entities[0].mass", "greater than 0", "0.0"]),
+        (replaced("mass = 1.0", "mass = nan"), ["entities[0].mass", "finite", "nan"]),
+        (replaced("mass = 1.0", "mass = inf"), ["entities[0].mass", "finite", "inf"]),
+        (replaced("[0.0, 1.0, 0.0]", "[0.0, 1e400, 0.0]"), ["positions[0][1]", "finite", "inf"]),
+        (replaced("dt = 0.01", "dt = 0.0"), ["integration.dt", "greater than 0", "0.0"]),
+        (replaced("dt = 0.01", "dt = -0.01"), ["integration.dt", "-0.01"]),
+        (replaced("dt = 0.01", "dt = 1.0"), ["integration.dt", "longer than the duration", "1.0"]),
+        (replaced("duration = 0.1", "duration = -5.0"), ["integration.duration", "-5.0"]),
+        (replaced("mass = 1.0", "masss = 1.0"), ["entities[0].masss", "unknown key", "'mass'"]),
+        (replaced("[integration]", "[integraton]"), ["integraton", "unknown key", "'integration'"]),
+        (replaced("mass = 1.0", 'mass = "heavy"'), ["entities[0].mass", "'heavy'"]),
+        (replaced("count = 10", "count = 2.5"), ["entities[1].count", "2.5"]),
+        (replaced('name = "cloud"', 'name = "ball"'), ["entities[1].name", "duplicate", "'ball'"]),
+        (replaced('type = "particle_cloud"', 'type = "partcle_cloud"'), ["entities[1]", "type"]),
+        (replaced("count = 10", "count = 10000000000000"), ["entities[1].count", "10000000000000"]),
+        (replaced('method = "symplectic_euler"', 'method = "rk5"'), ["integration.method", "rk4"]),
+        (replaced('method = "symplectic_euler"', 'method = "dopri5"'), ["fixed-step", "dopri5"]),
+        ('[scene]\nname = "empty"\n', ["entities", "empty"]),
+        (replaced("mass = 1.0", "mass = [1.0, 2.0]"), ["entities[0].mass", "2 entries for 1"]),
+        (VALID + '\n[[entities]]\ntype = "system"\nsystem = "pendulum"\n', ["named system"]),
+    ],
+    ids=[
+        "negative-mass",
+        "zero-mass",
+        "nan",
+        "inf",
+        "1e400",
+        "zero-dt",
+        "negative-dt",
+        "dt-above-duration",
+        "negative-duration",
+        "unknown-key",
+        "unknown-table",
+        "wrong-type",
+        "fractional-count",
+        "duplicate-name",
+        "unknown-entity-type",
+        "absurd-count",
+        "unknown-method",
+        "adaptive-method",
+        "empty-scene",
+        "list-length",
+        "system-mixed-with-particles",
+    ],
+)
+def test_bad_scene_is_refused(monkeypatch, capsys, tmp_path, text, fragments):
+    refused(monkeypatch, capsys, tmp_path, text, *fragments)
+
+
+def test_every_problem_is_reported_at_once(monkeypatch, capsys, tmp_path):
+    text = VALID.replace("mass = 1.0", "mass = -1.0").replace("count = 10", "count = 0")
+    err = refused(monkeypatch, capsys, tmp_path, text.replace("dt = 0.01", "dtt = 0.01"))
+    assert "3 problems" in err
+    assert all(p in err for p in ("entities[0].mass", "entities[1].count", "integration.dtt"))
+
+
+def test_unknown_system_and_parameter_suggest_names(monkeypatch, capsys, tmp_path):
+    text = '[[entities]]\ntype = "system"\nsystem = "pendulm"\n'
+    refused(monkeypatch, capsys, tmp_path, text, "entities[0].system", "'pendulum'")
+    text = '[[entities]]\ntype = "system"\nsystem = "pendulum"\nparameters = { lenght = 2.0 }\n'
+    refused(monkeypatch, capsys, tmp_path, text, "parameters.lenght", "'length'", ":4:")
+
+
+def test_toml_syntax_error_gives_line_and_column(monkeypatch, capsys, tmp_path):
+    text = VALID.replace("dt = 0.01", "dt = = 0.01")
+    refused(monkeypatch, capsys, tmp_path, text, "TOML syntax error", "line 6", "column")
+
+
+def test_json_scene_errors_carry_lines(monkeypatch, capsys, tmp_path):
+    scene = parse_scene(VALID)
+    text = dump_scene(scene, "json").replace('"mass": 1.0', '"mass": -1.0')
+    err = refused(monkeypatch, capsys, tmp_path, text, "entities[0].mass", "-1.0", suffix=".json")
+    line = next(i for i, row in enumerate(text.splitlines(), 1) if '"mass": -1.0' in row)
+    assert f":{line}:" in err
+    refused(monkeypatch, capsys, tmp_path, "{ not json", "JSON syntax error", suffix=".json")
+
+
+def test_non_utf8_file_is_refused(monkeypatch, capsys, tmp_path):
+    text = VALID.encode().replace(b'"valid"', b'"caf\xe9"')
+    refused(monkeypatch, capsys, tmp_path, text, "not UTF-8", "0xe9", ":2:")
+
+
+def test_file_above_the_size_limit_is_refused_unread(monkeypatch, capsys, tmp_path):
+    text = VALID + "# " + "x" * MAX_SCENE_BYTES + "\n"
+    refused(monkeypatch, capsys, tmp_path, text, "bytes", str(MAX_SCENE_BYTES))
+
+
+def test_wrong_suffix_and_missing_file(monkeypatch, capsys, tmp_path):
+    refused(monkeypatch, capsys, tmp_path, VALID, ".toml or .json", suffix=".yaml")
+    monkeypatch.setattr(sys, "argv", ["visviva", "validate", str(tmp_path / "nope.toml")])
+    with pytest.raises(SystemExit) as exit_:
+        main()
+    assert exit_.value.code == 2
+    assert "cannot read" in capsys.readouterr().err
+
+
+def test_existing_outputs_need_force(monkeypatch, capsys, tmp_path):
+    status, err, output = run_cli(monkeypatch, capsys, tmp_path, VALID)
+    assert status == 0, err
+    before = (output / "recording.h5").stat().st_mtime_ns
+    status, err, _ = run_cli(monkeypatch, capsys, tmp_path, VALID)
+    assert status == 2 and "--force" in err
+    assert (output / "recording.h5").stat().st_mtime_ns == before
+
+
+# Hypothesis: mutate a valid scene; the only exception allowed is SceneError with a path.
+
+MUTATIONS = st.sampled_from(["delete", "rename", "nan", "negative", "zero", "huge", "string"])
+BAD_VALUES = {"nan": float("nan"), "negative": -1, "zero": 0, "huge": 1e308, "string": "x"}
+
+
+def _keys(data, prefix=()):
+    """Every (path, container) pair of the parsed scene."""
+    if isinstance(data, dict):
+        for key, value in data.items():
+            yield (*prefix, key), data
+            yield from _keys(value, (*prefix, key))
+    elif isinstance(data, list):
+        for index, value in enumerate(data):
+            yield (*prefix, index), data
+            yield from _keys(value, (*prefix, index))
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(choices=st.lists(st.tuples(st.integers(0, 10**6), MUTATIONS), min_size=1, max_size=4))
+def test_mutated_scenes_fail_only_with_a_located_scene_error(choices):
+    data = copy.deepcopy(tomllib.loads(VALID))
+    for pick, mutation in choices:
+        paths = list(_keys(data))
+        if not paths:
+            break
+        path, container = paths[pick % len(paths)]
+        key = path[-1]
+        if mutation == "delete":
+            del container[key]
+        elif mutation == "rename" and isinstance(container, dict):
+            container[f"{key}_x"] = container.pop(key)
+        elif mutation in BAD_VALUES:
+            container[key] = BAD_VALUES[mutation]
+    try:
+        scene = parse_scene(_to_toml(data))
+        build_model(scene)
+    except vv.SceneError as error:
+        assert error.problems
+        for problem in error.problems:
+            assert problem.path or problem.message, error
+        assert any(p.path for p in error.problems) or "empty" in str(error) or "table" in str(error)
+
+
+def _to_toml(data) -> str:
+    """Write mutated data back as TOML: tables, arrays of tables and inline values."""
+    lines = []
+    for key, value in data.items():
+        if isinstance(value, dict):
+            lines.append(f"[{_quoted(key)}]")
+            lines += [f"{_quoted(k)} = {_value(v)}" for k, v in value.items()]
+        elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            for item in value:
+                lines.append(f"[[{_quoted(key)}]]")
+                lines += [f"{_quoted(k)} = {_value(v)}" for k, v in item.items()]
+        else:
+            lines.insert(0, f"{_quoted(key)} = {_value(value)}")
+    return "\n".join(lines) + "\n"
+
+
+def _quoted(key) -> str:
+    import json
+
+    return json.dumps(str(key))
+
+
+def _value(value) -> str:
+    from visviva.io.scene_files import _toml_value
+
+    if isinstance(value, float) and value != value:
+        return "nan"
+    if isinstance(value, list):
+        return "[" + ", ".join(_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{_quoted(k)} = {_value(v)}" for k, v in value.items()) + "}"
+    return _toml_value(value)
