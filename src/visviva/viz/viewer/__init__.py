@@ -1,0 +1,222 @@
+"""The single-file web viewer: a recording's animation as one self-contained HTML page.
+
+:func:`write_viewer` writes one ``.html`` file holding everything the page needs: a vendored
+three.js bundle (``three.min.js``, built by ``tools/three-bundle/build.sh``; MIT licence in
+``LICENSE-three.txt``), the viewer script (``viewer.js``) and the animation data (see
+``_payload.py``). It opens from ``file://`` in any WebGL browser and makes no network request:
+no CDN, no web fonts, no fetch of the data. The page is built from ``template.html`` by
+substituting ``{{name}}`` markers in one pass, so inserted text is never re-scanned.
+
+Frames are resampled to the playback rate with :func:`visviva.io.timeline.frames_at_rate`.
+The embedded ``<script>`` contents follow the HTML Living Standard's restrictions on script
+text (§ 4.12.1.3: no ``</script`` and no ``<!--`` inside an inline script), checked below.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+import os
+import re
+import warnings
+from functools import cache
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from ..._validation import describe, real_number
+from ...errors import ModelError
+from ...io.files import atomic_path
+from ...io.recording import Recording
+from ...io.timeline import frames_at_rate
+from ._payload import encode_payload, to_json
+
+__all__ = ["FALLBACK_FPS", "MAX_DEFAULT_FPS", "MAX_POSITION_BYTES", "default_fps", "write_viewer"]
+
+#: Playback rate [frames/s] when a recording's frames are not evenly spaced.
+FALLBACK_FPS = 30.0
+#: Highest default playback rate [frames/s]: a 1 kHz recording plays every 17th frame (58.8 fps).
+MAX_DEFAULT_FPS = 60.0
+#: Largest float32 position data [bytes] one page embeds (64 MiB, ~86 MB of base64 in the file):
+#: beyond it a browser tab needs several hundred MB to open the page. E.g. 4096 points at
+#: 30 frames/s fit 45 s. The default rate is lowered to fit; an explicit ``fps`` must fit.
+MAX_POSITION_BYTES = 64 * 2**20
+#: Relative tolerance on frame spacing for a recording to count as evenly spaced.
+_EVEN_SPACING_RTOL = 1e-6
+#: Bytes per point per frame: three float32 coordinates.
+_BYTES_PER_POINT_FRAME = 12
+
+
+def _recorded_rate(time: np.ndarray) -> float | None:
+    """Frame rate [1/s] of evenly spaced frames, or ``None``.
+
+    The last interval may be shorter (a run whose end is not a whole number of frames).
+    """
+    steps = np.diff(time)
+    if steps.size == 0 or not steps[0] > 0.0:
+        return None
+    step = steps[0]
+    body, last = steps[:-1], steps[-1]
+    tolerance = _EVEN_SPACING_RTOL * step
+    if np.all(np.abs(body - step) <= tolerance) and 0.0 < last <= step + tolerance:
+        return float(1.0 / step)
+    return None
+
+
+def _frame_count(time: np.ndarray, fps: float) -> int:
+    return int(frames_at_rate(time[[0, -1]], fps).size)
+
+
+def default_fps(recording: Recording) -> float:
+    """The playback rate [frames/s] :func:`write_viewer` uses when ``fps`` is not given.
+
+    The recording's own rate if its frames are evenly spaced, divided by the smallest whole
+    number that brings it to at most :data:`MAX_DEFAULT_FPS` (so every n-th frame is shown,
+    without jitter); :data:`FALLBACK_FPS` for uneven frames. If the frames at that rate would
+    exceed :data:`MAX_POSITION_BYTES`, the rate is lowered until they fit, with a warning.
+
+    Example:
+        >>> import numpy as np, visviva as vv
+        >>> rec = vv.Recording(np.arange(1001) * 1e-3, {"points": np.zeros((1001, 1, 3))})
+        >>> round(default_fps(rec), 3)          # 1000 Hz shown every 17th frame
+        58.824
+    """
+    geometry = recording.geometry()
+    time = recording.time
+    rate = _recorded_rate(time)
+    if rate is None:
+        fps = FALLBACK_FPS
+    else:
+        fps = rate / max(1, math.ceil(rate / MAX_DEFAULT_FPS * (1.0 - _EVEN_SPACING_RTOL)))
+    frame_bytes = max(1, geometry.points.shape[1]) * _BYTES_PER_POINT_FRAME
+    budget_frames = MAX_POSITION_BYTES // frame_bytes
+    span = float(time[-1] - time[0])
+    if budget_frames < 1:
+        raise ModelError(
+            f"recording has {geometry.points.shape[1]} points: one frame is {frame_bytes} bytes, "
+            f"more than the viewer's limit of {MAX_POSITION_BYTES} bytes of positions; export "
+            "to USD or glTF instead"
+        )
+    if _frame_count(time, fps) > budget_frames:
+        fps = (budget_frames - 1) / span if budget_frames > 1 else 1.0 / (2.0 * span)
+        warnings.warn(
+            f"the viewer plays this recording at {fps:.3g} frames/s so that its positions stay "
+            f"within {MAX_POSITION_BYTES // 2**20} MiB; pass fps= and a shorter recording for "
+            "smoother playback",
+            stacklevel=2,
+        )
+    return fps
+
+
+def _check_fps(recording: Recording, fps: float | None) -> float:
+    if fps is None:
+        return default_fps(recording)
+    value = real_number("fps", fps, positive=True, unit=" frames/s")
+    points = recording.geometry().points.shape[1]
+    size = _frame_count(recording.time, value) * max(1, points) * _BYTES_PER_POINT_FRAME
+    if size > MAX_POSITION_BYTES:
+        raise ModelError(
+            f"`fps` = {value:g} frames/s embeds {size / 2**20:.0f} MiB of positions, more than "
+            f"the viewer's limit of {MAX_POSITION_BYTES // 2**20} MiB; lower fps or leave it "
+            "unset to let the viewer choose a rate that fits"
+        )
+    return value
+
+
+def _check_target(path: str | os.PathLike[str]) -> Path:
+    if not isinstance(path, (str, os.PathLike)):
+        raise ModelError(f"`path` must be a file path (got {describe(path)})")
+    target = Path(path)
+    if target.is_dir():
+        raise ModelError(f"`path` {os.fspath(target)!r} is a directory; give a file name")
+    if not target.parent.is_dir():
+        raise ModelError(
+            f"`path` {os.fspath(target)!r}: directory {os.fspath(target.parent)!r} does not "
+            "exist; create it first"
+        )
+    return target
+
+
+def _check_finite(points: np.ndarray) -> None:
+    bad = ~np.isfinite(points).all(axis=(1, 2))
+    if bad.any():
+        frame = int(np.argmax(bad))
+        raise ModelError(
+            f"`points` of recorded frame {frame} are not finite; the viewer can only show "
+            "finite positions (cut the recording before the blow-up)"
+        )
+
+
+@cache
+def _asset(name: str) -> str:
+    text = resources.files(__name__).joinpath(name).read_text(encoding="utf-8")
+    if name.endswith(".js") and re.search(r"</script|<!--", text, re.IGNORECASE):
+        raise RuntimeError(f"{name} contains '</script' or '<!--' and cannot be inlined")
+    return text
+
+
+def _default_title(recording: Recording) -> str:
+    for key in ("scene", "problem"):
+        value = recording.attrs.get(key)
+        if isinstance(value, str) and value:
+            return f"visviva — {value}"
+    return "visviva viewer"
+
+
+def write_viewer(
+    recording: Recording,
+    path: str | os.PathLike[str],
+    *,
+    fps: float | None = None,
+    title: str | None = None,
+) -> Path:
+    """Write ``recording``'s animation as one self-contained HTML file.
+
+    The page plays the points (spheres of ``static["radius"]``), edges (lines) and faces
+    (a shaded surface) of :meth:`Recording.geometry` in real time, with an orbit camera, a
+    play/pause button (and the space bar), a frame slider, the time ``t`` [s] of the recorded
+    frame shown, a speed selector and a legend. See ``docs/viewer.md``.
+
+    Args:
+        recording: A recording with a ``points`` field.
+        path: File to write (conventionally ``.html``); its directory must exist. Written
+            atomically: a partial file never appears under this name.
+        fps: Playback rate [frames/s]; output frame ``k`` shows the recorded frame nearest
+            ``t0 + k/fps``. Default: :func:`default_fps`.
+        title: Page title; default ``"visviva — <scene or problem name>"``.
+
+    Returns:
+        The path written.
+
+    Raises:
+        ModelError: Before anything is written, if the recording has no drawable geometry,
+            non-finite positions, or too many frames (see :data:`MAX_POSITION_BYTES`), or if
+            an argument is invalid.
+    """
+    if not isinstance(recording, Recording):
+        raise ModelError(
+            f"`recording` must be a visviva Recording (got {type(recording).__name__}); "
+            "load one with visviva.Recording.load(path)"
+        )
+    geometry = recording.geometry()
+    if title is not None and not isinstance(title, str):
+        raise ModelError(f"`title` must be a string or None (got {describe(title)})")
+    target = _check_target(path)
+    _check_finite(geometry.points)
+    rate = _check_fps(recording, fps)
+    shown = frames_at_rate(recording.time, rate)
+    page_title = _default_title(recording) if title is None else title
+    payload = encode_payload(
+        geometry, recording.time, shown, fps=rate, title=page_title, attrs=recording.attrs
+    )
+    parts = {
+        "title": html.escape(page_title, quote=False),
+        "three": _asset("three.min.js"),
+        "viewer": _asset("viewer.js"),
+        "data": to_json(payload),
+    }
+    page = re.sub(r"\{\{(\w+)\}\}", lambda match: parts[match.group(1)], _asset("template.html"))
+    with atomic_path(target) as temporary:
+        temporary.write_text(page, encoding="utf-8")
+    return target

@@ -1,0 +1,331 @@
+/* visviva web viewer: plays the animation embedded in this page (the JSON element
+ * #visviva-data, written by visviva.viz.viewer.write_viewer) with three.js (global THREE).
+ *
+ * Frame k of the page shows recorded frame times[k]; playback picks the frame from the
+ * elapsed wall-clock time (k = floor(elapsed * fps * speed)), never by counting redraws, so it
+ * runs in real time however fast the machine draws. Y is up, lengths in metres.
+ *
+ * Each kind of geometry is one entry of LAYERS (points, edges, faces): a builder that adds
+ * its objects to the scene and returns an update() called after every frame change.
+ */
+(function () {
+  "use strict";
+
+  // A failure (no WebGL, corrupt data) is shown on the page, not only in the console.
+  window.addEventListener("error", (event) => {
+    const box = document.getElementById("failure");
+    box.textContent = "The viewer could not start: " + event.message;
+    box.style.display = "block";
+  });
+
+  const BACKGROUND = 0xeef1f5;
+  const POINT_COLOUR = 0x2f6fb3;
+  const EDGE_COLOUR = 0x1d2733;
+  const FACE_COLOUR = 0xd9822b;
+  const FIELD_OF_VIEW = 45; // degrees, vertical
+  const FRAMING_MARGIN = 1.15; // camera distance over the distance that just fits the scene
+  const ORBIT_RATE = 2 * Math.PI; // radians per canvas height dragged
+  const ZOOM_RATE = 0.0015; // log-distance per wheel delta unit
+  const POLAR_LIMIT = 0.01; // radians kept from the poles, where "up" is undefined
+
+  /* Base64 text of little-endian binary -> typed array (every WebGL host is little-endian). */
+  function decode(text, Type) {
+    let bytes;
+    if (typeof Uint8Array.fromBase64 === "function") {
+      bytes = Uint8Array.fromBase64(text);
+    } else {
+      const raw = atob(text);
+      bytes = new Uint8Array(raw.length);
+      for (let i = 0; i < raw.length; i++) bytes[i] = raw.charCodeAt(i);
+    }
+    return new Type(bytes.buffer, bytes.byteOffset, bytes.byteLength / Type.BYTES_PER_ELEMENT);
+  }
+
+  const data = JSON.parse(document.getElementById("visviva-data").textContent);
+  const frames = data.frames;
+  const fps = data.fps;
+  const times = decode(data.times, Float64Array);
+  const pointData = data.layers.points;
+  const pointCount = pointData.count;
+  const allPositions = decode(pointData.positions, Float32Array); // (frames, P, 3) [m]
+  const stride = pointCount * 3;
+
+  const low = new THREE.Vector3().fromArray(data.bounds[0]);
+  const high = new THREE.Vector3().fromArray(data.bounds[1]);
+  const centre = low.clone().add(high).multiplyScalar(0.5);
+  const diagonal = high.clone().sub(low).length();
+  const size = diagonal > 0 ? diagonal : 1; // [m] scale of grid, camera and zoom limits
+
+  const canvas = document.getElementById("view");
+  const renderer = new THREE.WebGLRenderer({
+    canvas, antialias: true, preserveDrawingBuffer: true, powerPreference: "high-performance",
+  });
+  renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+  const scene = new THREE.Scene();
+  scene.background = new THREE.Color(BACKGROUND);
+  scene.add(new THREE.HemisphereLight(0xffffff, 0x8d8a80, 1.6));
+  const sun = new THREE.DirectionalLight(0xffffff, 1.8);
+  sun.position.copy(centre).add(new THREE.Vector3(0.5, 1.0, 0.7).multiplyScalar(size));
+  sun.target.position.copy(centre);
+  scene.add(sun, sun.target);
+
+  /* The current frame's positions, shared by every layer that draws through point indices. */
+  const current = new THREE.BufferAttribute(new Float32Array(stride), 3);
+  current.setUsage(THREE.DynamicDrawUsage);
+  function loadFrame(k) {
+    current.array.set(allPositions.subarray(k * stride, (k + 1) * stride));
+    current.needsUpdate = true;
+  }
+
+  function indexedGeometry(layer, width) {
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute("position", current);
+    geometry.setIndex(new THREE.BufferAttribute(decode(layer.indices, Uint32Array), 1));
+    if (geometry.index.count !== layer.count * width) throw new Error("corrupt index data");
+    return geometry;
+  }
+
+  const LAYERS = {
+    /* Spheres of the recorded radii: one instanced mesh, a matrix per point per frame. */
+    points(layer) {
+      const radius = decode(layer.radius, Float32Array);
+      const segments = pointCount <= 500 ? [20, 14] : pointCount <= 5000 ? [10, 7] : [6, 4];
+      const sphere = new THREE.SphereGeometry(1, segments[0], segments[1]);
+      const material = new THREE.MeshLambertMaterial({ color: POINT_COLOUR });
+      const mesh = new THREE.InstancedMesh(sphere, material, pointCount);
+      mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+      mesh.frustumCulled = false; // the points move; a bounding sphere from frame 0 would lie
+      const matrices = mesh.instanceMatrix.array; // column-major 4x4 per point
+      for (let i = 0; i < pointCount; i++) {
+        matrices.fill(0, 16 * i, 16 * i + 16);
+        matrices[16 * i] = matrices[16 * i + 5] = matrices[16 * i + 10] = radius[i];
+        matrices[16 * i + 15] = 1;
+      }
+      scene.add(mesh);
+      return function update() {
+        const xyz = current.array;
+        for (let i = 0; i < pointCount; i++) {
+          matrices[16 * i + 12] = xyz[3 * i];
+          matrices[16 * i + 13] = xyz[3 * i + 1];
+          matrices[16 * i + 14] = xyz[3 * i + 2];
+        }
+        mesh.instanceMatrix.needsUpdate = true;
+      };
+    },
+    /* Lines between pairs of points (ropes, springs). */
+    edges(layer) {
+      const lines = new THREE.LineSegments(
+        indexedGeometry(layer, 2), new THREE.LineBasicMaterial({ color: EDGE_COLOUR }));
+      lines.frustumCulled = false;
+      scene.add(lines);
+      return function update() {};
+    },
+    /* Triangles between points (cloth, soft bodies), shaded from both sides. */
+    faces(layer) {
+      const geometry = indexedGeometry(layer, 3);
+      const material = new THREE.MeshLambertMaterial({
+        color: FACE_COLOUR, side: THREE.DoubleSide,
+        polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1, // edges stay on top
+      });
+      const mesh = new THREE.Mesh(geometry, material);
+      mesh.frustumCulled = false;
+      scene.add(mesh);
+      return function update() { geometry.computeVertexNormals(); };
+    },
+  };
+
+  const updates = [];
+  for (const [name, layer] of Object.entries(data.layers)) {
+    if (!(name in LAYERS)) throw new Error("this viewer cannot draw layer " + name);
+    updates.push(LAYERS[name](layer));
+  }
+
+  /* Ground grid at y = min(0, lowest point), a whole number of cells wide. */
+  const cell = Math.pow(10, Math.floor(Math.log10(size / 4)));
+  const cells = 2 * Math.ceil((0.75 * size) / cell);
+  const grid = new THREE.GridHelper(cells * cell, cells, 0x8794a3, 0xc3cad3);
+  grid.position.set(Math.round(centre.x / cell) * cell, Math.min(0, low.y),
+    Math.round(centre.z / cell) * cell);
+  scene.add(grid);
+
+  /* Orbit camera: spherical coordinates (distance, polar angle from +Y, azimuth from +Z)
+   * around a target point; drag orbits, right- or shift-drag pans, the wheel zooms. */
+  const camera = new THREE.PerspectiveCamera(FIELD_OF_VIEW, 1, 0.01, 100);
+  const home = {
+    target: centre.clone(),
+    distance: (FRAMING_MARGIN * 0.5 * size) / Math.sin((FIELD_OF_VIEW * Math.PI) / 360),
+    polar: 1.15,
+    azimuth: 0.6,
+  };
+  const view = { target: home.target.clone(), distance: home.distance, polar: home.polar,
+    azimuth: home.azimuth };
+
+  function placeCamera() {
+    const s = Math.sin(view.polar);
+    camera.position.set(s * Math.sin(view.azimuth), Math.cos(view.polar),
+      s * Math.cos(view.azimuth)).multiplyScalar(view.distance).add(view.target);
+    camera.near = view.distance / 200;
+    camera.far = view.distance + 20 * size;
+    camera.updateProjectionMatrix();
+    camera.lookAt(view.target);
+    camera.updateMatrixWorld();
+    needsDraw = true;
+  }
+
+  let drag = null;
+  canvas.addEventListener("pointerdown", (event) => {
+    canvas.setPointerCapture(event.pointerId);
+    const pan = event.button === 2 || event.shiftKey;
+    drag = { id: event.pointerId, pan, x: event.clientX, y: event.clientY };
+  });
+  canvas.addEventListener("pointermove", (event) => {
+    if (!drag || drag.id !== event.pointerId) return;
+    const dx = event.clientX - drag.x;
+    const dy = event.clientY - drag.y;
+    drag.x = event.clientX;
+    drag.y = event.clientY;
+    const height = canvas.clientHeight || 1;
+    if (drag.pan) {
+      // One pixel moves the target by the size of a pixel at the target's depth.
+      const perPixel = (2 * view.distance * Math.tan((FIELD_OF_VIEW * Math.PI) / 360)) / height;
+      const right = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 0);
+      const up = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 1);
+      view.target.addScaledVector(right, -dx * perPixel).addScaledVector(up, dy * perPixel);
+    } else {
+      view.azimuth -= (ORBIT_RATE * dx) / height;
+      view.polar = Math.min(Math.PI - POLAR_LIMIT,
+        Math.max(POLAR_LIMIT, view.polar - (ORBIT_RATE * dy) / height));
+    }
+    placeCamera();
+  });
+  const endDrag = () => { drag = null; };
+  canvas.addEventListener("pointerup", endDrag);
+  canvas.addEventListener("pointercancel", endDrag);
+  canvas.addEventListener("contextmenu", (event) => event.preventDefault());
+  canvas.addEventListener("wheel", (event) => {
+    event.preventDefault();
+    view.distance = Math.min(100 * size,
+      Math.max(1e-3 * size, view.distance * Math.exp(event.deltaY * ZOOM_RATE)));
+    placeCamera();
+  }, { passive: false });
+  canvas.addEventListener("dblclick", () => {
+    Object.assign(view, home, { target: home.target.clone() });
+    placeCamera();
+  });
+
+  /* Playback and controls. */
+  const playButton = document.getElementById("play");
+  const slider = document.getElementById("slider");
+  const timeText = document.getElementById("time");
+  const speedSelect = document.getElementById("speed");
+  slider.max = String(frames - 1);
+  document.getElementById("title").textContent = data.title;
+  document.title = data.title;
+  const legendRows = document.getElementById("legend-rows");
+  for (const [label, value] of data.legend) {
+    const row = legendRows.insertRow();
+    row.insertCell().textContent = label;
+    row.insertCell().textContent = value;
+  }
+
+  let frame = -1;
+  let playing = false;
+  let speed = 1;
+  let anchorTime = 0; // performance.now() [ms] when frame anchorFrame was shown
+  let anchorFrame = 0;
+  let needsDraw = true;
+
+  function show(k) {
+    if (k === frame) return;
+    frame = k;
+    loadFrame(k);
+    for (const update of updates) update();
+    slider.value = String(k);
+    timeText.textContent = "t = " + times[k].toFixed(3) + " s  (" + (k + 1) + "/" + frames + ")";
+    needsDraw = true;
+  }
+
+  function draw() {
+    renderer.render(scene, camera);
+    needsDraw = false;
+  }
+
+  function anchor() {
+    anchorTime = performance.now();
+    anchorFrame = frame;
+  }
+
+  function setPlaying(on) {
+    playing = on;
+    if (on) anchor();
+    playButton.textContent = on ? "Pause" : "Play";
+  }
+
+  function setFrame(k) {
+    if (!Number.isInteger(k) || k < 0 || k >= frames) {
+      throw new RangeError("frame must be a whole number in 0.." + (frames - 1) + " (got " + k + ")");
+    }
+    show(k);
+    if (playing) anchor();
+    draw();
+  }
+
+  playButton.addEventListener("click", () => setPlaying(!playing));
+  slider.addEventListener("input", () => setFrame(Number(slider.value)));
+  speedSelect.addEventListener("change", () => {
+    speed = Number(speedSelect.value);
+    if (playing) anchor();
+  });
+  window.addEventListener("keydown", (event) => {
+    const target = event.target;
+    // Focused controls keep their own keys (space presses a focused button, arrows move the slider).
+    if (target === playButton || target === slider || target === speedSelect) return;
+    if (event.code === "Space") {
+      event.preventDefault();
+      setPlaying(!playing);
+    } else if (event.code === "ArrowRight" || event.code === "ArrowLeft") {
+      setPlaying(false);
+      setFrame((frame + (event.code === "ArrowRight" ? 1 : frames - 1)) % frames);
+    }
+  });
+
+  function resize() {
+    const width = canvas.clientWidth || 1;
+    const height = canvas.clientHeight || 1;
+    renderer.setSize(width, height, false);
+    camera.aspect = width / height;
+    placeCamera();
+  }
+  window.addEventListener("resize", resize);
+
+  function tick(now) {
+    if (playing && frames > 1) {
+      const elapsed = Math.max(0, now - anchorTime) / 1000; // [s]
+      show((anchorFrame + Math.floor(elapsed * fps * speed)) % frames);
+    }
+    if (needsDraw) draw();
+    requestAnimationFrame(tick);
+  }
+
+  window.visviva = {
+    frames,
+    fps,
+    times: Array.from(times),
+    setFrame,
+    frame: () => frame,
+    play: () => setPlaying(true),
+    pause: () => setPlaying(false),
+    playing: () => playing,
+    /* Positions [m] of output frame k as a flat array (P * 3), as embedded (float32). */
+    points: (k) => Array.from(allPositions.subarray(k * stride, (k + 1) * stride)),
+    ready: false,
+    readyTime: null, // performance.now() [ms since navigation start] at the first draw
+  };
+
+  resize();
+  show(0);
+  draw();
+  window.visviva.readyTime = performance.now();
+  window.visviva.ready = true;
+  requestAnimationFrame(tick);
+})();
