@@ -185,3 +185,30 @@ def test_writer_final_attributes_replace_the_provisional_ones(tmp_path):
     recording = vv.Recording.load(tmp_path / "r.h5")
     assert recording.attrs["success"] is True and recording.attrs["method"] == "rk4"
     np.testing.assert_array_equal(recording["energy"], [1.0])
+
+
+def test_cli_validate_schema_dry_run_and_plot(tmp_path):
+    from typer.testing import CliRunner
+
+    from visviva.cli.main import app
+
+    runner = CliRunner()
+    scene = EXAMPLES[0]
+    result = runner.invoke(app, ["validate", str(scene)])
+    assert result.exit_code == 0 and "valid" in result.stdout
+    schema = json.loads(runner.invoke(app, ["schema"]).stdout)
+    assert schema["additionalProperties"] is False
+    discriminator = schema["properties"]["entities"]["items"]["discriminator"]
+    assert discriminator["propertyName"] == "type"
+    assert set(discriminator["mapping"]) == {"particles", "particle_cloud", "system"}
+    assert schema["$defs"]["Particles"]["additionalProperties"] is False
+    out = tmp_path / "dry"
+    result = runner.invoke(app, ["run", str(scene), "-o", str(out), "--dry-run"])
+    assert result.exit_code == 0 and "would write" in result.stdout
+    assert not out.exists()
+    result = runner.invoke(app, ["run", str(scene), "-o", str(out), "--duration", "0.05"])
+    assert result.exit_code == 0, result.output
+    for kind in ("energy", "momentum"):
+        result = runner.invoke(app, ["plot", str(out / "recording.h5"), f"--{kind}"])
+        assert result.exit_code == 0, result.output
+        assert (out / f"{kind}.png").stat().st_size > 10_000
