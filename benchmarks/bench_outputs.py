@@ -80,6 +80,7 @@ def main() -> None:
 
         print("(b) exports")
         from visviva.io.export import export_recording
+
         from visviva.viz.viewer import write_viewer
 
         targets = {
