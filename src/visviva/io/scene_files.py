@@ -125,7 +125,7 @@ def _problems(exc: ValidationError, raw: dict[str, Any], line_of: Any) -> list[S
     """One problem per field: pydantic reports each branch of a union; keep the telling one."""
     chosen: dict[tuple[Any, ...], Any] = {}
     for error in exc.errors(include_url=False):
-        path = _field_path(error["loc"], raw)
+        path = _field_path(error["loc"])
         previous = chosen.get(path)
         if previous is None or (
             previous["type"].endswith("_type") and not error["type"].endswith("_type")
@@ -151,7 +151,7 @@ def _problems(exc: ValidationError, raw: dict[str, Any], line_of: Any) -> list[S
     return problems
 
 
-def _field_path(loc: tuple[Any, ...], raw: dict[str, Any]) -> tuple[Any, ...]:
+def _field_path(loc: tuple[Any, ...]) -> tuple[Any, ...]:
     """The error's location as the user wrote it: no union-branch or entity-tag segments."""
     path: list[Any] = []
     for position, segment in enumerate(loc):
