@@ -26,6 +26,10 @@
   const FRAMING_MARGIN = 1.15; // camera distance over the distance that just fits the scene
   const ORBIT_RATE = 2 * Math.PI; // radians per canvas height dragged
   const ZOOM_RATE = 0.0015; // log-distance per wheel delta unit
+  // A sphere of n segments around and n/2 + 1 rings has n² triangles (minus n at the poles);
+  // ~150k in all keeps software WebGL (SwiftShader) near 10 frames/s with 4096 points.
+  const SPHERE_SEGMENTS = [24, 16, 12, 8, 6, 4];
+  const SPHERE_TRIANGLE_BUDGET = 150000;
   const POLAR_LIMIT = 0.01; // radians kept from the poles, where "up" is undefined
 
   /* Base64 text of little-endian binary -> typed array (every WebGL host is little-endian). */
@@ -89,8 +93,10 @@
     /* Spheres of the recorded radii: one instanced mesh, a matrix per point per frame. */
     points(layer) {
       const radius = decode(layer.radius, Float32Array);
-      const segments = pointCount <= 500 ? [20, 14] : pointCount <= 5000 ? [10, 7] : [6, 4];
-      const sphere = new THREE.SphereGeometry(1, segments[0], segments[1]);
+      // The finest sphere whose triangles, over all points, fit the budget.
+      let around = SPHERE_SEGMENTS.find((n) => pointCount * n * n <= SPHERE_TRIANGLE_BUDGET);
+      if (around === undefined) around = SPHERE_SEGMENTS[SPHERE_SEGMENTS.length - 1];
+      const sphere = new THREE.SphereGeometry(1, around, around / 2 + 1);
       const material = new THREE.MeshLambertMaterial({ color: POINT_COLOUR });
       const mesh = new THREE.InstancedMesh(sphere, material, pointCount);
       mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
@@ -322,10 +328,30 @@
     readyTime: null, // performance.now() [ms since navigation start] at the first draw
   };
 
+  /* Ready once the first frame is drawn: a GPU fence, polled between tasks (its status only
+   * changes when control returns to the event loop), tells when the GPU, or SwiftShader,
+   * has finished it. gl.finish() does not wait in Chrome; reading pixels back would stall. */
+  function whenDrawn(callback) {
+    const gl = renderer.getContext();
+    const fence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
+    gl.flush();
+    (function poll() {
+      if (gl.clientWaitSync(fence, 0, 0) === gl.TIMEOUT_EXPIRED) {
+        setTimeout(poll, 2);
+        return;
+      }
+      gl.deleteSync(fence);
+      callback();
+    })();
+  }
+
   resize();
   show(0);
   draw();
-  window.visviva.readyTime = performance.now();
-  window.visviva.ready = true;
-  requestAnimationFrame(tick);
+  whenDrawn(() => {
+    window.visviva.readyTime = performance.now();
+    window.visviva.ready = true;
+    setPlaying(frames > 1); // an animation plays as soon as it is shown
+    requestAnimationFrame(tick);
+  });
 })();

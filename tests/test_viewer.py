@@ -1,0 +1,325 @@
+"""The single-file web viewer, opened from ``file://`` in real headless Chromium.
+
+One Chromium (Debian's ``/usr/bin/chromium``, driven by Playwright, SwiftShader WebGL) serves
+every test of this module. Without it the tests fail: CI installs it (``.ci/run``).
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import math
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from PIL import Image
+from playwright.sync_api import Browser, Page, sync_playwright
+
+import visviva as vv
+from visviva.io.timeline import frames_at_rate
+from visviva.viz.viewer import MAX_POSITION_BYTES, default_fps, write_viewer
+
+CHROMIUM = Path("/usr/bin/chromium")
+#: From NOTES.md ("Files, formats, viewers"); Playwright makes its own temporary profile
+#: (it refuses --user-data-dir in launch()).
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--disable-quic",
+]
+#: The page's background colour, #eef1f5.
+BACKGROUND = (238, 241, 245)
+
+
+def falling_recording() -> vv.Recording:
+    """Three points 1 m apart, dropped from 2 m: y = 2 − g t²/2, 50 frames at 25 Hz."""
+    t = np.arange(50) / 25.0
+    points = np.zeros((50, 3, 3))
+    points[:, :, 0] = [0.0, 1.0, 2.0]
+    points[:, :, 1] = 2.0 - 4.9 * t[:, None] ** 2
+    return vv.Recording(
+        t,
+        {"points": points},
+        static={"radius": np.full(3, 0.1), "edges": np.array([[0, 1], [1, 2]])},
+        units={"points": "m", "radius": "m"},
+        attrs={"method": "velocity_verlet", "dt": 0.01, "substeps": 4},
+    )
+
+
+def waving_cloth(n: int = 64, frames: int = 300) -> vv.Recording:
+    """An n×n grid, 1 m square, waving in y: 300 frames at 30 Hz, 2(n−1)² triangles."""
+    u, w = np.meshgrid(np.linspace(0.0, 1.0, n), np.linspace(0.0, 1.0, n), indexing="ij")
+    t = np.arange(frames) / 30.0
+    points = np.empty((frames, n * n, 3))
+    points[:, :, 0] = u.ravel()
+    points[:, :, 1] = 1.0 + 0.1 * np.sin(2.0 * np.pi * (u.ravel()[None, :] - t[:, None]))
+    points[:, :, 2] = w.ravel()
+    i, j = np.meshgrid(np.arange(n - 1), np.arange(n - 1), indexing="ij")
+    a = (i * n + j).ravel()
+    faces = np.concatenate([np.stack([a, a + 1, a + n], 1), np.stack([a + 1, a + n + 1, a + n], 1)])
+    return vv.Recording(t, {"points": points}, static={"faces": faces}, units={"points": "m"})
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Browser]:
+    if not CHROMIUM.is_file():
+        pytest.fail(
+            f"the viewer tests need Debian's Chromium at {CHROMIUM} (not found); install it "
+            "with `sudo apt-get install -y chromium` (.ci/run does this)",
+            pytrace=False,
+        )
+    with sync_playwright() as playwright:
+        chromium = playwright.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_FLAGS)
+        yield chromium
+        chromium.close()
+
+
+@pytest.fixture(scope="module")
+def falling_page_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_viewer(falling_recording(), tmp_path_factory.mktemp("viewer") / "falling.html")
+
+
+class Opened:
+    """A page opened on a viewer file, with everything it logged and requested."""
+
+    def __init__(self, browser: Browser, path: Path) -> None:
+        self.page: Page = browser.new_page(viewport={"width": 800, "height": 600})
+        self.errors: list[str] = []
+        self.requests: list[str] = []
+        self.page.on(
+            "console",
+            lambda message: self.errors.append(message.text) if message.type == "error" else None,
+        )
+        self.page.on("pageerror", lambda error: self.errors.append(str(error)))
+        self.page.on("request", lambda request: self.requests.append(request.url))
+        self.page.goto(path.as_uri())
+        self.page.wait_for_function("window.visviva && window.visviva.ready === true")
+
+    def js(self, expression: str) -> Any:
+        return self.page.evaluate(expression)
+
+    def image(self, frame: int) -> np.ndarray:
+        """The canvas after showing ``frame``: RGB array (height, width, 3)."""
+        url = self.js(
+            f"visviva.pause(), visviva.setFrame({frame}), "
+            "document.getElementById('view').toDataURL('image/png')"
+        )
+        png = base64.b64decode(url.split(",", 1)[1])
+        return np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(np.int16)
+
+
+@pytest.fixture
+def falling(browser: Browser, falling_page_path: Path) -> Iterator[Opened]:
+    opened = Opened(browser, falling_page_path)
+    yield opened
+    opened.page.close()
+
+
+def test_page_loads_from_file_with_no_error_and_no_other_request(falling, falling_page_path):
+    falling.js("visviva.play()")
+    falling.page.wait_for_timeout(300)
+    falling.page.mouse.move(400, 300)
+    falling.page.mouse.wheel(0, -200)
+    assert falling.errors == []
+    assert falling.requests == [falling_page_path.as_uri()]
+    html = falling_page_path.read_text(encoding="utf-8")
+    assert "<script src" not in html and "<link" not in html
+
+
+def test_embedded_frames_are_the_recording_resampled(falling):
+    recording = falling_recording()
+    shown = frames_at_rate(recording.time, 25.0)
+    assert falling.js("[visviva.frames, visviva.fps]") == [50, 25]
+    np.testing.assert_array_equal(falling.js("visviva.times"), recording.time[shown])
+    for k in (0, 17, 49):
+        points = np.array(falling.js(f"visviva.points({k})")).reshape(3, 3)
+        # float32 storage: relative rounding ≤ 2⁻²⁴ ≈ 6e-8.
+        np.testing.assert_allclose(points, recording["points"][shown[k]], rtol=6e-8, atol=1e-12)
+    assert falling.js("document.getElementById('legend').textContent").count("velocity_verlet")
+
+
+def _blue(image: np.ndarray) -> np.ndarray:
+    """Mask of the points' blue (#2f6fb3, shaded): not the grey grid or background."""
+    red, blue = image[..., 0], image[..., 2]
+    return (blue - red) > 60
+
+
+def test_first_and_last_frames_draw_the_points_where_they_are(falling):
+    first, last = falling.image(0), falling.image(49)
+    assert falling.js("visviva.frame()") == 49
+    drawn = np.any(first != BACKGROUND, axis=2)
+    assert drawn.sum() > 2000  # grid, spheres and lines
+    blue_first, blue_last = _blue(first), _blue(last)
+    assert blue_first.sum() > 30 and blue_last.sum() > 10
+    # The points fell 18.8 m (the scene is ~19 m tall): on screen they moved down, a lot.
+    rows_first = np.nonzero(blue_first)[0].mean()
+    rows_last = np.nonzero(blue_last)[0].mean()
+    assert rows_last - rows_first > 0.3 * first.shape[0]
+    # Where the points were in frame 0 the image changed: they are no longer drawn there.
+    changed = np.any(first != last, axis=2)
+    assert changed[blue_first].mean() > 0.95
+    assert not blue_last[blue_first].any()
+
+
+def test_play_pause_button_space_bar_and_speed(falling):
+    page = falling.page
+    assert falling.js("visviva.playing()") is True  # an opened animation plays
+    page.click("#play")
+    assert falling.js("visviva.playing()") is False
+    assert page.inner_text("#play") == "Play"
+    held = falling.js("visviva.frame()")
+    page.wait_for_timeout(250)
+    assert falling.js("visviva.frame()") == held
+
+    for option, speed in (("1", 1.0), ("2", 2.0)):
+        page.select_option("#speed", option)
+        falling.js("visviva.setFrame(0)")
+        page.click("#play")
+        start = falling.js("[performance.now(), visviva.frame()]")
+        page.wait_for_timeout(600)
+        end = falling.js("[performance.now(), visviva.frame()]")
+        page.click("#play")
+        # Real time: frame = floor(elapsed · fps · speed), from the clock (not redraws).
+        expected = (end[0] - start[0]) / 1000.0 * 25.0 * speed
+        assert abs((end[1] - start[1]) - expected) <= 3, (speed, start, end)
+
+    falling.js("document.activeElement.blur()")
+    page.keyboard.press("Space")
+    assert falling.js("visviva.playing()") is True
+    page.keyboard.press("Space")
+    assert falling.js("visviva.playing()") is False
+    falling.js("visviva.setFrame(10)")
+    page.keyboard.press("ArrowRight")
+    assert falling.js("visviva.frame()") == 11
+    page.keyboard.press("ArrowLeft")
+    page.keyboard.press("ArrowLeft")
+    assert falling.js("visviva.frame()") == 9
+    assert falling.js("visviva.playing()") is False
+
+
+def test_slider_sets_the_frame_and_follows_playback(falling):
+    page = falling.page
+    falling.js("visviva.pause(); visviva.setFrame(0)")
+    box = page.locator("#slider").bounding_box()
+    assert box is not None
+    page.mouse.click(box["x"] + 0.75 * box["width"], box["y"] + box["height"] / 2)
+    frame = falling.js("visviva.frame()")
+    assert abs(frame - 0.75 * 49) <= 2
+    assert int(page.input_value("#slider")) == frame
+    assert page.inner_text("#time").startswith(f"t = {frame / 25.0:.3f} s")
+    page.keyboard.press("End")
+    assert falling.js("visviva.frame()") == 49
+    page.keyboard.press("Home")
+    assert falling.js("visviva.frame()") == 0
+    falling.js("visviva.setFrame(30)")
+    assert int(page.input_value("#slider")) == 30
+    with pytest.raises(Exception, match=r"whole number in 0\.\.49"):
+        falling.js("visviva.setFrame(50)")
+
+
+def test_title_is_text_not_markup(browser, tmp_path):
+    title = "</script><b>cloth & rope</b>"
+    path = write_viewer(falling_recording(), tmp_path / "title.html", title=title)
+    opened = Opened(browser, path)
+    try:
+        assert opened.errors == []
+        assert opened.page.title() == title
+        assert opened.page.inner_text("#title") == title
+    finally:
+        opened.page.close()
+
+
+def test_cloth_of_4096_vertices_and_300_frames_loads_quickly(browser, tmp_path):
+    recording = waving_cloth()
+    path = write_viewer(recording, tmp_path / "cloth.html")
+    # 300 frames × 4096 points × 12 bytes as base64, plus the ~0.55 MB page.
+    positions = 4 * math.ceil(300 * 4096 * 12 / 3)
+    assert positions < path.stat().st_size < positions + 1_000_000
+    started = time.perf_counter()
+    opened = Opened(browser, path)
+    wall = time.perf_counter() - started
+    try:
+        ready = opened.js("visviva.readyTime") / 1000.0  # [s] from navigation start
+        assert opened.errors == []
+        assert opened.js("visviva.frames") == 300
+        # Measured ~0.4–0.7 s here (benchmarks/bench_viewer.py); the bound only catches
+        # pathologies on a slow, shared machine.
+        assert ready < 10.0 and wall < 15.0
+        last = np.array(opened.js("visviva.points(299)")).reshape(-1, 3)
+        np.testing.assert_allclose(last, recording["points"][299], rtol=6e-8, atol=1e-7)
+        image = opened.image(150)
+        orange = (image[..., 0] - image[..., 2]) > 80  # the cloth, #d9822b shaded
+        assert orange.sum() > 0.05 * orange.size
+    finally:
+        opened.page.close()
+
+
+def test_default_rate():
+    even = falling_recording()
+    assert default_fps(even) == pytest.approx(25.0, rel=1e-12)
+    fast = vv.Recording(np.arange(1001) * 1e-3, {"points": np.zeros((1001, 1, 3))})
+    assert default_fps(fast) == pytest.approx(1000.0 / 17.0, rel=1e-12)
+    np.testing.assert_array_equal(frames_at_rate(fast.time, default_fps(fast)), np.arange(59) * 17)
+    # A shortened last interval still counts as even; uneven frames play at 30 fps.
+    short_end = vv.Recording(np.array([0.0, 0.1, 0.2, 0.25]), {"points": np.zeros((4, 1, 3))})
+    assert default_fps(short_end) == pytest.approx(10.0, rel=1e-12)
+    uneven = vv.Recording(np.array([0.0, 0.1, 0.3, 0.35]), {"points": np.zeros((4, 1, 3))})
+    assert default_fps(uneven) == 30.0
+
+
+def test_default_rate_is_lowered_to_fit_the_size_cap():
+    # 2¹⁸ points = 3 MiB per frame: 21 frames fit the 64 MiB cap; 100 s at 10 Hz do not.
+    # (A broadcast view: the 6 GB of positions are never allocated.)
+    points = np.broadcast_to(np.zeros((1, 1, 3)), (1001, 2**18, 3))
+    recording = vv.Recording(np.linspace(0.0, 100.0, 1001), {"points": points})
+    with pytest.warns(UserWarning, match="frames/s"):
+        fps = default_fps(recording)
+    frames = frames_at_rate(recording.time, fps).size
+    assert frames * 2**18 * 12 <= MAX_POSITION_BYTES
+    assert frames == MAX_POSITION_BYTES // (2**18 * 12)
+
+
+def blown_up(recording: vv.Recording) -> vv.Recording:
+    points = recording["points"].copy()
+    points[26:, 1] = np.inf
+    return vv.Recording(recording.time, {"points": points})
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda r, p: write_viewer("rec.h5", p), "`recording` must be a visviva Recording"),
+        (
+            lambda r, p: write_viewer(vv.Recording(r.time, {"q": r["points"]}), p),
+            "no `points` field",
+        ),
+        (lambda r, p: write_viewer(r, p, fps=0.0), "`fps` must be positive"),
+        (lambda r, p: write_viewer(r, p, fps=True), "`fps` must be a real number"),
+        (lambda r, p: write_viewer(r, p, title=3), "`title` must be a string"),
+        (lambda r, p: write_viewer(r, p.parent / "missing" / "x.html"), "does not exist"),
+        (lambda r, p: write_viewer(r, p.parent), "is a directory"),
+        (lambda r, p: write_viewer(blown_up(r), p), "recorded frame 26 are not finite"),
+        (
+            lambda r, p: write_viewer(
+                vv.Recording(np.array([0.0, 10.0]), {"points": np.zeros((2, 2**18, 3))}),
+                p,
+                fps=10.0,
+            ),
+            "lower fps",
+        ),
+    ],
+)
+def test_bad_input_is_refused_before_anything_is_written(tmp_path, change, message):
+    target = tmp_path / "viewer.html"
+    with pytest.raises(vv.ModelError, match=message):
+        change(falling_recording(), target)
+    assert list(tmp_path.iterdir()) == []
