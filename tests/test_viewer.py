@@ -226,6 +226,36 @@ def test_slider_sets_the_frame_and_follows_playback(falling):
         falling.js("visviva.setFrame(50)")
 
 
+def test_drag_wheel_and_pan_move_the_camera_and_double_click_restores_it(falling):
+    page = falling.page
+    home = falling.image(20)
+
+    def changed_pixels() -> int:
+        return int(np.any(falling.image(20) != home, axis=2).sum())
+
+    page.mouse.move(400, 300)
+    page.mouse.down()
+    page.mouse.move(480, 260, steps=4)
+    page.mouse.up()
+    orbited = changed_pixels()
+    page.mouse.dblclick(400, 300)
+    assert changed_pixels() == 0
+    page.mouse.wheel(0, 300)  # zoom out
+    page.wait_for_timeout(100)  # wheel events are delivered asynchronously
+    zoomed = changed_pixels()
+    page.mouse.dblclick(400, 300)
+    page.keyboard.down("Shift")
+    page.mouse.move(400, 300)
+    page.mouse.down()
+    page.mouse.move(300, 300, steps=4)
+    page.mouse.up()
+    page.keyboard.up("Shift")
+    panned = changed_pixels()
+    page.mouse.dblclick(400, 300)
+    assert changed_pixels() == 0
+    assert min(orbited, zoomed, panned) > 2000, (orbited, zoomed, panned)
+
+
 def test_title_is_text_not_markup(browser, tmp_path):
     title = "</script><b>cloth & rope</b>"
     path = write_viewer(falling_recording(), tmp_path / "title.html", title=title)
@@ -234,6 +264,18 @@ def test_title_is_text_not_markup(browser, tmp_path):
         assert opened.errors == []
         assert opened.page.title() == title
         assert opened.page.inner_text("#title") == title
+    finally:
+        opened.page.close()
+
+
+def test_a_single_still_point_loads_and_does_not_play(browser, tmp_path):
+    recording = vv.Recording(np.array([0.5]), {"points": np.array([[[0.0, 1.0, 0.0]]])})
+    opened = Opened(browser, write_viewer(recording, tmp_path / "still.html"))
+    try:
+        assert opened.errors == []
+        assert opened.js("[visviva.frames, visviva.playing(), visviva.times]") == [1, False, [0.5]]
+        blue = _blue(opened.image(0))
+        assert blue.sum() > 20  # the default radius of a scene with no extent, 0.05 m
     finally:
         opened.page.close()
 
@@ -301,6 +343,12 @@ def blown_up(recording: vv.Recording) -> vv.Recording:
         (
             lambda r, p: write_viewer(vv.Recording(r.time, {"q": r["points"]}), p),
             "no `points` field",
+        ),
+        (
+            lambda r, p: write_viewer(
+                vv.Recording(np.zeros(0), {"points": np.zeros((0, 1, 3))}), p
+            ),
+            "no frames",
         ),
         (lambda r, p: write_viewer(r, p, fps=0.0), "`fps` must be positive"),
         (lambda r, p: write_viewer(r, p, fps=True), "`fps` must be a real number"),

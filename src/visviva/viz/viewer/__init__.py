@@ -38,7 +38,7 @@ __all__ = ["FALLBACK_FPS", "MAX_DEFAULT_FPS", "MAX_POSITION_BYTES", "default_fps
 FALLBACK_FPS = 30.0
 #: Highest default playback rate [frames/s]: a 1 kHz recording plays every 17th frame (58.8 fps).
 MAX_DEFAULT_FPS = 60.0
-#: Largest float32 position data [bytes] one page embeds (64 MiB, ~86 MB of base64 in the file):
+#: Largest float32 position data [bytes] one page embeds (64 MiB, ~90 MB of base64 in the file):
 #: beyond it a browser tab needs several hundred MB to open the page. E.g. 4096 points at
 #: 30 frames/s fit 45 s. The default rate is lowered to fit; an explicit ``fps`` must fit.
 MAX_POSITION_BYTES = 64 * 2**20
@@ -84,6 +84,8 @@ def default_fps(recording: Recording) -> float:
     """
     geometry = recording.geometry()
     time = recording.time
+    if time.size == 0:
+        raise ModelError("the recording has no frames: there is nothing to play")
     rate = _recorded_rate(time)
     if rate is None:
         fps = FALLBACK_FPS
@@ -102,8 +104,8 @@ def default_fps(recording: Recording) -> float:
         fps = (budget_frames - 1) / span if budget_frames > 1 else 1.0 / (2.0 * span)
         warnings.warn(
             f"the viewer plays this recording at {fps:.3g} frames/s so that its positions stay "
-            f"within {MAX_POSITION_BYTES // 2**20} MiB; pass fps= and a shorter recording for "
-            "smoother playback",
+            f"within {MAX_POSITION_BYTES // 2**20} MiB; for smoother playback, write a shorter "
+            "part of the recording",
             stacklevel=2,
         )
     return fps
@@ -200,6 +202,8 @@ def write_viewer(
             "load one with visviva.Recording.load(path)"
         )
     geometry = recording.geometry()
+    if recording.frames == 0:
+        raise ModelError("the recording has no frames: there is nothing to play")
     if title is not None and not isinstance(title, str):
         raise ModelError(f"`title` must be a string or None (got {describe(title)})")
     target = _check_target(path)
