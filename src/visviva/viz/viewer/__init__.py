@@ -159,7 +159,8 @@ def _asset(name: str) -> str:
 
 
 def _default_title(recording: Recording) -> str:
-    for key in ("scene", "problem"):
+    # "scene_name" from scene runs ("scene" holds the scene file's text), "problem" from solves.
+    for key in ("scene_name", "problem"):
         value = recording.attrs.get(key)
         if isinstance(value, str) and value:
             return f"visviva — {value}"
