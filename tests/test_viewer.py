@@ -91,8 +91,10 @@ def falling_page_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
 class Opened:
     """A page opened on a viewer file, with everything it logged and requested."""
 
-    def __init__(self, browser: Browser, path: Path) -> None:
+    def __init__(self, browser: Browser, path: Path, *, before: str | None = None) -> None:
         self.page: Page = browser.new_page(viewport={"width": 800, "height": 600})
+        if before is not None:
+            self.page.add_init_script(before)
         self.errors: list[str] = []
         self.requests: list[str] = []
         self.page.on(
@@ -145,6 +147,20 @@ def test_embedded_frames_are_the_recording_resampled(falling):
         # float32 storage: relative rounding ≤ 2⁻²⁴ ≈ 6e-8.
         np.testing.assert_allclose(points, recording["points"][shown[k]], rtol=6e-8, atol=1e-12)
     assert falling.js("document.getElementById('legend').textContent").count("velocity_verlet")
+
+
+def test_base64_fallback_for_browsers_without_uint8array_frombase64(browser, falling_page_path):
+    # Uint8Array.fromBase64 is recent (Chromium 140); older browsers decode through atob.
+    opened = Opened(browser, falling_page_path, before="delete Uint8Array.fromBase64")
+    try:
+        assert opened.errors == []
+        assert opened.js("typeof Uint8Array.fromBase64") == "undefined"
+        recording = falling_recording()
+        np.testing.assert_array_equal(opened.js("visviva.times"), recording.time)
+        points = np.array(opened.js("visviva.points(49)")).reshape(3, 3)
+        np.testing.assert_allclose(points, recording["points"][49], rtol=6e-8, atol=1e-12)
+    finally:
+        opened.page.close()
 
 
 def _blue(image: np.ndarray) -> np.ndarray:

@@ -27,12 +27,13 @@
   const ORBIT_RATE = 2 * Math.PI; // radians per canvas height dragged
   const ZOOM_RATE = 0.0015; // log-distance per wheel delta unit
   // A sphere of n segments around and n/2 + 1 rings has n² triangles (minus n at the poles);
-  // ~150k in all keeps software WebGL (SwiftShader) near 10 frames/s with 4096 points.
+  // ~150k in all keeps software WebGL (SwiftShader, 2 cores) near 8 frames/s with 4096 points.
   const SPHERE_SEGMENTS = [24, 16, 12, 8, 6, 4];
   const SPHERE_TRIANGLE_BUDGET = 150000;
   const POLAR_LIMIT = 0.01; // radians kept from the poles, where "up" is undefined
 
-  /* Base64 text of little-endian binary -> typed array (every WebGL host is little-endian). */
+  /* Base64 text of little-endian binary -> typed array (typed arrays use the host's byte
+   * order, little-endian on every platform browsers run on in practice). */
   function decode(text, Type) {
     let bytes;
     if (typeof Uint8Array.fromBase64 === "function") {
