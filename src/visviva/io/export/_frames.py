@@ -1,0 +1,219 @@
+"""What every exporter starts from: a recording's geometry resampled to an output frame rate.
+
+:func:`prepare` checks the recording and the rate once, before any file is touched, and returns
+an :class:`ExportFrames`: output frame ``k`` (time ``k/fps`` after the first recorded frame) shows
+the recorded frame ``shown[k]`` chosen by :func:`visviva.io.timeline.frames_at_rate`. Each
+writer reads positions one output frame at a time (:meth:`ExportFrames.points_at`), so no
+format needs a resampled copy of the whole recording unless its layout demands one (glTF).
+
+The drawable parts follow the recording's convention (``points``, ``radius``, ``edges``,
+``faces``; see :mod:`visviva.io.recording`). A future kind (rigid bodies: a position and a
+quaternion per body per frame) becomes one more field here and one more part in each writer.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..._validation import real_number
+from ...errors import ModelError
+from ..recording import Geometry, Recording
+from ..timeline import frames_at_rate
+
+__all__ = ["FALLBACK_FPS", "MAX_OUTPUT_FRAMES", "ExportFrames", "default_fps", "prepare"]
+
+#: Output rate [frames/s] when the recorded frames are not evenly spaced (or there is only one).
+FALLBACK_FPS = 30.0
+#: Most output frames one export may have: a million frames is ~9 hours at 30 frames/s; more
+#: is almost surely an `fps` typed in the wrong unit.
+MAX_OUTPUT_FRAMES = 1_000_000
+#: Relative tolerance on frame spacing for a recording to count as evenly spaced, and on its
+#: rate for that rate to be rounded to a whole number of frames per second.
+_EVEN_SPACING_RTOL = 1e-6
+#: Point radius, as a fraction of the scene's bounding-box diagonal, when a recording gives none.
+_RADIUS_FRACTION = 0.01
+#: Radius [m] for a scene with no extent (points that never move apart).
+_RADIUS_OF_A_POINT_SCENE = 0.05
+
+
+def _output_count(time: np.ndarray, fps: float) -> int:
+    return int(frames_at_rate(time[[0, -1]], fps).size)
+
+
+def default_fps(time: np.ndarray) -> float:
+    """The output rate [frames/s] used when an export is not given ``fps``.
+
+    The recording's own rate, ``1 / median spacing``, if its frames are evenly spaced (the last
+    interval may be shorter: a run whose duration is not a whole number of frames); rounded to
+    a whole number of frames per second when it is one up to round-off (``1/(1/60)`` gives
+    ``59.999…``), provided the rounding keeps every recorded frame. :data:`FALLBACK_FPS` for
+    uneven frames or a single frame.
+
+    Args:
+        time: Recorded frame times [s], non-decreasing, shape ``(frames,)``.
+
+    Example:
+        >>> default_fps(np.arange(61) * (1 / 60)), default_fps(np.array([0.0, 0.1, 0.3]))
+        (60.0, 30.0)
+    """
+    steps = np.diff(np.asarray(time, dtype=np.float64))
+    if steps.size == 0:
+        return FALLBACK_FPS
+    step = float(np.median(steps[:-1])) if steps.size > 1 else float(steps[0])
+    if not step > 0.0:
+        return FALLBACK_FPS
+    tolerance = _EVEN_SPACING_RTOL * step
+    body, last = steps[:-1], steps[-1]
+    if not (np.all(np.abs(body - step) <= tolerance) and 0.0 < last <= step + tolerance):
+        return FALLBACK_FPS
+    rate = 1.0 / step
+    whole = float(round(rate))
+    if (
+        whole >= 1.0
+        and abs(whole - rate) <= _EVEN_SPACING_RTOL * rate
+        and _output_count(time, whole) == _output_count(time, rate)
+    ):
+        return whole
+    return rate
+
+
+def _topology(value: np.ndarray | None) -> np.ndarray | None:
+    """Index pairs or triangles as int64, or ``None`` when there are none."""
+    if value is None or value.shape[0] == 0:
+        return None
+    return np.ascontiguousarray(value, dtype=np.int64)
+
+
+@dataclass(frozen=True)
+class ExportFrames:
+    """A recording's drawable geometry, resampled to a fixed output rate.
+
+    Attributes:
+        geometry: The validated geometry of every recorded frame.
+        time: Recorded frame times [s], shape ``(frames,)``.
+        shown: Index of the recorded frame shown at each output frame, int64, shape
+            ``(count,)``.
+        fps: Output frames per second [1/s]; output frame ``k`` is at ``time[0] + k/fps``.
+        name: Name for the exported object (the recording's ``scene_name``, else "visviva").
+    """
+
+    geometry: Geometry
+    time: np.ndarray
+    shown: np.ndarray
+    fps: float
+    name: str
+
+    @property
+    def count(self) -> int:
+        """Number of output frames."""
+        return int(self.shown.shape[0])
+
+    @property
+    def point_count(self) -> int:
+        """Number of points ``P``."""
+        return int(self.geometry.points.shape[1])
+
+    @property
+    def edges(self) -> np.ndarray | None:
+        """Point-index pairs drawn as lines, int64 ``(E, 2)``, or ``None`` if there are none."""
+        return _topology(self.geometry.edges)
+
+    @property
+    def faces(self) -> np.ndarray | None:
+        """Point-index triangles, int64 ``(F, 3)``, or ``None`` if there are none."""
+        return _topology(self.geometry.faces)
+
+    def points_at(self, k: int) -> np.ndarray:
+        """Positions [m] at output frame ``k``: float64, shape ``(P, 3)``, world frame, Y up."""
+        return np.asarray(self.geometry.points[self.shown[k]], dtype=np.float64)
+
+    def output_times(self) -> np.ndarray:
+        """Time of each output frame after the first recorded frame [s]: ``k/fps``, ``(count,)``.
+
+        Computed from the integer ``k`` (never by accumulating ``1/fps``).
+        """
+        return np.arange(self.count) / self.fps
+
+    def radius(self) -> np.ndarray:
+        """Point radii [m], shape ``(P,)``: the recording's, else 1 % of the scene's diagonal."""
+        if self.geometry.radius is not None:
+            return np.asarray(self.geometry.radius, dtype=np.float64)
+        return np.full(self.point_count, self.default_radius())
+
+    def default_radius(self) -> float:
+        """Radius [m] drawn for points without one: 1 % of the scene's bounding-box diagonal."""
+        low, high = self.geometry.bounds()
+        diagonal = float(np.linalg.norm(high - low))
+        return _RADIUS_FRACTION * diagonal if diagonal > 0.0 else _RADIUS_OF_A_POINT_SCENE
+
+    def loose_points(self, *, faces: bool = True, edges: bool = False) -> np.ndarray:
+        """Indices of the points used by no face (and, if ``edges``, by no edge), int64.
+
+        A format that draws triangles (or lines) shows their vertices already; the points left
+        over still need a primitive of their own.
+        """
+        used = np.zeros(self.point_count, dtype=bool)
+        for wanted, topology in ((faces, self.faces), (edges, self.edges)):
+            if wanted and topology is not None:
+                used[topology.ravel()] = True
+        return np.flatnonzero(~used).astype(np.int64)
+
+
+def _scene_name(attrs: dict[str, Any]) -> str:
+    value = attrs.get("scene_name")
+    return value.strip() if isinstance(value, str) and value.strip() else "visviva"
+
+
+def prepare(recording: Recording, fps: float | None) -> ExportFrames:
+    """Check ``recording`` and ``fps`` and choose the recorded frame of every output frame.
+
+    Args:
+        recording: A recording with a ``points`` field (see :meth:`Recording.geometry`).
+        fps: Output frames per second [1/s], or ``None`` for :func:`default_fps`.
+
+    Raises:
+        ModelError: If the recording has no points or no frames, ``fps`` is not a positive
+            number or gives more than :data:`MAX_OUTPUT_FRAMES` frames, or a shown frame holds
+            a non-finite position.
+    """
+    if not isinstance(recording, Recording):
+        raise ModelError(
+            f"`recording` must be a visviva.Recording (got {type(recording).__name__}); "
+            "load one with visviva.Recording.load(path)"
+        )
+    geometry = recording.geometry()
+    points = geometry.points
+    if points.shape[1] == 0:
+        raise ModelError(
+            f"the recording's `points` field holds no points (shape {points.shape}); "
+            "there is nothing to export"
+        )
+    time = recording.time
+    if time.size == 0:
+        raise ModelError("the recording has no frames; there is nothing to export")
+    if fps is None:
+        rate = default_fps(time)
+    else:
+        rate = real_number("fps", fps, positive=True, unit=" frames/s")
+    span = float(time[-1] - time[0])
+    if span * rate >= MAX_OUTPUT_FRAMES:
+        raise ModelError(
+            f"`fps` = {rate:g} frames/s over the recording's {span:g} s gives "
+            f"{math.floor(span * rate) + 1} output frames, more than {MAX_OUTPUT_FRAMES}; "
+            "pass a lower fps (frames per second, e.g. 30)"
+        )
+    shown = frames_at_rate(time, rate)
+    for k in np.unique(shown):
+        bad = ~np.isfinite(points[k])
+        if bad.any():
+            point = int(np.argwhere(bad)[0][0])
+            raise ModelError(
+                f"`points` of recorded frame {int(k)} (t = {time[k]:g} s) is not finite at "
+                f"point {point} ({points[k, point].tolist()}): the run diverged there; re-run "
+                "it with a smaller step, or export a recording that ends before that frame"
+            )
+    return ExportFrames(geometry, time, shown, rate, _scene_name(recording.attrs))

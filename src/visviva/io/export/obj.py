@@ -1,0 +1,107 @@
+"""Wavefront OBJ sequences: one OBJ file per output frame.
+
+Where the files go depends on ``path``:
+
+* ``path`` ending in ``.obj`` (``out/cloth.obj``): ``out/cloth_0000.obj``, ``out/cloth_0001.obj``
+  … next to it (``path`` itself is not written);
+* any other ``path`` (``out/obj``): a directory, created if missing, holding
+  ``frame_0000.obj``, ``frame_0001.obj`` ….
+
+The number is the output frame ``k`` (time ``k/fps`` after the first recorded frame), padded to
+four digits (more when there are over 10,000 frames), so Houdini's ``$F4`` and Blender's
+sequence importers find them. Files of the same names are replaced; other files in the
+directory are left alone.
+
+Each file uses the OBJ subset every reader knows (Wavefront's "Object Files" appendix of the
+Advanced Visualizer manual): ``o`` name, one ``v x y z`` line per point in point order, ``l a b``
+per edge and ``f a b c`` per triangle, with 1-based indices. Coordinates are written with
+Python's ``repr``, the shortest decimal that reads back as the same float64, so the files hold
+the recording's positions exactly (``%.9g`` would only keep float32 precision) at the cost of a
+few more characters than needed for display. Units are metres, Y up.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import re
+from pathlib import Path
+
+from ._files import all_or_nothing
+from ._frames import ExportFrames
+
+__all__ = ["obj_sequence_paths", "write_obj_sequence"]
+
+#: Digits of the frame number in file names (more are used when the count needs them).
+_MIN_DIGITS = 4
+
+
+def obj_sequence_paths(path: Path, count: int) -> list[Path]:
+    """The files an OBJ export of ``count`` frames to ``path`` writes (see the module docstring).
+
+    Example:
+        >>> [p.as_posix() for p in obj_sequence_paths(Path("out/cloth.obj"), 2)]
+        ['out/cloth_0000.obj', 'out/cloth_0001.obj']
+        >>> obj_sequence_paths(Path("out/obj"), 12000)[-1].as_posix()
+        'out/obj/frame_11999.obj'
+    """
+    digits = max(_MIN_DIGITS, len(str(max(count - 1, 0))))
+    if path.suffix.lower() == ".obj":
+        folder, stem = path.parent, path.stem
+    else:
+        folder, stem = path, "frame"
+    return [folder / f"{stem}_{k:0{digits}d}.obj" for k in range(count)]
+
+
+def _topology_text(frames: ExportFrames) -> str:
+    """The ``l`` and ``f`` lines, the same in every file (1-based indices)."""
+    lines: list[str] = []
+    if frames.edges is not None:
+        lines.extend(f"l {a + 1} {b + 1}\n" for a, b in frames.edges.tolist())
+    if frames.faces is not None:
+        lines.extend(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in frames.faces.tolist())
+    return "".join(lines)
+
+
+def _object_name(name: str) -> str:
+    """``name`` as one OBJ token (OBJ statements split on white space)."""
+    return re.sub(r"\s+", "_", name)
+
+
+def write_obj_sequence(frames: ExportFrames, path: Path) -> list[Path]:
+    """Write one OBJ file per output frame; all files appear, or none does.
+
+    Args:
+        frames: The resampled recording (:func:`visviva.io.export._frames.prepare`).
+        path: ``something.obj`` (files next to it) or a directory (created if missing; its
+            parent must exist).
+
+    Returns:
+        The files written, in frame order.
+    """
+    targets = obj_sequence_paths(path, frames.count)
+    created = path.suffix.lower() != ".obj" and not path.exists()
+    if created:
+        path.mkdir()
+    topology = _topology_text(frames)
+    vertex_line = "v %r %r %r\n"
+    name = _object_name(frames.name)
+    try:
+        with all_or_nothing(targets) as temporaries:
+            for k, temporary in enumerate(temporaries):
+                shown = int(frames.shown[k])
+                header = (
+                    f"# visviva OBJ export: frame {k} of {frames.count} at {frames.fps:.9g} "
+                    f"frames/s (recorded frame {shown}, t = {float(frames.time[shown])!r} s)\n"
+                    "# units: metres, Y up\n"
+                    f"o {name}\n"
+                )
+                values = tuple(frames.points_at(k).ravel().tolist())
+                vertices = (vertex_line * frames.point_count) % values
+                temporary.write_text(header + vertices + topology, encoding="utf-8")
+    except BaseException:
+        if created:
+            # Only the directory this call made, and only if nothing else appeared in it.
+            with contextlib.suppress(OSError):
+                path.rmdir()
+        raise
+    return targets

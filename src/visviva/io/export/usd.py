@@ -1,0 +1,170 @@
+"""Universal Scene Description (USD) export: time-sampled geometry under one ``/World`` prim.
+
+Written with Pixar's ``usd-core`` (``pxr``), following the UsdGeom schemas (openusd.org,
+"UsdGeom" API documentation and the Universal Scene Description glossary):
+
+* stage metadata ``upAxis = "Y"``, ``metersPerUnit = 1``, ``timeCodesPerSecond`` and
+  ``framesPerSecond`` equal to the export's ``fps``, ``startTimeCode = 0`` and
+  ``endTimeCode = N − 1``: time code ``k`` is output frame ``k``, ``k/fps`` seconds after the
+  first recorded frame;
+* ``/World`` (an ``Xform``) is the default prim, so importers that load only the default prim
+  (Blender, references without a prim path) get everything;
+* ``/World/points`` (``UsdGeom.Points``): the points not used by any face, with time-sampled
+  ``points`` and ``extent`` and per-point ``widths`` (2 × radius, constant in time);
+* ``/World/edges`` (``UsdGeom.BasisCurves``, ``type = linear``, ``wrap = nonperiodic``): one
+  two-vertex curve per edge, time-sampled ``points`` (the two ends of every edge, in edge
+  order) and ``extent``, and a constant width of half the thinnest diameter among points
+  with a radius;
+* ``/World/mesh`` (``UsdGeom.Mesh``): the triangles as ``faceVertexCounts`` (all 3) and
+  ``faceVertexIndices``, ``orientation = rightHanded`` (counter-clockwise seen from outside,
+  the recording's convention), ``subdivisionScheme = none`` (a simulation mesh is the surface
+  itself, not a cage to be smoothed), ``doubleSided`` (cloth has no inside), time-sampled
+  ``points`` and ``extent``.
+
+Point-based ``points`` are float32 (``point3f[]``), so positions keep float32 precision. A
+future rigid body becomes one more part: an ``Xform`` with time-sampled translate and orient ops.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..._version import __version__
+from ._files import all_or_nothing
+from ._frames import ExportFrames
+
+__all__ = ["USD_ENCODINGS", "write_usd"]
+
+#: File encodings usd-core writes: text and binary ("crate").
+USD_ENCODINGS = ("usda", "usdc")
+#: Width of edge curves, as a fraction of the thinnest point diameter.
+_EDGE_WIDTH_FRACTION = 0.5
+
+
+def _extent(positions: np.ndarray, half_width: np.ndarray | float) -> np.ndarray:
+    """Bounding box [m] of one frame, float32 ``(2, 3)``: lower and upper corner, widths in."""
+    pad = np.asarray(half_width, dtype=np.float64).reshape(-1, 1)
+    return np.stack([(positions - pad).min(axis=0), (positions + pad).max(axis=0)]).astype(
+        np.float32
+    )
+
+
+def _animate(
+    prim: Any, frames: ExportFrames, chosen: np.ndarray | None, half_width: np.ndarray | float
+) -> Callable[[int], None]:
+    """A writer of the time samples of ``points`` and ``extent`` of a point-based prim.
+
+    Args:
+        prim: A ``UsdGeom.PointBased`` prim.
+        frames: The resampled recording.
+        chosen: Indices of the recording's points that make the prim's ``points`` (repeats
+            allowed), or ``None`` for all of them in order.
+        half_width: Half the width [m] of each of the prim's points (or one for all), which
+            the extent includes as UsdGeom's extent rules ask.
+    """
+    from pxr import Vt
+
+    points, extent = prim.CreatePointsAttr(), prim.CreateExtentAttr()
+
+    def write(k: int) -> None:
+        positions = frames.points_at(k)
+        if chosen is not None:
+            positions = positions[chosen]
+        points.Set(Vt.Vec3fArray.FromNumpy(positions.astype(np.float32)), k)
+        extent.Set(Vt.Vec3fArray.FromNumpy(_extent(positions, half_width)), k)
+
+    return write
+
+
+def _add_points(stage: Any, frames: ExportFrames, loose: np.ndarray) -> Callable[[int], None]:
+    from pxr import UsdGeom, Vt
+
+    prim = UsdGeom.Points.Define(stage, "/World/points")
+    radius = frames.radius()[loose]
+    prim.CreateWidthsAttr(Vt.FloatArray.FromNumpy((2.0 * radius).astype(np.float32)))
+    prim.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
+    chosen = None if loose.size == frames.point_count else loose
+    return _animate(prim, frames, chosen, radius)
+
+
+def _add_edges(stage: Any, frames: ExportFrames, edges: np.ndarray) -> Callable[[int], None]:
+    from pxr import UsdGeom, Vt
+
+    prim = UsdGeom.BasisCurves.Define(stage, "/World/edges")
+    prim.CreateTypeAttr(UsdGeom.Tokens.linear)
+    prim.CreateWrapAttr(UsdGeom.Tokens.nonperiodic)
+    counts = np.full(edges.shape[0], 2, dtype=np.int32)
+    prim.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(counts))
+    radius = frames.radius()
+    thinnest = float(radius[radius > 0.0].min()) if (radius > 0.0).any() else None
+    width = _EDGE_WIDTH_FRACTION * 2.0 * (thinnest or frames.default_radius())
+    prim.CreateWidthsAttr(Vt.FloatArray([width]))
+    prim.SetWidthsInterpolation(UsdGeom.Tokens.constant)
+    return _animate(prim, frames, edges.ravel(), width / 2.0)
+
+
+def _add_mesh(stage: Any, frames: ExportFrames, faces: np.ndarray) -> Callable[[int], None]:
+    from pxr import UsdGeom, Vt
+
+    prim = UsdGeom.Mesh.Define(stage, "/World/mesh")
+    counts = np.full(faces.shape[0], 3, dtype=np.int32)
+    prim.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(counts))
+    prim.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(faces.ravel().astype(np.int32)))
+    prim.CreateOrientationAttr(UsdGeom.Tokens.rightHanded)
+    prim.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+    prim.CreateDoubleSidedAttr(True)
+    return _animate(prim, frames, None, 0.0)
+
+
+def write_usd(frames: ExportFrames, path: Path, *, encoding: str) -> list[Path]:
+    """Write the resampled recording as a USD stage (see the module docstring), atomically.
+
+    Args:
+        frames: The resampled recording (:func:`visviva.io.export._frames.prepare`).
+        path: Target file ending in ``.usd``, ``.usda`` or ``.usdc``; its directory must
+            exist. An existing file is replaced.
+        encoding: ``"usda"`` (text) or ``"usdc"`` (binary crate), one of :data:`USD_ENCODINGS`.
+
+    Returns:
+        ``[path]``.
+    """
+    from pxr import Usd, UsdGeom
+
+    stage = Usd.Stage.CreateInMemory()
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    stage.SetTimeCodesPerSecond(frames.fps)
+    stage.SetFramesPerSecond(frames.fps)
+    stage.SetStartTimeCode(0.0)
+    stage.SetEndTimeCode(float(frames.count - 1))
+    first = float(frames.time[0])
+    stage.GetRootLayer().documentation = (
+        f"visviva {__version__} export of {frames.name!r}: {frames.count} frames at "
+        f"{frames.fps:.9g} frames/s; time code k is {first!r} s + k/{frames.fps:.9g} s of the "
+        "simulation; metres, Y up"
+    )
+    world = UsdGeom.Xform.Define(stage, "/World")
+    stage.SetDefaultPrim(world.GetPrim())
+
+    writers = []
+    loose = frames.loose_points(faces=True)
+    if loose.size:
+        writers.append(_add_points(stage, frames, loose))
+    if frames.edges is not None:
+        writers.append(_add_edges(stage, frames, frames.edges))
+    if frames.faces is not None:
+        writers.append(_add_mesh(stage, frames, frames.faces))
+    for k in range(frames.count):
+        for write in writers:
+            write(k)
+
+    # A ".usd" file may hold either encoding: say which; ".usda"/".usdc" name their own.
+    arguments = {"format": encoding} if path.suffix.lower() == ".usd" else {}
+    with all_or_nothing([path]) as (temporary,):
+        if not stage.GetRootLayer().Export(str(temporary), args=arguments):
+            raise OSError(f"usd-core could not write {temporary}")
+    return [path]
