@@ -203,6 +203,27 @@ def test_usd_faces_are_a_mesh(tmp_path: Path) -> None:
     assert np.array(mesh.GetPointsAttr().Get(checked[-1]))[3, 1] != 0.0  # it moved
 
 
+def test_points_off_the_mesh_keep_a_primitive_of_their_own(tmp_path: Path) -> None:
+    # Points 0-2 form a triangle; point 3 is on no face (USD) and on no face or edge (glTF).
+    recording = moving_points(static={"faces": np.array([[0, 1, 2]])})
+    positions, checked, tolerance = expected(recording)
+    (usd,) = export_recording(recording, tmp_path / "mixed.usda", fps=FPS)
+    (glb,) = export_recording(recording, tmp_path / "mixed.glb", fps=FPS)
+    stage = Usd.Stage.Open(str(usd))
+    loose = UsdGeom.Points(stage.GetPrimAtPath("/World/points"))
+    np.testing.assert_allclose(np.array(loose.GetWidthsAttr().Get()), [0.2])  # radius 0.1
+    document, blob, frames = gltf_frames(glb)
+    triangles, points = document.meshes[0].primitives
+    assert (triangles.mode, points.mode) == (pygltflib.TRIANGLES, pygltflib.POINTS)
+    np.testing.assert_array_equal(gltf_accessor(document, blob, points.indices), [3])
+    for k in checked:
+        read = usd_points(usd, "/World/points", k)
+        np.testing.assert_allclose(read, positions[k][[3]], rtol=0, atol=tolerance)
+        read = usd_points(usd, "/World/mesh", k)  # the mesh holds every point, in order
+        np.testing.assert_allclose(read, positions[k], rtol=0, atol=tolerance)
+        np.testing.assert_allclose(frames[k], positions[k], rtol=0, atol=tolerance)
+
+
 # --- glTF ----------------------------------------------------------------------------------
 
 
@@ -363,6 +384,13 @@ def test_unknown_or_unfitting_format(tmp_path: Path) -> None:
     )
     assert_refused(
         tmp_path, r"does not end in \.usda or \.usd", recording, tmp_path / "a.usdc", to="usda"
+    )
+    assert_refused(
+        tmp_path,
+        r"does not end in \.obj, as an OBJ sequence \(or name a directory",
+        recording,
+        tmp_path / "a.glb",
+        to="obj",
     )
 
 

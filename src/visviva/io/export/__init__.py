@@ -88,9 +88,14 @@ def _resolve_format(path: Path, to: str | None) -> str:
     if to == "obj" and (suffix == ".obj" or suffix not in _BY_SUFFIX):
         return to  # ".obj" names a file prefix, anything else a directory
     if suffix not in accepted:
-        wanted = " or ".join(accepted)
+        wanted = " or ".join(s for s in accepted if s)
+        what = (
+            "an OBJ sequence (or name a directory without a suffix)"
+            if to == "obj"
+            else f"a {to} file"
+        )
         raise ModelError(
-            f"`path` {os.fspath(path)!r} does not end in {wanted}, as a {to} file must; "
+            f"`path` {os.fspath(path)!r} does not end in {wanted}, as {what} must; "
             f"use e.g. {os.fspath(path.with_suffix(accepted[0]))!r}"
         )
     return to
