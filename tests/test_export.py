@@ -387,7 +387,7 @@ def test_unknown_or_unfitting_format(tmp_path: Path) -> None:
     )
     assert_refused(
         tmp_path,
-        r"does not end in \.obj, as an OBJ sequence \(or name a directory",
+        r"'.*a\.glb' names a glb file, not an OBJ sequence: use a path ending in \.obj",
         recording,
         tmp_path / "a.glb",
         to="obj",

@@ -45,19 +45,25 @@ EXPORT_FORMATS: dict[str, str] = {
     "pc2": "PC2 point cache (.pc2) for Blender's Mesh Cache modifier and 3ds Max",
 }
 
-#: Suffixes each format accepts (lower case); "" means "a directory" (OBJ only).
+#: Suffixes each file format accepts (lower case); OBJ takes ``.obj`` or a directory.
 _SUFFIXES: dict[str, tuple[str, ...]] = {
     "usd": (".usd", ".usda", ".usdc"),
     "usda": (".usda", ".usd"),
     "usdc": (".usdc", ".usd"),
     "glb": (".glb",),
     "gltf": (".gltf", ".glb"),
-    "obj": (".obj", ""),
     "pc2": (".pc2",),
 }
 #: Format chosen from a suffix when ``to`` is not given.
-_BY_SUFFIX = {".usd": "usd", ".usda": "usd", ".usdc": "usd", ".glb": "glb", ".gltf": "gltf"}
-_BY_SUFFIX |= {".obj": "obj", ".pc2": "pc2"}
+_BY_SUFFIX = {
+    ".usd": "usd",
+    ".usda": "usd",
+    ".usdc": "usd",
+    ".glb": "glb",
+    ".gltf": "gltf",
+    ".obj": "obj",
+    ".pc2": "pc2",
+}
 
 
 def _valid_formats() -> str:
@@ -84,19 +90,21 @@ def _resolve_format(path: Path, to: str | None) -> str:
             f"unknown export format `to` = {to!r}.{did_you_mean(to.lower(), EXPORT_FORMATS)} "
             f"Valid: {_valid_formats()}"
         )
+    if to == "obj":
+        # ".obj" names the files' prefix, anything else a directory, unless the suffix is
+        # another format's (a slip more likely than a directory named "rope.glb").
+        if suffix != ".obj" and suffix in _BY_SUFFIX:
+            raise ModelError(
+                f"`path` {os.fspath(path)!r} names a {_BY_SUFFIX[suffix]} file, not an OBJ "
+                f"sequence: use a path ending in .obj (e.g. "
+                f"{os.fspath(path.with_suffix('.obj'))!r}) or a directory"
+            )
+        return to
     accepted = _SUFFIXES[to]
-    if to == "obj" and (suffix == ".obj" or suffix not in _BY_SUFFIX):
-        return to  # ".obj" names a file prefix, anything else a directory
     if suffix not in accepted:
-        wanted = " or ".join(s for s in accepted if s)
-        what = (
-            "an OBJ sequence (or name a directory without a suffix)"
-            if to == "obj"
-            else f"a {to} file"
-        )
         raise ModelError(
-            f"`path` {os.fspath(path)!r} does not end in {wanted}, as {what} must; "
-            f"use e.g. {os.fspath(path.with_suffix(accepted[0]))!r}"
+            f"`path` {os.fspath(path)!r} does not end in {' or '.join(accepted)}, as a {to} "
+            f"file must; use e.g. {os.fspath(path.with_suffix(accepted[0]))!r}"
         )
     return to
 
@@ -117,9 +125,10 @@ def _check_target(path: Path, fmt: str) -> None:
                 "(or a path ending in .obj for NAME_0000.obj files next to it)"
             )
     elif path.is_dir():
+        example = "animation" + _SUFFIXES.get(fmt, (".obj",))[0]
         raise ModelError(
             f"`path` {os.fspath(path)!r} is a directory; give a file name such as "
-            f"{os.fspath(path / ('animation' + _SUFFIXES[fmt][0]))!r}"
+            f"{os.fspath(path / example)!r}"
         )
 
 
