@@ -1,0 +1,407 @@
+"""One video frame of a recording's geometry: camera projection, lighting and layers.
+
+:class:`FramePainter` turns the geometry of one recorded frame into an 8-bit RGB image with the
+kernels of :mod:`visviva.viz.raster`. The camera is fixed for the whole clip, so the sky and
+the ground (and each pixel's point on the ground, for shadows) are computed once. Each frame
+then takes the steps:
+
+1. project every point into the camera (pinhole model, view depth along the camera axis);
+2. each layer casts its shadow onto the ground, along a light from above;
+3. the ground is copied with those shadows, then faces, edges and spheres are drawn into the
+   colour and depth buffers (spheres far to near, so their anti-aliased rims blend over what
+   lies behind);
+4. the time label ``t = 1.234 s`` is stamped in the top-left corner.
+
+A geometry kind is a *layer*: an object with ``cast_shadows`` and ``draw``. Rigid bodies will
+be a new layer, not a change to the others.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Protocol
+
+import numpy as np
+
+from ..io.recording import Geometry
+from . import ground, raster
+from .viewer._payload import default_radius
+
+if TYPE_CHECKING:
+    from .video import Camera
+
+__all__ = ["FramePainter", "drawn_bounds", "drawn_radius"]
+
+#: Direction towards the light (world frame, Y up): from above, a little from the left front.
+LIGHT = np.array([-0.3, 1.0, 0.35]) / np.linalg.norm([-0.3, 1.0, 0.35])
+#: Colours, RGB in [0, 1]; points, edges and faces match the web viewer's.
+SPHERE_COLOUR = (0x2F / 255, 0x6F / 255, 0xB3 / 255)
+EDGE_COLOUR = (0x1D / 255, 0x27 / 255, 0x33 / 255)
+FACE_COLOUR = (0xD9 / 255, 0x82 / 255, 0x2B / 255)
+FACE_BACK_COLOUR = (0.62, 0.56, 0.50)
+#: Sky at the zenith, sky at the horizon, the two ground tones.
+ENVIRONMENT = ((0.50, 0.66, 0.86), (0.90, 0.92, 0.95), (0.80, 0.79, 0.76), (0.74, 0.73, 0.70))
+#: Ambient light from below and from above, diffuse, specular (Blinn-Phong exponent 32).
+MATERIAL = (0.30, 0.52, 0.62, 0.30)
+#: Rays per pixel along each axis for the (once per clip) sky and ground.
+BACKGROUND_SAMPLES = 3
+#: Ground haze: the ground is fully hazed at a few times this multiple of the camera distance.
+HAZE_DISTANCE = 3.0
+#: Fraction of the light a shadow removes from the ground.
+SHADOW_DARKNESS = 0.45
+#: A sphere's shadow is a disc this many times its radius, fading as the sphere rises: it
+#: blocks 1 / (1 + SHADOW_FADE · height / scene size) of the light.
+SHADOW_SIZE, SHADOW_FADE = 1.1, 2.0
+#: Light blocked by a triangle.
+FACE_SHADOW_WEIGHT = 1.0
+#: Occlusion map: at most this many cells along its longer side, and at least a third of a
+#: typical shadow's radius per cell (coarser cells blur the shadows into soft blobs and keep
+#: the cost per sphere to a few cells).
+SHADOW_MAP_CELLS, SHADOW_CELLS_PER_RADIUS = 512, 3.0
+#: Smallest sphere drawn [px]; smaller ones are drawn this size, fainter.
+MIN_SPHERE_PIXELS = 0.75
+#: Relative depth bias that keeps lines in front of the faces they border.
+LINE_DEPTH_BIAS = 2e-3
+#: Near plane, as a fraction of the camera's distance to its target.
+NEAR_FRACTION = 1e-3
+
+
+def drawn_radius(geometry: Geometry) -> np.ndarray:
+    """Radius [m] of each point as drawn: the recorded one, else the web viewer's default.
+
+    Returns:
+        Radii, shape ``(P,)``.
+    """
+    if geometry.radius is not None:
+        return np.asarray(geometry.radius, dtype=np.float64)
+    return np.full(geometry.points.shape[1], default_radius(geometry))
+
+
+def drawn_bounds(geometry: Geometry) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners [m] of every point of every frame as drawn (radii included)."""
+    low, high = geometry.bounds()
+    if geometry.radius is None:
+        pad = float(drawn_radius(geometry).max(initial=0.0))
+        low, high = low - pad, high + pad
+    return low, high
+
+
+@dataclass
+class _Frame:
+    positions: np.ndarray  # (P, 3) world [m]
+    view: np.ndarray  # (P, 3) camera coordinates: right, up, forward [m]
+    screen: np.ndarray  # (P, 3) pixel x, y (NaN behind the camera) and view depth [m]
+
+
+class _Stage:
+    """The fixed camera, light and ground shared by every layer."""
+
+    def __init__(
+        self, camera: Camera, width: int, height: int, ground_y: float, scene: float
+    ) -> None:
+        self.width, self.height = width, height
+        self.scene = scene  # size of the scene [m]: its bounding box's diagonal
+        self.eye = np.array(camera.eye, dtype=np.float64)
+        target = np.array(camera.target, dtype=np.float64)
+        forward = (target - self.eye) / np.linalg.norm(target - self.eye)
+        right = np.cross(forward, camera.up)
+        right /= np.linalg.norm(right)
+        self.basis = np.array([right, np.cross(right, forward), forward])
+        self.focal = 0.5 * height / math.tan(math.radians(camera.field_of_view) / 2.0)
+        self.distance = float(np.linalg.norm(target - self.eye))
+        self.near = NEAR_FRACTION * self.distance
+        self.ground_y = ground_y
+        # Light, world up and Blinn half vector in sphere-kernel coordinates (z to the viewer).
+        flip = np.array([1.0, 1.0, -1.0])
+        towards_light = (self.basis @ LIGHT) * flip
+        half = towards_light + np.array([0.0, 0.0, 1.0])
+        self.light = np.array(
+            [
+                towards_light,
+                (self.basis @ np.array([0.0, 1.0, 0.0])) * flip,
+                half / np.linalg.norm(half),
+            ]
+        )
+
+    def to_view(self, points: np.ndarray) -> np.ndarray:
+        """Camera coordinates (right, up, forward) [m] of world points, shape ``(..., 3)``."""
+        # Three broadcast products: a (P, 3) @ (3, 3) matmul goes through BLAS, whose threads
+        # are slower than this on a busy two-core machine.
+        relative = points - self.eye
+        return (
+            relative[..., 0:1] * self.basis[:, 0]
+            + relative[..., 1:2] * self.basis[:, 1]
+            + relative[..., 2:3] * self.basis[:, 2]
+        )
+
+    def to_screen(self, view: np.ndarray) -> np.ndarray:
+        """Pixel x, y and view depth of camera coordinates; x, y are NaN behind the near plane."""
+        depth = view[..., 2]
+        ahead = depth > self.near
+        scale = np.where(ahead, self.focal / np.where(ahead, depth, 1.0), np.nan)
+        return np.stack(
+            [
+                0.5 * self.width + view[..., 0] * scale,
+                0.5 * self.height - view[..., 1] * scale,
+                depth,
+            ],
+            axis=-1,
+        )
+
+    def on_ground(self, points: np.ndarray) -> np.ndarray:
+        """Where light through world points ``(..., 3)`` meets the ground: (x, z) [m]."""
+        height = points[..., 1:2] - self.ground_y
+        return points[..., [0, 2]] - height * (LIGHT[[0, 2]] / LIGHT[1])
+
+
+class _ShadowMap:
+    """Occlusion on a grid lying on the ground (see :mod:`visviva.viz.ground`)."""
+
+    def __init__(self, stage: _Stage, low: np.ndarray, high: np.ndarray, radius: np.ndarray):
+        signs = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
+        corners = np.where(signs == 1, high, low)
+        footprint = stage.on_ground(corners)
+        start, end = footprint.min(axis=0), footprint.max(axis=0)
+        extent = max(float((end - start).max()), 1e-9)
+        typical = SHADOW_SIZE * float(np.median(radius)) if radius.size else 0.0
+        self.cell = max(extent / SHADOW_MAP_CELLS, typical / SHADOW_CELLS_PER_RADIUS)
+        # A margin of two cells beyond the largest shadow, so no shadow is cut at the edge.
+        margin = SHADOW_SIZE * float(radius.max(initial=0.0)) + 2.0 * self.cell
+        self.origin = start - margin
+        cells = np.ceil((end - start + 2.0 * margin) / self.cell).astype(int) + 1
+        self.occlusion = np.zeros((cells[1], cells[0]), dtype=np.float32)
+
+    def soften(self) -> None:
+        """Blur by one [1, 2, 1]/4 pass along each axis: shadow edges a cell or two wide."""
+        grid = self.occlusion
+        for axis in (0, 1):
+            padded = np.pad(grid, [(1, 1) if a == axis else (0, 0) for a in (0, 1)], mode="edge")
+            ahead = padded[2:] if axis == 0 else padded[:, 2:]
+            behind = padded[:-2] if axis == 0 else padded[:, :-2]
+            grid = 0.5 * grid + 0.25 * (ahead + behind)
+        self.occlusion[...] = grid
+
+
+class _Layer(Protocol):
+    def cast_shadows(self, stage: _Stage, frame: _Frame, shadows: _ShadowMap) -> None:
+        """Add to ``shadows`` what this layer blocks of the light."""
+
+    def draw(self, stage: _Stage, frame: _Frame, color: np.ndarray, depth: np.ndarray) -> None:
+        """Draw into the colour and depth buffers."""
+
+
+class _Spheres:
+    def __init__(self, radius: np.ndarray) -> None:
+        self.radius = radius
+        self.colour = np.tile(np.array(SPHERE_COLOUR, dtype=np.float32), (radius.size, 1))
+        self.material = np.array(MATERIAL)
+
+    def cast_shadows(self, stage: _Stage, frame: _Frame, shadows: _ShadowMap) -> None:
+        height = frame.positions[:, 1] - stage.ground_y
+        weight = 1.0 / (1.0 + SHADOW_FADE * np.maximum(height, 0.0) / stage.scene)
+        ground.splat_discs(
+            shadows.occlusion,
+            shadows.origin,
+            shadows.cell,
+            stage.on_ground(frame.positions),
+            SHADOW_SIZE * self.radius,
+            weight,
+        )
+
+    def draw(self, stage: _Stage, frame: _Frame, color: np.ndarray, depth: np.ndarray) -> None:
+        z = frame.screen[:, 2]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            # Apparent radius of a sphere centred on the axis: f·r / sqrt(z² − r²).
+            size = stage.focal * self.radius / np.sqrt(z * z - self.radius * self.radius)
+        size[~(z - self.radius > stage.near) | np.isnan(frame.screen[:, 0])] = np.nan
+        order = np.argsort(-z, kind="stable")
+        raster.draw_spheres(
+            color,
+            depth,
+            frame.screen,
+            self.radius,
+            size,
+            order,
+            self.colour,
+            stage.light,
+            self.material,
+            MIN_SPHERE_PIXELS,
+        )
+
+
+class _Edges:
+    def __init__(self, edges: np.ndarray, height: int) -> None:
+        self.edges = np.asarray(edges, dtype=np.int64)
+        # At least 1 px wide; 1.5 px at 540 lines, growing with the picture.
+        self.half_width = 0.5 * max(1.0, height / 360.0)
+        self.colour = np.array(EDGE_COLOUR, dtype=np.float32)
+
+    def cast_shadows(self, stage: _Stage, frame: _Frame, shadows: _ShadowMap) -> None:
+        return None  # thin lines cast no visible shadow
+
+    def draw(self, stage: _Stage, frame: _Frame, color: np.ndarray, depth: np.ndarray) -> None:
+        start, end = frame.view[self.edges[:, 0]], frame.view[self.edges[:, 1]]
+        keep = (start[:, 2] > stage.near) | (end[:, 2] > stage.near)
+        start, end = start[keep], end[keep]
+        # Clip to the near plane: move the end behind it to where the segment crosses it.
+        for behind, other in ((start, end), (end, start)):
+            cut = behind[:, 2] <= stage.near
+            if cut.any():
+                s = (stage.near * 1.0001 - behind[cut, 2]) / (other[cut, 2] - behind[cut, 2])
+                behind[cut] += s[:, None] * (other[cut] - behind[cut])
+        segments = np.concatenate([stage.to_screen(start), stage.to_screen(end)], axis=1)
+        raster.draw_lines(color, depth, segments, self.half_width, self.colour, LINE_DEPTH_BIAS)
+
+
+class _Faces:
+    def __init__(self, faces: np.ndarray) -> None:
+        self.faces = np.asarray(faces, dtype=np.int64)
+        self.front = np.array(FACE_COLOUR, dtype=np.float32)
+        self.back = np.array(FACE_BACK_COLOUR, dtype=np.float32)
+
+    def cast_shadows(self, stage: _Stage, frame: _Frame, shadows: _ShadowMap) -> None:
+        corners = stage.on_ground(frame.positions[self.faces])  # (F, 3, 2)
+        ground.splat_triangles(
+            shadows.occlusion, shadows.origin, shadows.cell, corners, FACE_SHADOW_WEIGHT
+        )
+
+    def draw(self, stage: _Stage, frame: _Frame, color: np.ndarray, depth: np.ndarray) -> None:
+        corner = frame.positions[self.faces]
+        # Area-weighted vertex normals: the sum of the (unnormalised) normals of a vertex's faces.
+        face_normal = np.cross(corner[:, 1] - corner[:, 0], corner[:, 2] - corner[:, 0])
+        count = frame.positions.shape[0]
+        flat = self.faces.ravel()
+        normal = np.stack(
+            [np.bincount(flat, np.repeat(face_normal[:, a], 3), count) for a in range(3)], axis=1
+        )
+        length = np.linalg.norm(normal, axis=1, keepdims=True)
+        normal = np.divide(normal, length, out=np.zeros_like(normal), where=length > 0.0)
+        below, above, diffuse = MATERIAL[0], MATERIAL[1], MATERIAL[2]
+        sides = []
+        for sign in (1.0, -1.0):
+            n = sign * normal
+            ambient = below + (above - below) * (0.5 + 0.5 * n[:, 1])
+            sides.append(ambient + diffuse * np.maximum(n @ LIGHT, 0.0))
+        raster.draw_triangles(
+            color,
+            depth,
+            frame.screen,
+            self.faces,
+            sides[0],
+            sides[1],
+            self.front,
+            self.back,
+            stage.near,
+        )
+
+
+class FramePainter:
+    """Paints frames of one geometry, seen by one camera, at one size.
+
+    Args:
+        geometry: The recording's geometry (:meth:`Recording.geometry`), finite.
+        size: ``(width, height)`` [px].
+        camera: The view, fixed for every frame.
+    """
+
+    def __init__(self, geometry: Geometry, size: tuple[int, int], camera: Camera) -> None:
+        self.geometry = geometry
+        self.width, self.height = size
+        radius = drawn_radius(geometry)
+        low, high = drawn_bounds(geometry)
+        scene = max(float(np.linalg.norm(high - low)), 1e-9)
+        stage = _Stage(camera, self.width, self.height, min(0.0, float(low[1])), scene)
+        self.stage = stage
+        self.layers: list[_Layer] = []
+        if geometry.faces is not None and len(geometry.faces):
+            self.layers.append(_Faces(geometry.faces))
+        if geometry.edges is not None and len(geometry.edges):
+            self.layers.append(_Edges(geometry.edges, self.height))
+        self.layers.append(_Spheres(radius))
+        shape = (self.height, self.width)
+        self.background = np.empty((*shape, 3), dtype=np.float32)
+        self.background_depth = np.empty(shape, dtype=np.float32)
+        self.ground_x, self.ground_z = np.empty(shape), np.empty(shape)
+        ground.paint_background(
+            self.background,
+            self.background_depth,
+            self.ground_x,
+            self.ground_z,
+            stage.eye,
+            stage.basis,
+            stage.focal,
+            stage.ground_y,
+            _checker_cell(scene),
+            HAZE_DISTANCE * (stage.distance + scene),
+            np.array(ENVIRONMENT),
+            BACKGROUND_SAMPLES,
+        )
+        self.shadows = _ShadowMap(stage, low, high, radius)
+        self.color = np.empty_like(self.background)
+        self.depth = np.empty_like(self.background_depth)
+        self._label = _Label(self.height)
+
+    def paint(self, index: int, time: float) -> np.ndarray:
+        """Image of recorded frame ``index`` labelled with ``time`` [s]: uint8, ``(H, W, 3)``."""
+        positions = np.asarray(self.geometry.points[index], dtype=np.float64)
+        view = self.stage.to_view(positions)
+        frame = _Frame(positions, view, self.stage.to_screen(view))
+        shadows = self.shadows
+        shadows.occlusion.fill(0.0)
+        for layer in self.layers:
+            layer.cast_shadows(self.stage, frame, shadows)
+        shadows.soften()
+        ground.compose_ground(
+            self.color,
+            self.depth,
+            self.background,
+            self.background_depth,
+            self.ground_x,
+            self.ground_z,
+            shadows.occlusion,
+            shadows.origin,
+            shadows.cell,
+            SHADOW_DARKNESS,
+        )
+        for layer in self.layers:
+            layer.draw(self.stage, frame, self.color, self.depth)
+        self._label.stamp(self.color, f"t = {time:.3f} s")
+        image = np.empty((self.height, self.width, 3), dtype=np.uint8)
+        raster.to_bytes(self.color, image)
+        return image
+
+
+def _checker_cell(scene: float) -> float:
+    """Checker square [m]: the 1-2-5 step just below a quarter of the scene's size."""
+    step = 10.0 ** math.floor(math.log10(scene / 4.0))
+    for factor in (5.0, 2.0):
+        if factor * step <= scene / 4.0:
+            return factor * step
+    return step
+
+
+class _Label:
+    """White text on a translucent dark box in the top-left corner (Pillow's built-in font)."""
+
+    def __init__(self, height: int) -> None:
+        from PIL import ImageFont
+
+        self.pixels = max(8, round(height / 24))
+        self.margin = max(2, round(height / 60))
+        self.font: Any = ImageFont.load_default(size=self.pixels)
+
+    def stamp(self, color: np.ndarray, text: str) -> None:
+        from PIL import Image, ImageDraw
+
+        _left, top, right, bottom = self.font.getbbox(text)
+        pad = max(1, self.pixels // 4)
+        mask = Image.new("L", (right + 2 * pad, bottom - top + 2 * pad), 0)
+        ImageDraw.Draw(mask).text((pad, pad - top), text, fill=255, font=self.font)
+        alpha = np.asarray(mask, dtype=np.float32)[..., None] / 255.0
+        x, y = self.margin, self.margin
+        region = color[y : y + alpha.shape[0], x : x + alpha.shape[1]]
+        alpha = alpha[: region.shape[0], : region.shape[1]]
+        region *= 0.45
+        region += 0.55 * np.array([0.10, 0.12, 0.15], dtype=np.float32)
+        region += alpha * (1.0 - region)
