@@ -160,7 +160,11 @@ def export_command(
         )
     default = recording.with_name("obj" if to == "obj" else f"animation{suffixes[to]}")
     target = output or default
-    check_new_file(target, force)
+    if to == "obj" and target.is_dir():
+        if any(target.glob("*.obj")) and not force:
+            raise ModelError(f"{target} already holds OBJ files; pass --force to replace them")
+    else:
+        check_new_file(target, force)
     source = Recording.load(recording, run)
     if to in ("mp4", "gif"):
         from ..viz.video import render_video
