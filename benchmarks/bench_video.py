@@ -69,7 +69,7 @@ def main() -> None:
 
     camera = Camera.framing(drawn_bounds(geometry), aspect=size[0] / size[1])
     painter, _ = timed(
-        "set-up (sky, ground; first call compiles)", lambda: FramePainter(geometry, size, camera)
+        "set-up: kernels (cached), sky and ground", lambda: FramePainter(geometry, size, camera)
     )
     painter.paint(0, 0.0)
     _, seconds = timed(

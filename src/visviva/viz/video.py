@@ -368,9 +368,17 @@ class _GifWriter:
         # Octree keeps more shades for the small shaded spheres than median cut, which spends
         # the palette on the large ground; no dithering, so regions that do not change stay
         # identical from frame to frame (no shimmer, and Pillow stores only what changed).
-        self._palette = Image.fromarray(samples).quantize(
+        octree = Image.fromarray(samples).quantize(
             colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE
         )
+        # The octree often fills fewer than 256 entries and pads with black. Pillow's GIF
+        # writer matches a given palette entry by entry, quadratically slower on repeated
+        # entries, so the spare entries become distinct greys (useful for shadows).
+        entries = list(dict.fromkeys(map(tuple, np.reshape(octree.getpalette() or [], (-1, 3)))))
+        taken = set(entries)
+        entries += [(v, v, v) for v in range(256) if (v, v, v) not in taken]
+        self._palette = Image.new("P", (1, 1))
+        self._palette.putpalette(np.ravel(entries[:256]).astype(np.uint8).tobytes())
         self._fps = fps
         self._frames: list[np.ndarray] = []
 
