@@ -275,3 +275,15 @@ def test_a_failure_while_rendering_leaves_no_file(tmp_path, monkeypatch):
     with pytest.raises(RuntimeError, match="disk full"):
         render_video(falling_and_resting(), tmp_path / "drop.mp4", size=SIZE)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("suffix", ["mp4", "gif"])
+def test_a_still_and_an_empty_scene_render(tmp_path, suffix):
+    # One frame of one point without a radius (a scene of no size), and points of no count.
+    still = vv.Recording(np.array([0.0]), {"points": np.zeros((1, 1, 3))})
+    frames = read_frames(render_video(still, tmp_path / f"still.{suffix}", size=(64, 48)))
+    assert frames.shape == (1, 48, 64, 3)
+    assert sphere_mask(frames[0]).sum() > 50  # the default camera frames the lone sphere
+    empty = vv.Recording(np.arange(3) / 30.0, {"points": np.zeros((3, 0, 3))})
+    frames = read_frames(render_video(empty, tmp_path / f"empty.{suffix}", size=(64, 48)))
+    assert len(frames) == 3 and sphere_mask(frames[0]).sum() == 0

@@ -394,6 +394,7 @@ class _GifWriter:
         # Delays in hundredths of a second, rounded from integer frame counts so that the
         # sum never drifts: at 30 fps they run 3, 3, 4, 3, 3, 4, ...
         ticks = np.round(np.arange(len(self._frames) + 1) * 100.0 / self._fps)
+        delays = [int(10 * d) for d in np.diff(ticks)]  # Pillow takes milliseconds
         palette = self._palette.getpalette() or []
         iio.imwrite(
             path,
@@ -403,6 +404,7 @@ class _GifWriter:
             mode="L",
             is_batch=True,
             palette=bytes(palette[:768]),
-            duration=[int(10 * d) for d in np.diff(ticks)],
+            # Pillow's writer takes a list for an animation, a number for a still.
+            duration=delays if len(delays) > 1 else delays[0],
             loop=0,
         )
