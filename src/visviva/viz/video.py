@@ -104,8 +104,8 @@ class Camera:
         side = np.linalg.norm(np.cross(view, self.up))
         if not side > 1e-9 * np.linalg.norm(view) * np.linalg.norm(self.up):
             raise ModelError(
-                f"`up` {self.up} must not be parallel to the view direction "
-                f"{tuple(view.tolist())}: nothing would say which way is up"
+                f"`up` {self.up} must be non-zero and not parallel to the view direction "
+                f"{tuple(view.tolist())}: nothing would say which way is up; use (0, 1, 0)"
             )
 
     @classmethod
