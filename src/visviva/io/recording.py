@@ -54,6 +54,13 @@ __all__ = [
     "write_recordings",
 ]
 
+#: Default point radius, as a fraction of the scene's bounding-box diagonal.
+_RADIUS_FRACTION = 0.01
+#: With edges or faces, at most this fraction of the median edge length.
+_RADIUS_FRACTION_OF_EDGE = 0.1
+#: Radius [m] for a scene with no extent (one point that never moves).
+_RADIUS_OF_A_POINT_SCENE = 0.05
+
 FORMAT = "visviva.recording"
 FORMAT_VERSION = 1
 
@@ -78,6 +85,36 @@ class Geometry:
     def frames(self) -> int:
         """Number of frames."""
         return self.points.shape[0]
+
+    def default_radius(self) -> float:
+        """Radius [m] drawn for points when the recording gives none.
+
+        1 % of the diagonal of :meth:`bounds`; with edges or faces, where points are only the
+        vertices of the shape, at most a tenth of the median edge length in the first frame (so
+        neighbouring dots never touch); 0.05 m for a scene with no extent.
+        """
+        low, high = self.bounds()
+        diagonal = float(np.linalg.norm(high - low))
+        if not diagonal > 0.0:
+            return _RADIUS_OF_A_POINT_SCENE
+        radius = _RADIUS_FRACTION * diagonal
+        pairs = [] if self.edges is None else [self.edges]
+        if self.faces is not None:
+            pairs.extend(self.faces[:, [i, (i + 1) % 3]] for i in range(3))
+        if pairs and self.frames:
+            ends = self.points[0][np.concatenate(pairs)]
+            lengths = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
+            lengths = lengths[lengths > 0.0]
+            if lengths.size:
+                radius = min(radius, _RADIUS_FRACTION_OF_EDGE * float(np.median(lengths)))
+        return radius
+
+    def drawn_radius(self) -> np.ndarray:
+        """Radius [m] of each point as drawn, shape ``(P,)``: the recorded one, else
+        :meth:`default_radius` (the same in the video, the viewer and every export)."""
+        if self.radius is not None:
+            return np.asarray(self.radius, dtype=np.float64)
+        return np.full(self.points.shape[1], self.default_radius())
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper corners [m] of the box holding every point of every frame (radii

@@ -26,12 +26,11 @@ import numpy as np
 
 from ..io.recording import Geometry
 from . import ground, raster
-from .viewer._payload import default_radius
 
 if TYPE_CHECKING:
     from .video import Camera
 
-__all__ = ["FramePainter", "drawn_bounds", "drawn_radius"]
+__all__ = ["FramePainter", "drawn_bounds"]
 
 #: Direction towards the light (world frame, Y up): from above, a little from the left front.
 LIGHT = np.array([-0.3, 1.0, 0.35]) / np.linalg.norm([-0.3, 1.0, 0.35])
@@ -67,22 +66,11 @@ LINE_DEPTH_BIAS = 2e-3
 NEAR_FRACTION = 1e-3
 
 
-def drawn_radius(geometry: Geometry) -> np.ndarray:
-    """Radius [m] of each point as drawn: the recorded one, else the web viewer's default.
-
-    Returns:
-        Radii, shape ``(P,)``.
-    """
-    if geometry.radius is not None:
-        return np.asarray(geometry.radius, dtype=np.float64)
-    return np.full(geometry.points.shape[1], default_radius(geometry))
-
-
 def drawn_bounds(geometry: Geometry) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper corners [m] of every point of every frame as drawn (radii included)."""
     low, high = geometry.bounds()
     if geometry.radius is None:
-        pad = float(drawn_radius(geometry).max(initial=0.0))
+        pad = float(geometry.drawn_radius().max(initial=0.0))
         low, high = low - pad, high + pad
     return low, high
 
@@ -308,7 +296,7 @@ class FramePainter:
     def __init__(self, geometry: Geometry, size: tuple[int, int], camera: Camera) -> None:
         self.geometry = geometry
         self.width, self.height = size
-        radius = drawn_radius(geometry)
+        radius = geometry.drawn_radius()
         low, high = drawn_bounds(geometry)
         scene = max(float(np.linalg.norm(high - low)), 1e-9)
         stage = _Stage(camera, self.width, self.height, min(0.0, float(low[1])), scene)

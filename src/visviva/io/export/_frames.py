@@ -34,10 +34,6 @@ MAX_OUTPUT_FRAMES = 1_000_000
 #: Relative tolerance on frame spacing for a recording to count as evenly spaced, and on its
 #: rate for that rate to be rounded to a whole number of frames per second.
 _EVEN_SPACING_RTOL = 1e-6
-#: Point radius, as a fraction of the scene's bounding-box diagonal, when a recording gives none.
-_RADIUS_FRACTION = 0.01
-#: Radius [m] for a scene with no extent (points that never move apart).
-_RADIUS_OF_A_POINT_SCENE = 0.05
 
 
 def _output_count(time: np.ndarray, fps: float) -> int:
@@ -139,16 +135,8 @@ class ExportFrames:
         return np.arange(self.count) / self.fps
 
     def radius(self) -> np.ndarray:
-        """Point radii [m], shape ``(P,)``: the recording's, else 1 % of the scene's diagonal."""
-        if self.geometry.radius is not None:
-            return np.asarray(self.geometry.radius, dtype=np.float64)
-        return np.full(self.point_count, self.default_radius())
-
-    def default_radius(self) -> float:
-        """Radius [m] drawn for points without one: 1 % of the scene's bounding-box diagonal."""
-        low, high = self.geometry.bounds()
-        diagonal = float(np.linalg.norm(high - low))
-        return _RADIUS_FRACTION * diagonal if diagonal > 0.0 else _RADIUS_OF_A_POINT_SCENE
+        """Point radii [m], shape ``(P,)``: as drawn everywhere (:meth:`Geometry.drawn_radius`)."""
+        return self.geometry.drawn_radius()
 
     def loose_points(self, *, faces: bool = True, edges: bool = False) -> np.ndarray:
         """Indices of the points used by no face (and, if ``edges``, by no edge), int64.

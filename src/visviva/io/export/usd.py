@@ -101,7 +101,7 @@ def _add_edges(stage: Any, frames: ExportFrames, edges: np.ndarray) -> Callable[
     prim.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(counts))
     radius = frames.radius()
     thinnest = float(radius[radius > 0.0].min()) if (radius > 0.0).any() else None
-    width = _EDGE_WIDTH_FRACTION * 2.0 * (thinnest or frames.default_radius())
+    width = _EDGE_WIDTH_FRACTION * 2.0 * (thinnest or frames.geometry.default_radius())
     prim.CreateWidthsAttr(Vt.FloatArray([width]))
     prim.SetWidthsInterpolation(UsdGeom.Tokens.constant)
     return _animate(prim, frames, edges.ravel(), width / 2.0)

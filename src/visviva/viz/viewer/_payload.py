@@ -21,18 +21,11 @@ import numpy as np
 
 from ...io.recording import Geometry
 
-__all__ = ["PAYLOAD_FORMAT", "PAYLOAD_VERSION", "default_radius", "encode_payload", "to_json"]
+__all__ = ["PAYLOAD_FORMAT", "PAYLOAD_VERSION", "encode_payload", "to_json"]
 
 PAYLOAD_FORMAT = "visviva.viewer"
 PAYLOAD_VERSION = 1
 
-#: Point radius, as a fraction of the scene's bounding-box diagonal, when a recording gives none.
-_RADIUS_FRACTION = 0.01
-#: With edges or faces, points are only their vertices: at most this fraction of the median
-#: edge length (frame 0), so that neighbouring dots never touch.
-_RADIUS_FRACTION_OF_EDGE = 0.1
-#: Radius [m] for a scene with no extent (one point that never moves).
-_RADIUS_OF_A_POINT_SCENE = 0.05
 
 #: Recording attributes shown in the viewer's legend, with their labels and units.
 _LEGEND_ATTRIBUTES = (("method", "method", ""), ("dt", "dt", " s"), ("substeps", "substeps", ""))
@@ -43,35 +36,10 @@ def _base64(array: np.ndarray, dtype: str) -> str:
     return base64.b64encode(np.ascontiguousarray(array, dtype=dtype).tobytes()).decode("ascii")
 
 
-def default_radius(geometry: Geometry) -> float:
-    """Radius [m] drawn for points of a recording without ``static["radius"]``.
-
-    1 % of the diagonal of :meth:`Geometry.bounds`; with edges or faces, where points are only
-    the vertices of the shape, at most a tenth of the median edge length in the first frame.
-    """
-    low, high = geometry.bounds()
-    diagonal = float(np.linalg.norm(high - low))
-    if not diagonal > 0.0:
-        return _RADIUS_OF_A_POINT_SCENE
-    radius = _RADIUS_FRACTION * diagonal
-    pairs = []
-    if geometry.edges is not None:
-        pairs.append(geometry.edges)
-    if geometry.faces is not None:
-        pairs.extend(geometry.faces[:, [i, (i + 1) % 3]] for i in range(3))
-    if pairs and geometry.frames:
-        ends = geometry.points[0][np.concatenate(pairs)]
-        lengths = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
-        lengths = lengths[lengths > 0.0]
-        if lengths.size:
-            radius = min(radius, _RADIUS_FRACTION_OF_EDGE * float(np.median(lengths)))
-    return radius
-
-
 def _points_layer(geometry: Geometry, shown: np.ndarray) -> dict[str, Any]:
     count = geometry.points.shape[1]
     if geometry.radius is None:
-        radius = np.full(count, default_radius(geometry))
+        radius = np.full(count, geometry.default_radius())
     else:
         radius = geometry.radius
     return {
