@@ -80,7 +80,6 @@ def main() -> None:
 
         print("(b) exports")
         from visviva.io.export import export_recording
-
         from visviva.viz.viewer import write_viewer
 
         targets = {
