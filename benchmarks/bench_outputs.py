@@ -19,12 +19,14 @@ import os
 import platform
 import tempfile
 import time
+import warnings
 from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 
 import visviva as vv
+from visviva.io.timeline import frames_at_rate
 
 
 def timed(label: str, call):
@@ -78,18 +80,29 @@ def main() -> None:
         timed("h5py, the same arrays in one call (floor)", floor)
         print(f"  recording.h5: {size(out / 'recording.h5')}")
 
-        print("(b) exports")
+        print("(b) exports (USD and glb: every recorded frame; the viewer: its default rate)")
         from visviva.io.export import export_recording
-        from visviva.viz.viewer import write_viewer
+        from visviva.viz.viewer import default_fps, write_viewer
 
+        every_frame = 1.0 / (4 * dt)  # the recorded rate [frames/s]
         targets = {
             "USD (usdc)": Path(tmp) / "scene.usdc",
             "glb": Path(tmp) / "scene.glb",
         }
         for label, path in targets.items():
-            timed(label, lambda path=path: export_recording(recording, path, fps=30.0))
+            timed(
+                f"{label}, {frames} frames",
+                lambda path=path: export_recording(recording, path, fps=every_frame),
+            )
         html = Path(tmp) / "viewer.html"
-        timed("HTML viewer", lambda: write_viewer(recording, html, fps=30.0))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the viewer says it lowered its rate to fit
+            fps = default_fps(recording)
+        shown = frames_at_rate(recording.time, fps).size
+        timed(
+            f"HTML viewer, {shown} frames at {fps:.3g} fps",
+            lambda: write_viewer(recording, html, fps=fps),
+        )
         print("(c) sizes")
         for label, path in [*targets.items(), ("HTML viewer", html)]:
             print(f"  {label:46s} {size(path):>10s}")
