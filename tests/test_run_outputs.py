@@ -16,17 +16,24 @@ from pathlib import Path
 import imageio.v3 as iio
 import numpy as np
 import pytest
-from test_export import FLOAT32_RTOL, gltf_frames, read_obj, read_pc2, usd_points
 from typer.testing import CliRunner
 
 import visviva as vv
+from test_export import FLOAT32_RTOL, gltf_frames, read_obj, read_pc2, usd_points
 from visviva.cli.main import app, main
 from visviva.io.timeline import frames_at_rate
 
 FPS = 20.0
 FORMATS = ("mp4", "gif", "html", "usd", "glb", "obj", "pc2")
-OUTPUTS = ("animation.mp4", "animation.gif", "viewer.html", "scene.usdc", "scene.glb", "obj",
-           "points.pc2")
+OUTPUTS = (
+    "animation.mp4",
+    "animation.gif",
+    "viewer.html",
+    "scene.usdc",
+    "scene.glb",
+    "obj",
+    "points.pc2",
+)
 
 
 @pytest.fixture(scope="module")
@@ -36,8 +43,14 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, vv.Recording]:
     builder.set_integration(method="symplectic_euler", dt=0.005, duration=0.5, record_every=2)
     builder.set_output(fps=FPS)
     builder.add_particle_cloud(
-        name="cloud", count=40, center=(0.0, 1.0, 0.0), size=(0.4, 0.4, 0.4),
-        velocity=(0.5, 3.0, 0.0), velocity_jitter=0.5, radius=0.03, seed=3,
+        name="cloud",
+        count=40,
+        center=(0.0, 1.0, 0.0),
+        size=(0.4, 0.4, 0.4),
+        velocity=(0.5, 3.0, 0.0),
+        velocity_jitter=0.5,
+        radius=0.03,
+        seed=3,
     )
     folder = tmp_path_factory.mktemp("run")
     scene = folder / "scene.toml"
