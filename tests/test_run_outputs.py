@@ -134,3 +134,36 @@ def test_an_existing_output_needs_force(run, monkeypatch, capsys):
         main()
     assert exit_.value.code == 2 and "--force" in capsys.readouterr().err
     assert {p.name: p.stat().st_mtime_ns for p in out.iterdir()} == before
+
+
+def run_main(monkeypatch, capsys, *arguments: str | Path) -> tuple[int, str]:
+    """``visviva ARGUMENTS`` through the entry point; the exit status and stdout + stderr."""
+    monkeypatch.setattr(sys, "argv", ["visviva", *map(str, arguments)])
+    try:
+        main()
+        status = 0
+    except SystemExit as exit_:
+        status = 0 if exit_.code is None else int(exit_.code)
+    captured = capsys.readouterr()
+    return status, captured.out + captured.err
+
+
+def test_export_command_writes_the_run_names_next_to_the_recording(
+    run, tmp_path, monkeypatch, capsys
+):
+    out, recording = run
+    source = tmp_path / "recording.h5"
+    source.write_bytes((out / "recording.h5").read_bytes())
+    for to in ("usd", "glb", "obj", "pc2", "gif"):
+        status, output = run_main(monkeypatch, capsys, "export", source, "--to", to)
+        assert status == 0, output
+    names = {"scene.usdc", "scene.glb", "obj", "points.pc2", "animation.gif"}
+    assert {p.name for p in tmp_path.iterdir()} == names | {"recording.h5"}
+    # Without --fps the exports keep every recorded frame (an even 100 frames/s here).
+    _, pc2 = read_pc2(tmp_path / "points.pc2")
+    tolerance = FLOAT32_RTOL * float(np.abs(recording["points"]).max())
+    np.testing.assert_allclose(pc2, recording["points"], rtol=0, atol=tolerance)
+    status, output = run_main(monkeypatch, capsys, "export", source, "--to", "pc2")
+    assert status == 2 and "--force" in output
+    status, output = run_main(monkeypatch, capsys, "export", source, "--to", "usdz")
+    assert status == 2 and "'usdz'" in output and "usd" in output

@@ -24,7 +24,7 @@ from .errors import ModelError, SceneError, SceneProblem, SimulationError
 from .model import Model
 from .model.build import build_model
 
-__all__ = ["DryRun", "dry_run", "load_model", "run_scene"]
+__all__ = ["OUTPUT_FILES", "DryRun", "dry_run", "load_model", "run_scene"]
 
 
 def load_model(path: str | os.PathLike[str]) -> Model:
@@ -209,8 +209,9 @@ def _duration(model: Model, duration: float | None) -> float:
     return seconds
 
 
-#: Output format → file name in the output directory.
-_OUTPUT_FILES = {
+#: Output format → its file (or, for OBJ, folder) name in a run's output directory; `visviva
+#: export` uses the same names next to the recording.
+OUTPUT_FILES = {
     "mp4": "animation.mp4",
     "gif": "animation.gif",
     "html": "viewer.html",
@@ -226,17 +227,17 @@ def _planned(model: Model, formats: Iterable[str]) -> list[str]:
 
     chosen = list(dict.fromkeys([*model.output_formats, *formats]))
     for name in chosen:
-        if name not in _OUTPUT_FILES:
+        if name not in OUTPUT_FILES:
             raise ModelError(
-                f"unknown output format {name!r}.{did_you_mean(name, _OUTPUT_FILES)} "
-                f"Valid: {', '.join(_OUTPUT_FILES)}"
+                f"unknown output format {name!r}.{did_you_mean(name, OUTPUT_FILES)} "
+                f"Valid: {', '.join(OUTPUT_FILES)}"
             )
     if chosen and not model.has_geometry:
         raise ModelError(
             f"the {model.system.system if model.system else ''} system has no picture, so it "
             f"cannot be written as {', '.join(chosen)}; drop the output formats"
         )
-    return ["recording.h5", "summary.json", *(_OUTPUT_FILES[name] for name in chosen)]
+    return ["recording.h5", "summary.json", *(OUTPUT_FILES[name] for name in chosen)]
 
 
 def _frame(model: Model, parts: tuple[Any, ...]) -> dict[str, Any]:

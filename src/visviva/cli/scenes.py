@@ -145,20 +145,14 @@ def export_command(
     from ..errors import ModelError
     from ..io.recording import Recording
 
-    suffixes = {
-        "usd": ".usdc",
-        "glb": ".glb",
-        "obj": "",
-        "pc2": ".pc2",
-        "mp4": ".mp4",
-        "gif": ".gif",
-    }
-    if to not in suffixes:
+    from ..scenes import OUTPUT_FILES
+
+    formats = ("usd", "glb", "obj", "pc2", "mp4", "gif")
+    if to not in formats:
         raise ModelError(
-            f"unknown export format {to!r}.{did_you_mean(to, suffixes)} "
-            f"Valid: {', '.join(suffixes)}"
+            f"unknown export format {to!r}.{did_you_mean(to, formats)} Valid: {', '.join(formats)}"
         )
-    default = recording.with_name("obj" if to == "obj" else f"animation{suffixes[to]}")
+    default = recording.with_name(OUTPUT_FILES[to])
     target = output or default
     if to == "obj" and target.is_dir():
         if any(target.glob("*.obj")) and not force:
