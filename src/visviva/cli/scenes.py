@@ -144,7 +144,6 @@ def export_command(
     from .._validation import did_you_mean
     from ..errors import ModelError
     from ..io.recording import Recording
-
     from ..scenes import OUTPUT_FILES
 
     formats = ("usd", "glb", "obj", "pc2", "mp4", "gif")
