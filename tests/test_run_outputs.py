@@ -167,3 +167,33 @@ def test_export_command_writes_the_run_names_next_to_the_recording(
     assert status == 2 and "--force" in output
     status, output = run_main(monkeypatch, capsys, "export", source, "--to", "usdz")
     assert status == 2 and "'usdz'" in output and "usd" in output
+
+
+def test_export_video_size(run, tmp_path, monkeypatch, capsys):
+    out, _ = run
+    gif = tmp_path / "small.gif"
+    status, output = run_main(
+        monkeypatch,
+        capsys,
+        "export",
+        out / "recording.h5",
+        "--to",
+        "gif",
+        "--size",
+        "160x90",
+        "-o",
+        gif,
+    )
+    assert status == 0, output
+    assert iio.imread(gif, index=0).shape == (90, 160, 3)
+    refused = {
+        ("gif", "160y90"): "WIDTHxHEIGHT",
+        ("mp4", "161x90"): "even",
+        ("usd", "160x90"): "does not apply",
+    }
+    for (to, size), message in refused.items():
+        target = tmp_path / f"refused.{to}"
+        arguments = ("export", out / "recording.h5", "--to", to, "--size", size, "-o", target)
+        status, output = run_main(monkeypatch, capsys, *arguments)
+        assert status == 2 and message in output and size.partition("x")[0] in output
+        assert not target.exists()

@@ -137,6 +137,10 @@ def export_command(
         Path | None, typer.Option("--output", "-o", help="Output file (default: next to it).")
     ] = None,
     fps: FpsOption = None,
+    size: Annotated[
+        str | None,
+        typer.Option("--size", help="Video size WIDTHxHEIGHT in pixels (mp4, gif), e.g. 1280x720."),
+    ] = None,
     run: RunOption = None,
     force: ForceOption = False,
 ) -> None:
@@ -151,6 +155,10 @@ def export_command(
         raise ModelError(
             f"unknown export format {to!r}.{did_you_mean(to, formats)} Valid: {', '.join(formats)}"
         )
+    video = to in ("mp4", "gif")
+    if size is not None and not video:
+        raise ModelError(f"--size {size} sets a video's size; it does not apply to --to {to}")
+    pixels = _video_size(size) if size is not None else (960, 540)
     default = recording.with_name(OUTPUT_FILES[to])
     target = output or default
     if to == "obj" and target.is_dir():
@@ -159,13 +167,23 @@ def export_command(
     else:
         check_new_file(target, force)
     source = Recording.load(recording, run)
-    if to in ("mp4", "gif"):
+    if video:
         from ..viz.video import render_video
 
-        written = [render_video(source, target, fps=fps or 30.0)]
+        written = [render_video(source, target, fps=fps or 30.0, size=pixels)]
     else:
         from ..io.export import export_recording
 
         written = export_recording(source, target, to=to, fps=fps)
     for path in written:
         typer.echo(f"wrote {path}")
+
+
+def _video_size(text: str) -> tuple[int, int]:
+    """``"1280x720"`` → ``(1280, 720)``; the renderer checks the range and evenness."""
+    from ..errors import ModelError
+
+    width, _, height = text.lower().partition("x")
+    if not (width.isdigit() and height.isdigit()):
+        raise ModelError(f"--size must be WIDTHxHEIGHT in pixels, such as 1280x720 (got {text!r})")
+    return int(width), int(height)
