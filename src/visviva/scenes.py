@@ -129,7 +129,7 @@ def run_scene(
         ModelError: Bad arguments or existing outputs, before anything runs.
         SimulationError: If the run failed; its recording and summary were written first.
     """
-    from .demos.output import JobOutput
+    from .io.job import JobOutput
     from .io.writer import RecordingWriter
     from .simulation.loop import simulate
 
@@ -173,7 +173,7 @@ def run_scene(
         recording = _as_scene_recording(model, recording)
         series = {"energy": recording["energy"]} if "energy" in recording else {}
         writer.finish(recording.attrs | {"scene": model.source or ""}, series)
-    from .demos.output import run_summary
+    from .io.job import run_summary
 
     summary = {
         "scene": model.name,

@@ -22,9 +22,9 @@ ForceOption = Annotated[bool, typer.Option("--force", help="Replace existing out
 
 def print_json(data: Any) -> None:
     """Print ``data`` as indented JSON (NumPy values unwrapped)."""
-    from ..demos.output import _plain
+    from ..io.job import plain_json
 
-    typer.echo(json.dumps(_plain(data), indent=2, allow_nan=False))
+    typer.echo(json.dumps(plain_json(data), indent=2, allow_nan=False))
 
 
 def check_new_file(path: Path, force: bool) -> None:

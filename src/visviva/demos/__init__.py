@@ -17,7 +17,7 @@ from typing import Any
 
 from .._validation import did_you_mean, real_number
 from ..errors import ModelError
-from .output import JobOutput, run_summary
+from ..io.job import JobOutput, run_summary
 
 __all__ = ["Demo", "demos", "register_demo", "run_demo"]
 

@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 
+from ..io.job import JobOutput
 from ..ode.problems import SecondOrderProblem
 from ..simulation.solve import solve
 from . import Demo, register_demo
-from .output import JobOutput
 
 RADIUS = 1.0  # r0 [m]
 DT = 0.1  # step [s]

@@ -14,11 +14,11 @@ from typing import Any
 import numpy as np
 
 from ..analysis.stability import stability_function
+from ..io.job import JobOutput
 from ..ode.problems import FirstOrderProblem
 from ..simulation.solve import solve
 from ..viz.plots import plot_stability_regions
 from . import Demo, register_demo
-from .output import JobOutput
 
 LAMBDA = -1.0  # eigenvalue λ [1/s]
 STEPS = (0.5, 1.5, 1.9, 2.5, 3.0)  # h [s]

@@ -13,11 +13,11 @@ from typing import Any
 import numpy as np
 
 from ..integrators import get, names
+from ..io.job import JobOutput
 from ..ode.problems import SecondOrderProblem
 from ..simulation.solve import solve
 from ..viz.plots import plot_energy, plot_phase
 from . import Demo, register_demo
-from .output import JobOutput
 
 OMEGA = 2.0 * np.pi  # angular frequency [rad/s]: one oscillation per second
 DT = 0.02  # step [s]: ωh ≈ 0.126

@@ -18,14 +18,14 @@ from typing import TYPE_CHECKING, Any
 
 from ..analysis.invariants import energy_drift, max_energy_error
 from ..errors import ModelError
-from ..io.recording import write_recordings
+from .recording import write_recordings
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from ..io.recording import Recording
+    from .recording import Recording
 
-__all__ = ["JobOutput", "run_summary"]
+__all__ = ["JobOutput", "plain_json", "run_summary"]
 
 
 def run_summary(recording: Recording) -> dict[str, Any]:
@@ -123,7 +123,7 @@ class JobOutput:
             for name, figure in self.figures.items():
                 figure.savefig(staging / f"{name}.png", dpi=110)
             full = dict(summary) | {"outputs": self.planned()}
-            text = json.dumps(_plain(full), indent=2, allow_nan=False)
+            text = json.dumps(plain_json(full), indent=2, allow_nan=False)
             (staging / "summary.json").write_text(text + "\n")
             written = []
             for name in self.planned():
@@ -135,16 +135,16 @@ class JobOutput:
             self.discard()
 
 
-def _plain(value: Any) -> Any:
+def plain_json(value: Any) -> Any:
     """``value`` as plain JSON: NumPy scalars unwrapped, non-finite floats as strings."""
     import math
 
     import numpy as np
 
     if isinstance(value, Mapping):
-        return {str(k): _plain(v) for k, v in value.items()}
+        return {str(k): plain_json(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
+        return [plain_json(v) for v in value]
     if isinstance(value, np.generic):
         value = value.item()
     if isinstance(value, float) and not math.isfinite(value):
