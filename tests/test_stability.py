@@ -178,13 +178,20 @@ def _chain_stiffness(n, k=1.0):
 
 def test_max_stable_dt_of_a_large_sparse_system():
     """A 3000-mass chain (6000 × 6000 sparse Jacobian) uses the Arnoldi solver for the extreme
-    eigenvalues (to ~1e-4): Verlet's limit is 2/ω_max with ω_max = 2 sin(nπ/(2(n+1)))."""
+    eigenvalues: Verlet's limit is 2/ω_max with ω_max = 2 sin(nπ/(2(n+1))).
+
+    ARPACK stops at a residual ‖Jx − θx‖ ≤ tol·|θ|; for this non-symmetric J (eigenvectors
+    (x, iωx), condition ~ max(ω, 1/ω) ≈ 2 at ω_max) the eigenvalue is then within ~2·tol, so
+    the bound asserted is 3·tol. The start vector is fixed, so the result is also reproducible.
+    """
     n = 3000
     stiffness = _chain_stiffness(n)
     jacobian = sp.bmat([[None, sp.identity(n)], [stiffness, None]], format="csr")
     omega_max = 2.0 * math.sin(n * math.pi / (2 * (n + 1)))
     dt = vv.analysis.max_stable_dt("velocity_verlet", jacobian=jacobian)
-    assert dt == pytest.approx(2.0 / omega_max, rel=1e-4)
+    tolerance = 3.0 * vv.analysis.stability.SPARSE_EIGEN_TOLERANCE
+    assert dt == pytest.approx(2.0 / omega_max, rel=tolerance)
+    assert vv.analysis.max_stable_dt("velocity_verlet", jacobian=jacobian) == dt
 
 
 def test_state_jacobian_of_a_second_order_problem_with_mass():
