@@ -30,7 +30,7 @@ from .errors import (
 )
 
 if TYPE_CHECKING:
-    from . import analysis, demos, forces, integrators, io, model, ode, simulation, viz
+    from . import analysis, demos, forces, integrators, io, mechanics, model, ode, simulation, viz
     from .io import Recording
     from .model import Model, SceneBuilder
     from .scenes import load_model, run_scene
@@ -54,6 +54,7 @@ __all__ = [
     "integrators",
     "io",
     "load_model",
+    "mechanics",
     "model",
     "ode",
     "run_scene",
@@ -69,6 +70,7 @@ _SUBPACKAGES = {
     "forces",
     "integrators",
     "io",
+    "mechanics",
     "model",
     "ode",
     "simulation",
