@@ -13,6 +13,10 @@ Three pieces, each a closure compiled once per (method, user function, size) and
   the method's NumPy step;
 * the *runner*: the loop over systems (in parallel) and steps, with time computed from the
   integer step counter, frame recording and the divergence watch.
+
+Arrays are copied element by element, never with slice stores (``out[:] = x``): Numba takes
+seconds to compile a slice store in each new closure, against milliseconds for a loop, and these
+closures are compiled afresh for every user function (first run of an RK4 problem: 6 s → 1 s).
 """
 
 from __future__ import annotations
@@ -100,7 +104,9 @@ def acceleration_adapter(problem: Problem) -> Callable[..., None] | None:
 
             @numba.njit
             def raw(t, q, v, out):  # pragma: no cover - compiled
-                out[:] = func(t, q, v)
+                result = func(t, q, v)
+                for k in range(n):
+                    out[k] = result[k]
         elif writes_out:
 
             @numba.njit
@@ -110,7 +116,9 @@ def acceleration_adapter(problem: Problem) -> Callable[..., None] | None:
 
             @numba.njit
             def raw(t, q, v, out):  # pragma: no cover - compiled
-                out[:] = func(t, q)
+                result = func(t, q)
+                for k in range(n):
+                    out[k] = result[k]
 
         if not has_mass:
             return raw
@@ -144,9 +152,13 @@ def derivative_adapter(problem: Problem) -> Callable[..., None] | None:
             if key[2]:
                 return func
 
+            size = problem.size
+
             @numba.njit
             def first(t, y, out):  # pragma: no cover - compiled
-                out[:] = func(t, y)
+                result = func(t, y)
+                for k in range(size):
+                    out[k] = result[k]
 
             return first
 
@@ -155,7 +167,8 @@ def derivative_adapter(problem: Problem) -> Callable[..., None] | None:
 
         @numba.njit
         def second(t, y, out):  # pragma: no cover - compiled
-            out[:n] = y[n:]
+            for k in range(n):
+                out[k] = y[n + k]
             accel(t, y[:n], y[n:], out[n:])
 
         return second
@@ -255,10 +268,15 @@ def make_runner(step: CompiledStep, systems: int) -> Callable[..., None]:
                         status[i] = k
                         break
                     if (s + 1) % record_every == 0:
-                        frames[(s + 1) // record_every - 1, i, :] = state
+                        frame = (s + 1) // record_every - 1
+                        for j in range(m):
+                            frames[frame, i, j] = state[j]
                 evaluations[i] += evaluated
-                y[i, :] = state
-                work[i, :, :] = scratch
+                for j in range(m):
+                    y[i, j] = state[j]
+                for r in range(scratch.shape[0]):
+                    for j in range(m):
+                        work[i, r, j] = scratch[r, j]
 
         return run
 
