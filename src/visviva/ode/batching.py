@@ -4,7 +4,8 @@ A Numba function written for one system (``y`` of shape ``(n,)``) is wrapped her
 parallel loop over the leading batch axis, so the rest of visviva can treat it exactly like a
 NumPy function that takes the whole batch. The loops are closures over the user's function, so
 they compile once per function per process (Numba cannot cache a function that calls a
-dispatcher it receives at run time).
+dispatcher it receives at run time). Results are stored element by element: a slice store
+costs Numba seconds of compilation in every closure that contains one.
 """
 
 from __future__ import annotations
@@ -62,7 +63,9 @@ def batched(function: UserFunction, result: str) -> Callable[..., Any]:
             @numba.njit(parallel=True)
             def loop_ret2(t, a, b, out):  # pragma: no cover - compiled
                 for i in numba.prange(a.shape[0]):
-                    out[i, :] = func(t, a[i], b[i])
+                    result = func(t, a[i], b[i])
+                    for k in range(a.shape[1]):
+                        out[i, k] = result[k]
 
             kernel = loop_ret2
         else:
@@ -70,7 +73,9 @@ def batched(function: UserFunction, result: str) -> Callable[..., Any]:
             @numba.njit(parallel=True)
             def loop_ret1(t, a, out):  # pragma: no cover - compiled
                 for i in numba.prange(a.shape[0]):
-                    out[i, :] = func(t, a[i])
+                    result = func(t, a[i])
+                    for k in range(a.shape[1]):
+                        out[i, k] = result[k]
 
             kernel = loop_ret1
 
@@ -86,7 +91,10 @@ def batched(function: UserFunction, result: str) -> Callable[..., Any]:
         @numba.njit(parallel=True)
         def loop_matrix(t, a, out):  # pragma: no cover - compiled
             for i in numba.prange(a.shape[0]):
-                out[i, :, :] = func(t, a[i])
+                matrix = func(t, a[i])
+                for r in range(a.shape[1]):
+                    for c in range(a.shape[1]):
+                        out[i, r, c] = matrix[r, c]
 
         def call_matrix(t: float, a: np.ndarray) -> np.ndarray:
             out = np.empty(a.shape + a.shape[-1:], dtype=a.dtype)
@@ -101,8 +109,10 @@ def batched(function: UserFunction, result: str) -> Callable[..., Any]:
         def loop_pair(t, a, b, out_q, out_v):  # pragma: no cover - compiled
             for i in numba.prange(a.shape[0]):
                 jq, jv = func(t, a[i], b[i])
-                out_q[i, :, :] = jq
-                out_v[i, :, :] = jv
+                for r in range(a.shape[1]):
+                    for c in range(a.shape[1]):
+                        out_q[i, r, c] = jq[r, c]
+                        out_v[i, r, c] = jv[r, c]
 
         def call_pair(t: float, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             out_q = np.empty(a.shape + a.shape[-1:], dtype=a.dtype)
