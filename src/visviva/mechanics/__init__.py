@@ -2,4 +2,6 @@
 
 from __future__ import annotations
 
-__all__: list[str] = []
+from .lagrangian import LagrangianSystem
+
+__all__: list[str] = ["LagrangianSystem"]
