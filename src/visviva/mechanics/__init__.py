@@ -2,6 +2,26 @@
 
 from __future__ import annotations
 
+from . import classic
+from .classic import (
+    constrained_pendulum,
+    damped_oscillator,
+    double_pendulum,
+    pendulum,
+    pendulum_period,
+    rock,
+    spring_pendulum,
+)
 from .lagrangian import LagrangianSystem
 
-__all__: list[str] = ["LagrangianSystem"]
+__all__: list[str] = [
+    "LagrangianSystem",
+    "classic",
+    "constrained_pendulum",
+    "damped_oscillator",
+    "double_pendulum",
+    "pendulum",
+    "pendulum_period",
+    "rock",
+    "spring_pendulum",
+]

@@ -12,7 +12,7 @@ velocity derivatives), ``b_i`` the momentum offset ``p = M q̇ + b``, ``g_i = �
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
@@ -87,13 +87,20 @@ class EquationsCode:
         derived: The equations.
         constants: Parameter symbol → value, written into the source as literals.
         flavour: ``"numba"`` or ``"numpy"``.
+        points: Positions ``(x, y, z)`` of the drawn points as expressions of ``q`` and ``t``.
     """
 
     def __init__(
-        self, derived: Derived, constants: Mapping[sympy.Symbol, float], flavour: str
+        self,
+        derived: Derived,
+        constants: Mapping[sympy.Symbol, float],
+        flavour: str,
+        *,
+        points: Sequence[Sequence[sympy.Expr]] = (),
     ) -> None:
         self.derived, self.constants, self.flavour = derived, constants, flavour
         self.n = derived.size
+        self._points = points
 
     def _writer(self, name: str, arguments: tuple[str, ...]) -> SourceWriter:
         return SourceWriter(name, arguments, flavour=self.flavour, constants=self.constants)
@@ -207,6 +214,18 @@ class EquationsCode:
         named = _vector(self.derived.momentum, "p")
         w.assign(named)
         w.write("out", {(i,): n or "0.0" for i, n in enumerate(self._names("p", named))})
+        return w.compile()
+
+    @cached_property
+    def points(self) -> Callable[..., Any]:
+        """``points(t, q, out)``: the drawn points' positions into ``out[..., P, 3]``."""
+        w = self._writer("points", ("q", "out"))
+        self._read_state(w, velocities=False)
+        named = {
+            f"x_{i}_{c}": e for i, point in enumerate(self._points) for c, e in enumerate(point)
+        }
+        w.assign(named)
+        w.write("out", {(i, c): f"x_{i}_{c}" for i in range(len(self._points)) for c in range(3)})
         return w.compile()
 
     # --- (q, p) form -----------------------------------------------------------------------

@@ -53,6 +53,10 @@ class LagrangianSystem:
             per coordinate, in the units of ``∂L/∂q_i``.
         time: The time symbol, if ``K``, ``U`` or ``forces`` depend on time explicitly and
             the coordinates are plain symbols (with functions of time it is their argument).
+        points: Where the bodies are, for pictures: ``(x, y)`` or ``(x, y, z)`` [m] per point,
+            as expressions of the coordinates (and parameters, time), world Y up. Recordings
+            of the system then carry ``points`` and the video, viewer and exporters draw them.
+        edges: Pairs of point indices drawn as lines (rods, springs).
         name: Short description for messages and recordings.
 
     Example:
@@ -80,6 +84,8 @@ class LagrangianSystem:
         parameters: Mapping[Any, float] | None = None,
         forces: Sequence[Any] | None = None,
         time: Any = None,
+        points: Sequence[Sequence[Any]] | None = None,
+        edges: Sequence[tuple[int, int]] = (),
         name: str = "Lagrangian system",
     ) -> None:
         self.name = str(name)
@@ -128,6 +134,8 @@ class LagrangianSystem:
                 )
         #: The acceleration depends on the velocities (``acceleration(t, q, v)``).
         self.velocity_dependent = self._derived.velocity_dependent
+        self._points = self._read_points(points or ())
+        self.edges = _read_edges(edges, len(self._points))
         self._compiled: dict[str, EquationsCode] = {}
 
     # --- symbols --------------------------------------------------------------------------
@@ -168,6 +176,29 @@ class LagrangianSystem:
         if not internal.is_finite and internal.is_number:
             raise ModelError(f"`{what}` is not finite (got {expression})")
         return internal
+
+    def _read_points(self, points: Sequence[Sequence[Any]]) -> list[list[sympy.Expr]]:
+        """Each point as three internal expressions of ``q``, ``t`` and the parameters."""
+        read = []
+        allowed = {self._t, *self._q, *self._constants}
+        for i, point in enumerate(points):
+            if isinstance(point, (str, bytes)) or len(point) not in (2, 3):
+                raise ModelError(
+                    f"`points[{i}]` must be (x, y) or (x, y, z) (got {describe(point)})"
+                )
+            xyz = [self._internal(f"points[{i}][{c}]", e) for c, e in enumerate(point)]
+            xyz += [sympy.Integer(0)] * (3 - len(xyz))
+            stray = set().union(*(e.free_symbols for e in xyz)) - allowed
+            if stray:
+                names = sorted(
+                    str(self._shown_velocity(s)) if s in self._v else str(s) for s in stray
+                )
+                raise ModelError(
+                    f"`points[{i}]` uses {', '.join(names)}: a point's position may depend on "
+                    "the coordinates, the time and the parameters only"
+                )
+            read.append(xyz)
+        return read
 
     def _shown_expression(self, expression: sympy.Expr) -> sympy.Expr:
         """An internal expression written back in the user's coordinates and parameters."""
@@ -254,6 +285,17 @@ class LagrangianSystem:
         q, p = self._state("q", q), self._state("p", p)
         out = np.empty(np.broadcast_shapes(q.shape, p.shape))
         self._code("numpy").velocities(t, q, p, out)
+        return out
+
+    def points(self, q: Any, t: Any = 0.0) -> np.ndarray:
+        """The positions of the system's ``points`` [m]: shape ``(frames, P, 3)`` for ``q`` of
+        shape ``(frames, n)`` (or ``(P, 3)`` for one state); ``t`` [s] per frame or one value.
+        """
+        q = self._state("q", q)
+        if not self._points:
+            raise ModelError(f"{self.name} was built without `points`: nothing to draw")
+        out = np.empty(q.shape[:-1] + (len(self._points), 3))
+        self._code("numpy").points(np.asarray(t, dtype=float), q, out)
         return out
 
     def _state(self, name: str, value: Any) -> np.ndarray:
@@ -377,7 +419,9 @@ class LagrangianSystem:
                 f"Valid: {', '.join(FLAVOURS)}"
             )
         if flavour not in self._compiled:
-            self._compiled[flavour] = EquationsCode(self._derived, self._constants, flavour)
+            self._compiled[flavour] = EquationsCode(
+                self._derived, self._constants, flavour, points=self._points
+            )
         return self._compiled[flavour]
 
 
@@ -465,6 +509,21 @@ def _internal_substitution(
                 f"the time (got {describe(w)})"
             )
     return [dict(zip(coordinates, q, strict=True)) | dict(zip(velocities, v, strict=True))]
+
+
+def _read_edges(edges: Sequence[tuple[int, int]], count: int) -> tuple[tuple[int, int], ...]:
+    read = []
+    for i, edge in enumerate(edges):
+        pair = tuple(edge) if not isinstance(edge, (str, bytes)) else ()
+        if len(pair) != 2 or not all(
+            isinstance(k, (int, np.integer)) and 0 <= k < count and not isinstance(k, bool)
+            for k in pair
+        ):
+            raise ModelError(
+                f"`edges[{i}]` must be two point indices in 0..{count - 1} (got {describe(edge)})"
+            )
+        read.append((int(pair[0]), int(pair[1])))
+    return tuple(read)
 
 
 def _read_parameters(
