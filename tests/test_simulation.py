@@ -151,6 +151,19 @@ def test_compiled_loop_matches_numpy_loop(method, form):
         assert a.counters == b.counters
 
 
+def test_problems_from_one_numba_function_share_their_batch_wrappers():
+    """The compiled loop over a batch is built once per function, not once per problem (each
+    build is a parallel Numba compilation of about half a second)."""
+    from visviva.ode.batching import batched
+
+    rng = np.random.default_rng(4)
+    problems = [
+        vv.ode.SecondOrderProblem(_filling, rng.uniform(-1, 1, (3, 2)), np.zeros((3, 2)))
+        for _ in range(2)
+    ]
+    assert batched(problems[0].force, "array") is batched(problems[1].force, "array")
+
+
 @numba.njit
 def _first_order_numba(t, y, out):
     out[0] = y[1]
