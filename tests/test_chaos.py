@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 import sympy
 
@@ -38,7 +37,7 @@ def test_double_pendulum_is_chaotic_at_high_energy_only():
     )
     assert wild.exponent > 0.5  # measured ≈ 1.1 /s over 100 s
     assert calm.exponent < 0.1  # tends to 0 like log(t)/t
-    t, distance = chaos.separation(system, [2.0, 1.0], [0.0, 0.0], delta=1e-9, t_end=15.0, dt=1e-3)
+    _t, distance = chaos.separation(system, [2.0, 1.0], [0.0, 0.0], delta=1e-9, t_end=15.0, dt=1e-3)
     assert distance[0] == pytest.approx(1e-9)
     assert distance[-1] > 1e-3  # a billionth of a radian grows to a visible difference
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from . import classic
+from . import chaos, classic
 from .classic import (
     constrained_pendulum,
     damped_oscillator,
@@ -16,6 +16,7 @@ from .lagrangian import LagrangianSystem
 
 __all__: list[str] = [
     "LagrangianSystem",
+    "chaos",
     "classic",
     "constrained_pendulum",
     "damped_oscillator",

@@ -110,7 +110,7 @@ def lyapunov_exponent(
     interval = real_number("interval", interval, positive=True, unit=" s")
     delta = real_number("delta", delta, positive=True)
     t_end = real_number("t_end", t_end, positive=True, unit=" s")
-    count = int(round(t_end / interval))
+    count = round(t_end / interval)
     if count < 1:
         raise ModelError(f"`t_end` ({t_end} s) must cover at least one `interval` ({interval} s)")
     steps = max(1, round(interval / real_number("dt", dt, positive=True, unit=" s")))
