@@ -165,7 +165,7 @@ class Model:
         names = ("y",) if len(parts) == 1 else ("q", "v")
         fields = dict(zip(names, parts, strict=True))
         if kind.draw is not None:
-            fields["points"] = kind.draw(self.system.parameters, parts)
+            fields["points"] = kind.draw(self.system.parameters, self.gravity, parts)
         return fields
 
     def static(self) -> dict[str, np.ndarray]:
@@ -177,6 +177,5 @@ class Model:
 
     def units(self) -> dict[str, str]:
         """Units of the recorded fields and static arrays."""
-        # The named systems are written per unit mass, so their energy is in J/kg.
-        energy = "J" if self.system is None else "J/kg"
+        energy = "J" if self.system is None else SYSTEMS[self.system.system].energy_unit
         return {"points": "m", "velocities": "m/s", "radius": "m", "mass": "kg", "energy": energy}

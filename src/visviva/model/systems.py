@@ -3,63 +3,22 @@
 Each entry knows its parameters (with defaults and units), builds the ordinary
 :mod:`visviva.ode` problem that the one simulation loop runs, and draws itself: it maps the
 recorded coordinates to points (and edges) in the world so the video, viewer and exporters can
-show it. A system without a picture (the test equation) records no geometry.
+show it. A system without a picture (the test equation) records no geometry. The systems of
+classical mechanics (pendulums, the rock, ...) live in :mod:`.classic_systems`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from ..ode.problems import FirstOrderProblem, Problem, SecondOrderProblem
+from .classic_systems import CLASSIC_SYSTEMS
+from .system_type import Parameter, SystemType
 
 __all__ = ["SYSTEMS", "Parameter", "SystemType"]
-
-
-@dataclass(frozen=True)
-class Parameter:
-    """One parameter of a named system.
-
-    Attributes:
-        default: Value used when the scene does not give one.
-        unit: SI unit, for messages and the schema.
-        description: One line.
-        positive: The value must be > 0.
-    """
-
-    default: float
-    unit: str
-    description: str
-    positive: bool = False
-
-
-#: Draws frames of a system: ``(q, v)`` or ``(y,)`` with a leading frame axis → points
-#: ``(frames, P, 3)`` [m].
-Drawing = Callable[[Mapping[str, float], tuple[np.ndarray, ...]], np.ndarray]
-
-
-@dataclass(frozen=True)
-class SystemType:
-    """A named system: its parameters, its problem and its picture.
-
-    Attributes:
-        name: Name used in scene files.
-        summary: One line.
-        parameters: Parameter name → :class:`Parameter`.
-        build: ``build(values, gravity)`` → the problem; ``gravity`` [m/s²] is the world's.
-        draw: Maps recorded frames to points, or ``None`` if the system has no picture.
-        edges: Point-index pairs drawn as lines, or ``None``.
-    """
-
-    name: str
-    summary: str
-    parameters: Mapping[str, Parameter]
-    build: Callable[[Mapping[str, float], np.ndarray], Problem]
-    draw: Drawing | None = None
-    edges: tuple[tuple[int, int], ...] | None = None
 
 
 def _oscillator(p: Mapping[str, float], gravity: np.ndarray) -> Problem:
@@ -79,46 +38,15 @@ def _oscillator(p: Mapping[str, float], gravity: np.ndarray) -> Problem:
     )
 
 
-def _draw_oscillator(p: Mapping[str, float], parts: tuple[np.ndarray, ...]) -> np.ndarray:
+def _draw_oscillator(
+    p: Mapping[str, float], gravity: np.ndarray, parts: tuple[np.ndarray, ...]
+) -> np.ndarray:
     q = parts[0][:, 0]
     amplitude = np.hypot(p["q0"], p["v0"] / p["omega"])
     points = np.zeros((q.shape[0], 2, 3))
     points[:, 0, 0] = -2.0 * amplitude  # the wall the spring hangs from
     points[:, 1, 0] = q
     points[:, :, 1] = amplitude  # lift the picture off the ground plane
-    return points
-
-
-def _pendulum(p: Mapping[str, float], gravity: np.ndarray) -> Problem:
-    g_over_l = float(np.linalg.norm(gravity)) / p["length"]
-    length = p["length"]
-
-    def acceleration(t: float, q: np.ndarray) -> np.ndarray:
-        return -g_over_l * np.sin(q)  # θ'' = −(g/L) sin θ
-
-    def jacobian(t: float, q: np.ndarray) -> np.ndarray:
-        return (-g_over_l * np.cos(q))[..., None]
-
-    def energy(t: float, q: np.ndarray, v: np.ndarray) -> Any:
-        # per unit mass [J/kg]: ½ L² θ'² + g L (1 − cos θ)
-        return length**2 * (0.5 * v[..., 0] ** 2 + g_over_l * (1.0 - np.cos(q[..., 0])))
-
-    return SecondOrderProblem(
-        acceleration,
-        [p["theta0"]],
-        [p["omega0"]],
-        jacobian=jacobian,
-        energy=energy,
-        name="pendulum",
-    )
-
-
-def _draw_pendulum(p: Mapping[str, float], parts: tuple[np.ndarray, ...]) -> np.ndarray:
-    theta, length = parts[0][:, 0], p["length"]
-    points = np.zeros((theta.shape[0], 2, 3))
-    points[:, :, 1] = 1.2 * length  # pivot above the ground
-    points[:, 1, 0] = length * np.sin(theta)
-    points[:, 1, 1] -= length * np.cos(theta)
     return points
 
 
@@ -145,7 +73,9 @@ def _circular(p: Mapping[str, float], gravity: np.ndarray) -> Problem:
     )
 
 
-def _draw_circular(p: Mapping[str, float], parts: tuple[np.ndarray, ...]) -> np.ndarray:
+def _draw_circular(
+    p: Mapping[str, float], gravity: np.ndarray, parts: tuple[np.ndarray, ...]
+) -> np.ndarray:
     q = parts[0]
     points = np.zeros((q.shape[0], 2, 3))
     points[:, :, 1] = 0.25 * p["radius"]  # orbit in a horizontal plane above the ground
@@ -181,18 +111,7 @@ SYSTEMS: dict[str, SystemType] = {
             _oscillator,
             _draw_oscillator,
             ((0, 1),),
-        ),
-        SystemType(
-            "pendulum",
-            "simple pendulum in the world's gravity: theta'' = -(g/L) sin theta",
-            {
-                "length": Parameter(1.0, "m", "rod length", positive=True),
-                "theta0": Parameter(0.5, "rad", "initial angle from the downward vertical"),
-                "omega0": Parameter(0.0, "rad/s", "initial angular velocity"),
-            },
-            _pendulum,
-            _draw_pendulum,
-            ((0, 1),),
+            energy_unit="J/kg",
         ),
         SystemType(
             "circular",
@@ -204,6 +123,7 @@ SYSTEMS: dict[str, SystemType] = {
             _circular,
             _draw_circular,
             ((0, 1),),
+            energy_unit="J/kg",
         ),
         SystemType(
             "test-equation",
@@ -215,4 +135,4 @@ SYSTEMS: dict[str, SystemType] = {
             _test_equation,
         ),
     )
-}
+} | CLASSIC_SYSTEMS

@@ -1,0 +1,58 @@
+"""What a named system is: its parameters, how it builds its problem and how it draws itself."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..ode.problems import Problem
+
+__all__ = ["Drawing", "Parameter", "SystemType"]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One parameter of a named system.
+
+    Attributes:
+        default: Value used when the scene does not give one.
+        unit: SI unit, for messages and the schema.
+        description: One line.
+        positive: The value must be > 0.
+    """
+
+    default: float
+    unit: str
+    description: str
+    positive: bool = False
+
+
+#: Draws frames of a system: ``(values, gravity, parts)`` with ``parts`` = ``(q, v)`` or ``(y,)``
+#: with a leading frame axis → points ``(frames, P, 3)`` [m].
+Drawing = Callable[[Mapping[str, float], np.ndarray, tuple[np.ndarray, ...]], np.ndarray]
+
+
+@dataclass(frozen=True)
+class SystemType:
+    """A named system: its parameters, its problem and its picture.
+
+    Attributes:
+        name: Name used in scene files.
+        summary: One line.
+        parameters: Parameter name → :class:`Parameter`.
+        build: ``build(values, gravity)`` → the problem; ``gravity`` [m/s²] is the world's.
+        draw: Maps recorded frames to points, or ``None`` if the system has no picture.
+        edges: Point-index pairs drawn as lines, or ``None``.
+        energy_unit: Unit of the recorded energy (``"J/kg"`` for systems written per unit
+            mass).
+    """
+
+    name: str
+    summary: str
+    parameters: Mapping[str, Parameter]
+    build: Callable[[Mapping[str, float], np.ndarray], Problem]
+    draw: Drawing | None = None
+    edges: tuple[tuple[int, int], ...] | None = None
+    energy_unit: str = "J"
