@@ -12,6 +12,7 @@ from scipy.special import ellipk
 
 import visviva as vv
 from visviva.errors import ModelError
+from visviva.mechanics import classic
 
 LagrangianSystem = vv.mechanics.LagrangianSystem
 t = sympy.Symbol("t")
@@ -229,31 +230,7 @@ def test_damping_as_a_generalized_force():
 
 
 def measured_period(solution: vv.Solution) -> float:
-    """Mean time between upward zero crossings of θ, located by cubic Hermite interpolation."""
-    theta, omega, time = solution.q[:, 0], solution.v[:, 0], solution.t
-    crossings = []
-    for i in np.flatnonzero((theta[:-1] < 0) & (theta[1:] >= 0)):
-        h = time[i + 1] - time[i]
-        # Hermite cubic through (θ, θ̇) at both ends; its root by Newton from the secant guess.
-        s = -theta[i] / (theta[i + 1] - theta[i])
-        for _ in range(8):
-            h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
-            h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
-            value = (
-                h00 * theta[i] + h10 * h * omega[i] + h01 * theta[i + 1] + h11 * h * omega[i + 1]
-            )
-            d00, d10, d01, d11 = (
-                6 * s**2 - 6 * s,
-                3 * s**2 - 4 * s + 1,
-                -6 * s**2 + 6 * s,
-                3 * s**2 - 2 * s,
-            )
-            slope = (
-                d00 * theta[i] + d10 * h * omega[i] + d01 * theta[i + 1] + d11 * h * omega[i + 1]
-            )
-            s -= value / slope
-        crossings.append(time[i] + s * h)
-    return float(np.mean(np.diff(crossings)))
+    return classic.oscillation_period(solution.t, solution.q[:, 0], solution.v[:, 0])
 
 
 @pytest.mark.parametrize("theta0", [0.05, 1.0])

@@ -24,7 +24,7 @@ from .errors import ModelError, SceneError, SceneProblem, SimulationError
 from .model import Model
 from .model.build import build_model
 
-__all__ = ["OUTPUT_FILES", "DryRun", "dry_run", "load_model", "run_scene"]
+__all__ = ["DryRun", "dry_run", "load_model", "run_scene"]
 
 
 def load_model(path: str | os.PathLike[str]) -> Model:
@@ -186,8 +186,10 @@ def run_scene(
         "message": recording.attrs.get("message", ""),
     } | {"energy_drift": run_summary(recording)["energy_drift"]}
     if failure is None:
+        from .io.outputs import write_output
+
         for name in extra:
-            _write_output(recording, job.stage(name), model.output_fps)
+            write_output(recording, job.stage(name), model.output_fps)
     else:
         job.staged = [name for name in job.staged if name == "recording.h5"]
     written = job.write(summary)
@@ -209,35 +211,17 @@ def _duration(model: Model, duration: float | None) -> float:
     return seconds
 
 
-#: Output format → its file (or, for OBJ, folder) name in a run's output directory; `visviva
-#: export` uses the same names next to the recording.
-OUTPUT_FILES = {
-    "mp4": "animation.mp4",
-    "gif": "animation.gif",
-    "html": "viewer.html",
-    "usd": "scene.usdc",
-    "glb": "scene.glb",
-    "obj": "obj",
-    "pc2": "points.pc2",
-}
-
-
 def _planned(model: Model, formats: Iterable[str]) -> list[str]:
-    from ._validation import did_you_mean
+    from .io.outputs import output_names
 
-    chosen = list(dict.fromkeys([*model.output_formats, *formats]))
-    for name in chosen:
-        if name not in OUTPUT_FILES:
-            raise ModelError(
-                f"unknown output format {name!r}.{did_you_mean(name, OUTPUT_FILES)} "
-                f"Valid: {', '.join(OUTPUT_FILES)}"
-            )
-    if chosen and not model.has_geometry:
+    chosen = [*model.output_formats, *formats]
+    names = output_names(chosen)
+    if names and not model.has_geometry:
         raise ModelError(
             f"the {model.system.system if model.system else ''} system has no picture, so it "
-            f"cannot be written as {', '.join(chosen)}; drop the output formats"
+            f"cannot be written as {', '.join(dict.fromkeys(chosen))}; drop the output formats"
         )
-    return ["recording.h5", "summary.json", *(OUTPUT_FILES[name] for name in chosen)]
+    return ["recording.h5", "summary.json", *names]
 
 
 def _frame(model: Model, parts: tuple[Any, ...]) -> dict[str, Any]:
@@ -261,21 +245,3 @@ def _as_scene_recording(model: Model, recording: Any) -> Any:
         attrs=recording.attrs | {"scene_name": model.name},
         static=model.static(),
     )
-
-
-def _write_output(recording: Any, path: Path, fps: float) -> None:
-    """Write one extra output (video, viewer or export) of a finished run."""
-    suffix = path.suffix.lower()
-    if suffix in (".mp4", ".gif"):
-        from .viz.video import render_video
-
-        render_video(recording, path, fps=fps)
-    elif suffix == ".html":
-        from .viz.viewer import write_viewer
-
-        write_viewer(recording, path, fps=fps)
-    else:
-        from .io.export import export_recording
-
-        to = {".usdc": "usd", ".glb": "glb", ".pc2": "pc2", "": "obj"}[suffix]
-        export_recording(recording, path, to=to, fps=fps)

@@ -167,6 +167,13 @@ def demo_command(
     name: Annotated[str | None, typer.Argument(help="Demo to run; omit to list them.")] = None,
     output: Annotated[Path | None, typer.Option("--output", "-o", help="Output directory.")] = None,
     duration: Annotated[float | None, typer.Option(help="Simulated duration [s].")] = None,
+    formats: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--format", "-f", help="Also write mp4, gif, html, usd, glb, obj or pc2 (repeatable)."
+        ),
+    ] = None,
+    fps: Annotated[float, typer.Option(help="Frame rate of -f outputs [frames/s].")] = 30.0,
     force: ForceOption = False,
 ) -> None:
     """Run a demonstration and write its recording, summary and figures (no NAME: list them)."""
@@ -177,7 +184,9 @@ def demo_command(
             typer.echo(f"{demo.name:16s} {demo.summary}")
         return
     directory = output if output is not None else Path("out") / name
-    written = run_demo(name, directory, duration=duration, force=force)
+    written = run_demo(
+        name, directory, duration=duration, formats=formats or (), fps=fps, force=force
+    )
     for path in written:
         typer.echo(f"wrote {path}")
 

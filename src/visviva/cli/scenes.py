@@ -147,8 +147,8 @@ def export_command(
     """Export a recording for Blender/Houdini (USD, glTF, OBJ, PC2) or as a video."""
     from .._validation import did_you_mean
     from ..errors import ModelError
+    from ..io.outputs import OUTPUT_FILES
     from ..io.recording import Recording
-    from ..scenes import OUTPUT_FILES
 
     formats = ("usd", "glb", "obj", "pc2", "mp4", "gif")
     if to not in formats:

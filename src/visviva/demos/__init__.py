@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 import warnings
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -18,6 +18,7 @@ from typing import Any
 from .._validation import did_you_mean, real_number
 from ..errors import ModelError
 from ..io.job import JobOutput, run_summary
+from ..io.outputs import output_names, write_output
 
 __all__ = ["Demo", "demos", "register_demo", "run_demo"]
 
@@ -32,12 +33,15 @@ class Demo:
         duration: Default simulated duration [s].
         run: ``run(output, duration)``: simulates, adds recordings and figures to ``output``
             and returns extra summary entries.
+        picture: The demo's first recording carries drawable geometry (``points``), so it can
+            be written as a video, the web viewer or an export (``visviva demo NAME -f mp4``).
     """
 
     name: str
     summary: str
     duration: float
     run: Callable[[JobOutput, float], dict[str, Any]]
+    picture: bool = False
 
 
 _DEMOS: dict[str, Demo] = {}
@@ -56,7 +60,13 @@ def demos() -> dict[str, Demo]:
 
 
 def run_demo(
-    name: str, directory: str | Path, *, duration: float | None = None, force: bool = False
+    name: str,
+    directory: str | Path,
+    *,
+    duration: float | None = None,
+    formats: Iterable[str] = (),
+    fps: float = 30.0,
+    force: bool = False,
 ) -> list[Path]:
     """Run demo ``name`` and write its outputs into ``directory``.
 
@@ -64,6 +74,9 @@ def run_demo(
         name: Demo name (see :func:`demos`).
         directory: Output directory, created if missing.
         duration: Simulated duration [s]; default: the demo's own.
+        formats: Outputs of the demo's first recording (``mp4``, ``gif``, ``html``, ``usd``,
+            ``glb``, ``obj``, ``pc2``), for demos with a picture.
+        fps: Frame rate of those outputs [frames/s].
         force: Replace outputs that already exist.
 
     Returns:
@@ -81,8 +94,16 @@ def run_demo(
         if duration is None
         else real_number("duration", duration, positive=True, unit=" s")
     )
+    extras = output_names(formats)
+    if extras and not demo.picture:
+        raise ModelError(
+            f"demo {name!r} has no picture, so it cannot be written as "
+            f"{', '.join(dict.fromkeys(formats))}; demos with one: "
+            f"{', '.join(d.name for d in available.values() if d.picture)}"
+        )
+    fps = real_number("fps", fps, positive=True, unit=" frames/s")
     output = JobOutput(directory, force=force)
-    output.check_target()
+    output.check_target(["recording.h5", "summary.json", *extras])
     started = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -99,8 +120,21 @@ def run_demo(
         "warnings": dict(Counter(w.category.__name__ for w in caught)),
         "runs": runs,
     } | extra
+    if extras:
+        primary = next(iter(output.recordings.values()))
+        for file_name in extras:
+            write_output(primary, output.stage(file_name), fps)
     return output.write(summary)
 
 
 def _load_builtins() -> None:
-    from . import circular, dahlquist, oscillator  # noqa: F401 - registers the demos
+    from . import (  # noqa: F401 - registers the demos
+        circular,
+        constrained_pendulum,
+        dahlquist,
+        double_pendulum,
+        oscillator,
+        pendulum,
+        rock,
+        spring_pendulum,
+    )

@@ -1,0 +1,58 @@
+"""The extra outputs of a run: video, the web viewer and the exports, by format name.
+
+``visviva run -f``, ``visviva demo -f`` and ``visviva export`` share one table of formats and
+file names and one function that writes any of them from a finished recording.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+
+from .._validation import did_you_mean
+from ..errors import ModelError
+from .recording import Recording
+
+__all__ = ["OUTPUT_FILES", "output_names", "write_output"]
+
+#: Output format → its file (or, for OBJ, folder) name in a run's output directory; `visviva
+#: export` uses the same names next to the recording.
+OUTPUT_FILES = {
+    "mp4": "animation.mp4",
+    "gif": "animation.gif",
+    "html": "viewer.html",
+    "usd": "scene.usdc",
+    "glb": "scene.glb",
+    "obj": "obj",
+    "pc2": "points.pc2",
+}
+
+
+def output_names(formats: Iterable[str]) -> list[str]:
+    """The file names of ``formats`` (duplicates dropped), or an error naming an unknown one."""
+    chosen = list(dict.fromkeys(formats))
+    for name in chosen:
+        if name not in OUTPUT_FILES:
+            raise ModelError(
+                f"unknown output format {name!r}.{did_you_mean(name, OUTPUT_FILES)} "
+                f"Valid: {', '.join(OUTPUT_FILES)}"
+            )
+    return [OUTPUT_FILES[name] for name in chosen]
+
+
+def write_output(recording: Recording, path: Path, fps: float) -> None:
+    """Write one output (video, viewer or export, chosen by the suffix of ``path``)."""
+    suffix = path.suffix.lower()
+    if suffix in (".mp4", ".gif"):
+        from ..viz.video import render_video
+
+        render_video(recording, path, fps=fps)
+    elif suffix == ".html":
+        from ..viz.viewer import write_viewer
+
+        write_viewer(recording, path, fps=fps)
+    else:
+        from .export import export_recording
+
+        to = {".usdc": "usd", ".glb": "glb", ".pc2": "pc2", "": "obj"}[suffix]
+        export_recording(recording, path, to=to, fps=fps)
