@@ -15,7 +15,8 @@ from visviva.io.scene_files import dump_scene, load_scene, parse_scene
 from visviva.io.writer import RecordingWriter
 from visviva.scenes import dry_run
 
-EXAMPLES = sorted((Path(__file__).parents[1] / "examples" / "scenes").glob("*.toml"))
+EXAMPLES_DIR = Path(__file__).parents[1] / "examples" / "scenes"
+EXAMPLES = sorted(EXAMPLES_DIR.glob("*.toml"))
 
 
 def build_in_python() -> vv.SceneBuilder:
@@ -193,7 +194,7 @@ def test_cli_validate_schema_dry_run_and_plot(tmp_path):
     from visviva.cli.main import app
 
     runner = CliRunner()
-    scene = EXAMPLES[0]
+    scene = EXAMPLES_DIR / "falling_particles.toml"
     result = runner.invoke(app, ["validate", str(scene)])
     assert result.exit_code == 0 and "valid" in result.stdout
     schema = json.loads(runner.invoke(app, ["schema"]).stdout)
