@@ -1,5 +1,6 @@
 """Analysis of integrators and runs: stability, convergence order, invariants."""
 
+from .compare import Comparison, MethodResult, compare_methods
 from .convergence import ConvergenceStudy, convergence_order
 from .invariants import (
     angular_momentum,
@@ -19,9 +20,12 @@ from .stability import (
 )
 
 __all__ = [
+    "Comparison",
     "ConvergenceStudy",
+    "MethodResult",
     "angular_momentum",
     "center_of_mass",
+    "compare_methods",
     "convergence_order",
     "energy_drift",
     "linear_momentum",

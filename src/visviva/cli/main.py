@@ -162,6 +162,64 @@ def convergence_command(
         typer.echo(f"wrote {output}")
 
 
+#: Methods compared by default: one of each family the notes contrast.
+COMPARED = ("explicit_euler", "symplectic_euler", "velocity_verlet", "rk4", "implicit_midpoint")
+
+
+@app.command("compare")
+def compare_command(
+    target: Annotated[
+        str, typer.Argument(help="A scene file (.toml/.json) or a named system (e.g. pendulum).")
+    ],
+    methods: Annotated[list[str] | None, typer.Argument(help="Methods to compare.")] = None,
+    dt: Annotated[
+        float | None, typer.Option(help="Step [s] (default: the scene's, or 1 ms).")
+    ] = None,
+    duration: Annotated[
+        float | None, typer.Option(help="Length of the runs [s] (default: the scene's, or 10 s).")
+    ] = None,
+    convergence_time: Annotated[
+        float, typer.Option(help="Span of the order measurement [s].")
+    ] = 1.0,
+    output: Annotated[Path | None, typer.Option("--output", "-o", help="Output directory.")] = None,
+    force: ForceOption = False,
+) -> None:
+    """Run one system under several integrators: energy plot, convergence plot and a table."""
+    from ..analysis.compare import compare_methods
+    from ..io.job import JobOutput
+    from ..model.builder import SceneBuilder
+    from ..scenes import load_model
+
+    if target.endswith((".toml", ".json")) or Path(target).exists():
+        model = load_model(target)
+    else:
+        builder = SceneBuilder(name=target)
+        builder.set_integration(method="rk4", dt=dt or 1e-3, duration=duration or 10.0)
+        builder.add_system(target)
+        model = builder.build()
+    directory = output if output is not None else Path("out") / f"compare-{model.name}"
+    job = JobOutput(directory, force=force)
+    job.check_target(["recording.h5", "summary.json", "energy.png", "convergence.png"])
+    problem = model.problem()
+    step = dt or model.integration.dt
+    end = problem.t0 + (duration or model.integration.duration)
+    comparison = compare_methods(
+        problem,
+        list(methods or COMPARED),
+        dt=step,
+        t_end=end,
+        convergence_t_end=problem.t0 + min(convergence_time, end - problem.t0),
+        record_every=max(1, round((end - problem.t0) / step / 2000)),
+    )
+    job.recordings.update(comparison.runs)
+    job.figures["energy"] = comparison.energy_figure(f"{model.name}: energy, h = {step:g} s")
+    job.figures["convergence"] = comparison.convergence_figure()
+    table = comparison.table()
+    typer.echo(table)
+    for path in job.write({"target": target, "table": table} | comparison.as_dict()):
+        typer.echo(f"wrote {path}")
+
+
 @app.command("demo")
 def demo_command(
     name: Annotated[str | None, typer.Argument(help="Demo to run; omit to list them.")] = None,
