@@ -364,10 +364,7 @@ class LagrangianSystem:
                 positive definite at ``q0`` (a coordinate singularity, or a kinetic energy
                 that is not a positive quadratic form).
         """
-        q0, v0 = self._state("q0", q0), self._state("v0", v0)
-        if q0.shape != v0.shape:
-            raise ModelError(f"`q0` and `v0` must have the same shape (got {q0.shape}, {v0.shape})")
-        self._check_mass_matrix(q0, v0, real_number("t0", t0, unit=" s"))
+        q0, v0, t0 = self._initial_state(q0, v0, t0)
         code = self._code(backend)
         return SecondOrderProblem(
             code.acceleration,
@@ -401,11 +398,7 @@ class LagrangianSystem:
             q0, v0, t0, backend, name: As for :meth:`problem`.
         """
         self._require_canonical()
-        q0, v0 = self._state("q0", q0), self._state("v0", v0)
-        if q0.shape != v0.shape:
-            raise ModelError(f"`q0` and `v0` must have the same shape (got {q0.shape}, {v0.shape})")
-        t0 = real_number("t0", t0, unit=" s")
-        self._check_mass_matrix(q0, v0, t0)
+        q0, v0, t0 = self._initial_state(q0, v0, t0)
         y0 = np.concatenate([q0, self.momenta(q0, v0, t0)], axis=-1)
         f, hamiltonian = self._code(backend).canonical
         return FirstOrderProblem(f, y0, t0, energy=hamiltonian, name=name or f"{self.name} (q, p)")
@@ -416,6 +409,15 @@ class LagrangianSystem:
                 f"{self.name}: the kinetic energy is not quadratic in the velocities (M depends "
                 "on them), so p = ∂L/∂q̇ cannot be inverted in closed form; use problem()"
             )
+
+    def _initial_state(self, q0: Any, v0: Any, t0: Any) -> tuple[np.ndarray, np.ndarray, float]:
+        """Checked initial state: shapes, finite values and an invertible mass matrix."""
+        q0, v0 = self._state("q0", q0), self._state("v0", v0)
+        if q0.shape != v0.shape:
+            raise ModelError(f"`q0` and `v0` must have the same shape (got {q0.shape}, {v0.shape})")
+        t0 = real_number("t0", t0, unit=" s")
+        self._check_mass_matrix(q0, v0, t0)
+        return q0, v0, t0
 
     def _check_mass_matrix(self, q0: np.ndarray, v0: np.ndarray, t0: float) -> None:
         mass = self.mass_matrix(q0, v0, t0)
