@@ -120,3 +120,19 @@ def test_points_are_where_the_bodies_are():
     np.testing.assert_allclose(points[0], [[0, 0, 0], [0, -1, 0], [0, -1.5, 0]], atol=1e-15)
     np.testing.assert_allclose(points[1], [[0, 0, 0], [1, 0, 0], [1, 0.5, 0]], atol=1e-15)
     assert system.edges == ((0, 1), (1, 2))
+
+
+def test_cli_prints_the_derived_equations():
+    from typer.testing import CliRunner
+
+    from visviva.cli.main import app
+
+    result = CliRunner().invoke(app, ["equations", "spring-pendulum"])
+    assert result.exit_code == 0
+    # m r̈ = m r θ̇² − k (r − L0) + m g cos θ ;  m r² θ̈ = −m r (g sin θ + 2 ṙ θ̇)
+    assert result.stdout.splitlines() == [
+        "m*r'' = L0*k + g*m*cos(theta) - k*r + m*r*theta'**2",
+        "m*r**2*theta'' = -m*(g*sin(theta) + 2*r'*theta')*r",
+    ]
+    latex = CliRunner().invoke(app, ["equations", "pendulum", "--latex"]).stdout
+    assert "\\ddot{\\theta}" in latex

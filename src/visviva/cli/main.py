@@ -162,6 +162,25 @@ def convergence_command(
         typer.echo(f"wrote {output}")
 
 
+@app.command("equations")
+def equations_command(
+    system: Annotated[str, typer.Argument(help="A classic system, e.g. double-pendulum.")],
+    latex: Annotated[bool, typer.Option("--latex", help="Print LaTeX instead of text.")] = False,
+) -> None:
+    """Print the equations of motion visviva derives from a classic system's K and U."""
+    from .._validation import did_you_mean
+    from ..errors import ModelError
+    from ..mechanics.classic import LAGRANGIAN_SYSTEMS
+
+    if system not in LAGRANGIAN_SYSTEMS:
+        raise ModelError(
+            f"unknown system {system!r}.{did_you_mean(system, LAGRANGIAN_SYSTEMS)} "
+            f"Available: {', '.join(LAGRANGIAN_SYSTEMS)}"
+        )
+    derived = LAGRANGIAN_SYSTEMS[system]()
+    typer.echo(derived.latex() if latex else derived.text())
+
+
 #: Methods compared by default: one of each family the notes contrast.
 COMPARED = ("explicit_euler", "symplectic_euler", "velocity_verlet", "rk4", "implicit_midpoint")
 

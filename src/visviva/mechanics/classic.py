@@ -21,6 +21,7 @@ from ..ode.problems import SecondOrderProblem
 from .lagrangian import LagrangianSystem
 
 __all__ = [
+    "LAGRANGIAN_SYSTEMS",
     "STANDARD_GRAVITY",
     "constrained_pendulum",
     "damped_oscillator",
@@ -329,3 +330,14 @@ def constrained_pendulum(
         acceleration, q0, v0, energy=energy, name="pendulum as a constrained particle"
     )
     return problem, multiplier
+
+
+#: The classic Lagrangian systems by their scene and command-line names, each with its defaults
+#: (``visviva equations NAME`` prints their equations of motion).
+LAGRANGIAN_SYSTEMS = {
+    "rock": rock,
+    "pendulum": pendulum,
+    "double-pendulum": double_pendulum,
+    "spring-pendulum": spring_pendulum,
+    "damped-oscillator": damped_oscillator,
+}
