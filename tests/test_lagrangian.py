@@ -142,6 +142,23 @@ def test_jacobians_match_finite_differences(backend):
     np.testing.assert_allclose(jv, finite_difference(lambda x: acceleration(q, x), v), atol=1e-8)
 
 
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+@pytest.mark.parametrize("which", ["double pendulum", "rotating frame"])
+def test_canonical_jacobian_matches_finite_differences(backend, which):
+    """Hamilton's f(q, p) and its analytic Jacobian: M(q) in the double pendulum, the offset
+    b(q) in p = M q̇ + b for the rotating frame."""
+    system = double_pendulum() if which == "double pendulum" else rotating_frame()
+    problem = system.canonical_problem([0.7, -1.2], [1.5, -0.4], backend=backend)
+    y = problem.y0
+
+    def f(yy):
+        out = np.empty(4)
+        problem.f.func(0.0, yy, out)
+        return out
+
+    np.testing.assert_allclose(problem.jacobian.func(0.0, y), finite_difference(f, y), atol=1e-7)
+
+
 def test_position_only_systems_get_position_only_functions():
     system = pendulum()
     assert not system.velocity_dependent

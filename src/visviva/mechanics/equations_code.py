@@ -230,9 +230,9 @@ class EquationsCode:
 
     # --- (q, p) form -----------------------------------------------------------------------
 
-    def _canonical_velocities(self, w: SourceWriter, *, stacked: bool) -> None:
+    def _canonical_velocities(self, w: SourceWriter, *, stacked: bool) -> UnrolledLDLT:
         """Read ``q`` and ``p`` (from ``y = (q, p)`` if ``stacked``, else from arrays ``q``
-        and ``p``) and solve ``M q̇ = p − b`` into the velocity locals."""
+        and ``p``) and solve ``M q̇ = p − b`` into the velocity locals; return ``M``'s factor."""
         d, n = self.derived, self.n
         w.read("y" if stacked else "q", d.q)
         momenta = [sympy.Dummy(f"p{i}") for i in range(n)]
@@ -244,9 +244,11 @@ class EquationsCode:
             w.line(f"r_{i} = {w.local(momenta[i])}" + (f" - b_{i}" if f"b_{i}" in offset else ""))
             rest.append(f"r_{i}")
         velocities = [f"v_{i}" for i in range(n)]
-        self._factor_mass(w).solve(rest, velocities)
+        factor = self._factor_mass(w)
+        factor.solve(rest, velocities)
         for symbol, local in zip(d.v, velocities, strict=True):
             w.name_local(symbol, local)
+        return factor
 
     @cached_property
     def canonical(self) -> tuple[Callable[..., Any], Callable[..., Any]]:
@@ -263,6 +265,57 @@ class EquationsCode:
         h.assign({"E": self.derived.energy})
         h.line(f"return {h.scalar('E')}")
         return w.compile(), h.compile()
+
+    @cached_property
+    def canonical_jacobian(self) -> Callable[..., Any]:
+        """``jacobian(t, y)``: ``∂f/∂y`` of Hamilton's equations, ``(2n, 2n)``.
+
+        With ``q̇ = M⁻¹(p − b)`` and ``ṗ = g(q, q̇)``: ``∂q̇/∂p = M⁻¹``,
+        ``∂q̇/∂q_k = −M⁻¹(∂b/∂q_k + (∂M/∂q_k) q̇)``, and by the chain rule
+        ``∂ṗ/∂q = ∂g/∂q + (∂g/∂q̇)(∂q̇/∂q)``, ``∂ṗ/∂p = (∂g/∂q̇) M⁻¹``.
+        """
+        d, n = self.derived, self.n
+        w = self._writer("hamilton_jacobian", ("y",))
+        factor = self._canonical_velocities(w, stacked=True)
+        named: dict[str, sympy.Expr] = {}
+        for k, x in enumerate(d.q):
+            named |= {f"dMq_{k}_{key[2:]}": e for key, e in _lower(d.mass.diff(x), "M").items()}
+        for name, matrix in (
+            ("dbq", d.offset.jacobian(d.q)),
+            ("Gq", d.potential_force.jacobian(d.q)),
+            ("Gv", d.potential_force.jacobian(d.v)),
+        ):
+            named |= {f"{name}_{i}_{k}": e for (i, k), e in _entries(matrix).items()}
+        w.assign(named)
+        entries: dict[tuple[int, ...], str] = {}
+        for k in range(n):
+            rhs: list[str | None] = []
+            for i in range(n):
+                terms = [f"- dbq_{i}_{k}"] if f"dbq_{i}_{k}" in named else []
+                terms += [
+                    f"- dMq_{k}_{max(i, j)}_{min(i, j)}*v_{j}"
+                    for j in range(n)
+                    if f"dMq_{k}_{max(i, j)}_{min(i, j)}" in named
+                ]
+                if terms:
+                    w.line(f"r_{i} = 0.0 {' '.join(terms)}")
+                rhs.append(f"r_{i}" if terms else None)
+            factor.solve(rhs, [f"Vq_{i}_{k}" for i in range(n)])
+            factor.solve(
+                ["1.0" if i == k else None for i in range(n)], [f"Vp_{i}_{k}" for i in range(n)]
+            )
+            for i in range(n):
+                entries[i, k], entries[i, n + k] = f"Vq_{i}_{k}", f"Vp_{i}_{k}"
+                chain = [m for m in range(n) if f"Gv_{i}_{m}" in named]
+                own = [f"Gq_{i}_{k}"] if f"Gq_{i}_{k}" in named else []
+                entries[n + i, k] = (
+                    " + ".join(own + [f"Gv_{i}_{m}*Vq_{m}_{k}" for m in chain]) or "0.0"
+                )
+                entries[n + i, n + k] = " + ".join(f"Gv_{i}_{m}*Vp_{m}_{k}" for m in chain) or "0.0"
+        w.new_array("J", (2 * n, 2 * n))
+        w.write("J", entries)
+        w.line("return J")
+        return w.compile()
 
     @cached_property
     def velocities(self) -> Callable[..., Any]:

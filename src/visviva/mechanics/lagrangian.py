@@ -392,7 +392,7 @@ class LagrangianSystem:
         energy of a conservative system bounded for any ``M(q)``; in ``(q, q̇)`` no method
         can promise that when ``M`` depends on ``q``. Needs a kinetic energy quadratic in the
         velocities. The state starts from ``(q0, p(q0, v0))``; :meth:`velocities` maps
-        recorded momenta back. Implicit methods use finite-difference Jacobians here.
+        recorded momenta back. The analytic Jacobian serves the implicit methods.
 
         Args:
             q0, v0, t0, backend, name: As for :meth:`problem`.
@@ -400,8 +400,16 @@ class LagrangianSystem:
         self._require_canonical()
         q0, v0, t0 = self._initial_state(q0, v0, t0)
         y0 = np.concatenate([q0, self.momenta(q0, v0, t0)], axis=-1)
-        f, hamiltonian = self._code(backend).canonical
-        return FirstOrderProblem(f, y0, t0, energy=hamiltonian, name=name or f"{self.name} (q, p)")
+        code = self._code(backend)
+        f, hamiltonian = code.canonical
+        return FirstOrderProblem(
+            f,
+            y0,
+            t0,
+            jacobian=code.canonical_jacobian,
+            energy=hamiltonian,
+            name=name or f"{self.name} (q, p)",
+        )
 
     def _require_canonical(self) -> None:
         if not self._derived.quadratic:
