@@ -10,6 +10,7 @@ tests and demos compare against it.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -334,7 +335,7 @@ def constrained_pendulum(
 
 #: The classic Lagrangian systems by their scene and command-line names, each with its defaults
 #: (``visviva equations NAME`` prints their equations of motion).
-LAGRANGIAN_SYSTEMS = {
+LAGRANGIAN_SYSTEMS: dict[str, Callable[[], LagrangianSystem]] = {
     "rock": rock,
     "pendulum": pendulum,
     "double-pendulum": double_pendulum,
