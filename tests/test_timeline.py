@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import visviva as vv
+from visviva.errors import ModelError
 from visviva.io.timeline import frames_at_rate
 
 
@@ -32,3 +33,17 @@ def test_single_frame_and_bad_rate():
     np.testing.assert_array_equal(frames_at_rate(np.array([2.0]), 30.0), [0])
     with pytest.raises(vv.ModelError, match="fps"):
         frames_at_rate(np.array([0.0, 1.0]), 0.0)
+
+
+def test_speed_plays_simulated_time_faster():
+    """Output frame k shows t0 + k·speed/fps: a day per second at 2 frames/s over 2 days."""
+    day = 86_400.0
+    time = np.arange(49) * 3600.0  # hourly frames for two days
+    shown = frames_at_rate(time, 2.0, speed=day)
+    np.testing.assert_array_equal(time[shown], [0.0, 0.5 * day, day, 1.5 * day, 2 * day])
+
+
+def test_absurd_frame_counts_are_refused_before_allocating():
+    """A year in seconds at 30 frames/s would be ~9.5e8 frames: refused with the fix named."""
+    with pytest.raises(ModelError, match=r"more than 1000000.*speed"):
+        frames_at_rate(np.array([0.0, 3.15e7]), 30.0)

@@ -189,7 +189,7 @@ def run_scene(
         from .io.outputs import write_output
 
         for name in extra:
-            write_output(recording, job.stage(name), model.output_fps)
+            write_output(recording, job.stage(name), model.output_fps, model.output_speed)
     else:
         job.staged = [name for name in job.staged if name == "recording.h5"]
     written = job.write(summary)

@@ -18,6 +18,12 @@ RunOption = Annotated[
 FpsOption = Annotated[
     float | None, typer.Option("--fps", help="Frames per second of the output [1/s].")
 ]
+SpeedOption = Annotated[
+    float,
+    typer.Option(
+        "--speed", help="Simulated seconds per second of playback (86400: a day per second)."
+    ),
+]
 
 
 @app.command("run")
@@ -116,6 +122,7 @@ def view_command(
         typer.Option("--output", "-o", help="HTML file (default: viewer.html next to it)."),
     ] = None,
     fps: FpsOption = None,
+    speed: SpeedOption = 1.0,
     run: RunOption = None,
     force: ForceOption = False,
 ) -> None:
@@ -125,7 +132,7 @@ def view_command(
 
     target = output or recording.with_name("viewer.html")
     check_new_file(target, force)
-    written = write_viewer(Recording.load(recording, run), target, fps=fps)
+    written = write_viewer(Recording.load(recording, run), target, fps=fps, speed=speed)
     typer.echo(f"wrote {written}; open it in a browser (file://{written.resolve()})")
 
 
@@ -137,6 +144,7 @@ def export_command(
         Path | None, typer.Option("--output", "-o", help="Output file (default: next to it).")
     ] = None,
     fps: FpsOption = None,
+    speed: SpeedOption = 1.0,
     size: Annotated[
         str | None,
         typer.Option("--size", help="Video size WIDTHxHEIGHT in pixels (mp4, gif), e.g. 1280x720."),
@@ -170,11 +178,11 @@ def export_command(
     if video:
         from ..viz.video import render_video
 
-        written = [render_video(source, target, fps=fps or 30.0, size=pixels)]
+        written = [render_video(source, target, fps=fps or 30.0, size=pixels, speed=speed)]
     else:
         from ..io.export import export_recording
 
-        written = export_recording(source, target, to=to, fps=fps)
+        written = export_recording(source, target, to=to, fps=fps, speed=speed)
     for path in written:
         typer.echo(f"wrote {path}")
 

@@ -35,6 +35,7 @@ class Demo:
             and returns extra summary entries.
         picture: The demo's first recording carries drawable geometry (``points``), so it can
             be written as a video, the web viewer or an export (``visviva demo NAME -f mp4``).
+        speed: Simulated seconds per second of those outputs' playback.
     """
 
     name: str
@@ -42,6 +43,7 @@ class Demo:
     duration: float
     run: Callable[[JobOutput, float], dict[str, Any]]
     picture: bool = False
+    speed: float = 1.0
 
 
 _DEMOS: dict[str, Demo] = {}
@@ -123,7 +125,7 @@ def run_demo(
     if extras:
         primary = next(iter(output.recordings.values()))
         for file_name in extras:
-            write_output(primary, output.stage(file_name), fps)
+            write_output(primary, output.stage(file_name), fps, demo.speed)
     return output.write(summary)
 
 
@@ -133,8 +135,11 @@ def _load_builtins() -> None:
         constrained_pendulum,
         dahlquist,
         double_pendulum,
+        galaxy,
+        kepler,
         oscillator,
         pendulum,
         rock,
         spring_pendulum,
+        sun_earth_moon,
     )

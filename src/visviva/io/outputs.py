@@ -40,19 +40,20 @@ def output_names(formats: Iterable[str]) -> list[str]:
     return [OUTPUT_FILES[name] for name in chosen]
 
 
-def write_output(recording: Recording, path: Path, fps: float) -> None:
-    """Write one output (video, viewer or export, chosen by the suffix of ``path``)."""
+def write_output(recording: Recording, path: Path, fps: float, speed: float = 1.0) -> None:
+    """Write one output (video, viewer or export, chosen by the suffix of ``path``) at ``fps``
+    frames per second, playing ``speed`` simulated seconds per second."""
     suffix = path.suffix.lower()
     if suffix in (".mp4", ".gif"):
         from ..viz.video import render_video
 
-        render_video(recording, path, fps=fps)
+        render_video(recording, path, fps=fps, speed=speed)
     elif suffix == ".html":
         from ..viz.viewer import write_viewer
 
-        write_viewer(recording, path, fps=fps)
+        write_viewer(recording, path, fps=fps, speed=speed)
     else:
         from .export import export_recording
 
         to = {".usdc": "usd", ".glb": "glb", ".pc2": "pc2", "": "obj"}[suffix]
-        export_recording(recording, path, to=to, fps=fps)
+        export_recording(recording, path, to=to, fps=fps, speed=speed)

@@ -99,6 +99,11 @@ class Output(_Strict):
     fps: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = Field(
         30.0, description="frames per second of videos, viewer and exports [1/s]"
     )
+    speed: Annotated[float, Field(gt=0, allow_inf_nan=False)] = Field(
+        1.0,
+        description="simulated seconds per second of playback (1: real time; 86400: a day "
+        "per second)",
+    )
 
 
 class Particles(_Strict):

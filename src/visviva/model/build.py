@@ -62,6 +62,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         system=system,
         output_formats=tuple(scene.output.formats),
         output_fps=scene.output.fps,
+        output_speed=scene.output.speed,
         source=source,
     )
 
@@ -168,9 +169,16 @@ def _check_system(entity: System, where: str) -> list[SceneProblem]:
                     f" Parameters: {', '.join(kind.parameters)}",
                 )
             )
-        elif kind.parameters[key].positive and value <= 0:
-            unit = kind.parameters[key].unit
-            problems.append(SceneProblem(path, f"must be positive [{unit}]", repr(value)))
+            continue
+        parameter = kind.parameters[key]
+        if parameter.positive and value <= 0:
+            problems.append(SceneProblem(path, f"must be positive [{parameter.unit}]", repr(value)))
+        if parameter.integer and value != int(value):
+            problems.append(SceneProblem(path, "must be a whole number", repr(value)))
+        if parameter.maximum is not None and value > parameter.maximum:
+            problems.append(
+                SceneProblem(path, f"must be at most {parameter.maximum:g}", repr(value))
+            )
     return problems
 
 

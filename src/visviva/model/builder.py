@@ -72,7 +72,8 @@ class SceneBuilder:
         self._replace(integration=_validated(Integration, "integration", **settings))
 
     def set_output(self, **settings: Any) -> None:
-        """Set the extra output ``formats`` of ``visviva run`` and their ``fps``."""
+        """Set the extra output ``formats`` of ``visviva run``, their ``fps`` and ``speed``
+        (simulated seconds per second of playback)."""
         self._replace(output=_validated(Output, "output", **settings))
 
     def add_particles(self, **fields: Any) -> int:
@@ -86,7 +87,7 @@ class SceneBuilder:
         return self._add(ParticleCloud, fields | {"type": "particle_cloud"})
 
     def add_system(self, system: str, *, name: str | None = None, **parameters: float) -> int:
-        """Add a named system (``oscillator``, ``pendulum``, ``circular``, ``test-equation``)
+        """Add a named system (``visviva schema`` lists them: ``pendulum``, ``kepler``, ...)
         with parameter values; returns the entity id."""
         fields = {"type": "system", "system": system, "name": name, "parameters": parameters}
         return self._add(System, fields)

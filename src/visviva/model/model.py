@@ -97,6 +97,7 @@ class Model:
         system: The named system, if the scene holds one instead of particles.
         output_formats: Extra outputs the scene asks ``visviva run`` for.
         output_fps: Frame rate of videos, viewer and exports [1/s].
+        output_speed: Simulated seconds per second of their playback.
         source: The scene file's text, stored in recordings for reproducibility.
     """
 
@@ -111,6 +112,7 @@ class Model:
     system: SystemInstance | None = None
     output_formats: tuple[str, ...] = ()
     output_fps: float = 30.0
+    output_speed: float = 1.0
     source: str | None = field(default=None, repr=False)
 
     @property

@@ -21,12 +21,16 @@ class Parameter:
         unit: SI unit, for messages and the schema.
         description: One line.
         positive: The value must be > 0.
+        integer: The value must be a whole number (a count).
+        maximum: Largest value accepted (counts are capped before anything is allocated).
     """
 
     default: float
     unit: str
     description: str
     positive: bool = False
+    integer: bool = False
+    maximum: float | None = None
 
 
 #: Draws frames of a system: ``(values, gravity, parts)`` with ``parts`` = ``(q, v)`` or ``(y,)``

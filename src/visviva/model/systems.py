@@ -4,7 +4,8 @@ Each entry knows its parameters (with defaults and units), builds the ordinary
 :mod:`visviva.ode` problem that the one simulation loop runs, and draws itself: it maps the
 recorded coordinates to points (and edges) in the world so the video, viewer and exporters can
 show it. A system without a picture (the test equation) records no geometry. The systems of
-classical mechanics (pendulums, the rock, ...) live in :mod:`.classic_systems`.
+classical mechanics (pendulums, the rock, ...) live in :mod:`.classic_systems`, gravitating
+bodies in :mod:`.gravity_systems`.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 
 from ..ode.problems import FirstOrderProblem, Problem, SecondOrderProblem
 from .classic_systems import CLASSIC_SYSTEMS
+from .gravity_systems import GRAVITY_SYSTEMS
 from .system_type import Parameter, SystemType
 
 __all__ = ["SYSTEMS", "Parameter", "SystemType"]
@@ -97,42 +99,46 @@ def _test_equation(p: Mapping[str, float], gravity: np.ndarray) -> Problem:
 
 
 #: Every named system, by name.
-SYSTEMS: dict[str, SystemType] = {
-    system.name: system
-    for system in (
-        SystemType(
-            "oscillator",
-            "unit mass on a spring: q'' = -omega^2 q",
-            {
-                "omega": Parameter(2.0 * np.pi, "rad/s", "angular frequency", positive=True),
-                "q0": Parameter(1.0, "m", "initial displacement"),
-                "v0": Parameter(0.0, "m/s", "initial velocity"),
-            },
-            _oscillator,
-            _draw_oscillator,
-            ((0, 1),),
-            energy_unit="J/kg",
-        ),
-        SystemType(
-            "circular",
-            "seed 004's circular motion: a particle pulled to the centre, q'' = -omega^2 q",
-            {
-                "radius": Parameter(1.0, "m", "orbit radius", positive=True),
-                "omega": Parameter(1.0, "rad/s", "angular velocity", positive=True),
-            },
-            _circular,
-            _draw_circular,
-            ((0, 1),),
-            energy_unit="J/kg",
-        ),
-        SystemType(
-            "test-equation",
-            "Dahlquist's test equation y' = lambda y (no picture)",
-            {
-                "lambda": Parameter(-1.0, "1/s", "rate"),
-                "y0": Parameter(1.0, "", "initial value"),
-            },
-            _test_equation,
-        ),
-    )
-} | CLASSIC_SYSTEMS
+SYSTEMS: dict[str, SystemType] = (
+    {
+        system.name: system
+        for system in (
+            SystemType(
+                "oscillator",
+                "unit mass on a spring: q'' = -omega^2 q",
+                {
+                    "omega": Parameter(2.0 * np.pi, "rad/s", "angular frequency", positive=True),
+                    "q0": Parameter(1.0, "m", "initial displacement"),
+                    "v0": Parameter(0.0, "m/s", "initial velocity"),
+                },
+                _oscillator,
+                _draw_oscillator,
+                ((0, 1),),
+                energy_unit="J/kg",
+            ),
+            SystemType(
+                "circular",
+                "seed 004's circular motion: a particle pulled to the centre, q'' = -omega^2 q",
+                {
+                    "radius": Parameter(1.0, "m", "orbit radius", positive=True),
+                    "omega": Parameter(1.0, "rad/s", "angular velocity", positive=True),
+                },
+                _circular,
+                _draw_circular,
+                ((0, 1),),
+                energy_unit="J/kg",
+            ),
+            SystemType(
+                "test-equation",
+                "Dahlquist's test equation y' = lambda y (no picture)",
+                {
+                    "lambda": Parameter(-1.0, "1/s", "rate"),
+                    "y0": Parameter(1.0, "", "initial value"),
+                },
+                _test_equation,
+            ),
+        )
+    }
+    | CLASSIC_SYSTEMS
+    | GRAVITY_SYSTEMS
+)

@@ -185,6 +185,7 @@ def render_video(
     size: tuple[int, int] = (960, 540),
     camera: Camera | None = None,
     progress: bool | None = None,
+    speed: float = 1.0,
 ) -> Path:
     """Render a recording's geometry to an mp4 or GIF file.
 
@@ -199,6 +200,8 @@ def render_video(
             everything stays in view for the whole clip.
         progress: Show a progress bar on stderr for long renders; ``None`` (default): only
             when stderr is a terminal.
+        speed: Simulated seconds per second of video (1: real time; 86400: a day per
+            second). The time label shows simulated time.
 
     Returns:
         The path written.
@@ -242,7 +245,7 @@ def render_video(
             f"`path` {os.fspath(path)!r}: directory {os.fspath(target.parent)!r} does not "
             "exist; create it first"
         )
-    shown = frames_at_rate(recording.time, fps)
+    shown = frames_at_rate(recording.time, fps, speed=speed)
 
     if camera is None:
         camera = Camera.framing(drawn_bounds(geometry), aspect=width / height)

@@ -138,6 +138,7 @@ def export_recording(
     *,
     to: str | None = None,
     fps: float | None = None,
+    speed: float = 1.0,
 ) -> list[Path]:
     """Export a recording's geometry as USD, glTF 2.0, an OBJ sequence or a PC2 point cache.
 
@@ -156,6 +157,8 @@ def export_recording(
         fps: Output frames per second [1/s]; output frame ``k`` shows the recorded frame
             nearest ``t0 + k/fps``. Default: the recording's own rate if its frames are evenly
             spaced, else :data:`FALLBACK_FPS` (see :func:`default_fps`).
+        speed: Simulated seconds per second of playback (output frame ``k`` shows the
+            recorded frame nearest ``t0 + k·speed/fps``): 86400 plays a day per second.
 
     Returns:
         The files written, in order (one, or one per frame for OBJ, or ``.gltf`` and ``.bin``).
@@ -183,7 +186,7 @@ def export_recording(
     target = Path(path)
     fmt = _resolve_format(target, to)
     _check_target(target, fmt)
-    frames = prepare(recording, fps)
+    frames = prepare(recording, fps, speed)
     suffix = target.suffix.lower()
     if fmt in ("usd", "usda", "usdc"):
         from .usd import write_usd

@@ -13,7 +13,6 @@ quaternion per body per frame) becomes one more field here and one more part in 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,15 +21,12 @@ import numpy as np
 from ..._validation import real_number
 from ...errors import ModelError
 from ..recording import Geometry, Recording
-from ..timeline import frames_at_rate
+from ..timeline import MAX_OUTPUT_FRAMES, frames_at_rate
 
 __all__ = ["FALLBACK_FPS", "MAX_OUTPUT_FRAMES", "ExportFrames", "default_fps", "prepare"]
 
 #: Output rate [frames/s] when the recorded frames are not evenly spaced (or there is only one).
 FALLBACK_FPS = 30.0
-#: Most output frames one export may have: a million frames is ~9 hours at 30 frames/s; more
-#: is almost surely an `fps` typed in the wrong unit.
-MAX_OUTPUT_FRAMES = 1_000_000
 #: Relative tolerance on frame spacing for a recording to count as evenly spaced, and on its
 #: rate for that rate to be rounded to a whole number of frames per second.
 _EVEN_SPACING_RTOL = 1e-6
@@ -93,8 +89,10 @@ class ExportFrames:
         time: Recorded frame times [s], shape ``(frames,)``.
         shown: Index of the recorded frame shown at each output frame, int64, shape
             ``(count,)``.
-        fps: Output frames per second [1/s]; output frame ``k`` is at ``time[0] + k/fps``.
+        fps: Output frames per second [1/s]; output frame ``k`` is at
+            ``time[0] + k·speed/fps``.
         name: Name for the exported object (the recording's ``scene_name``, else "visviva").
+        speed: Simulated seconds per second of playback.
     """
 
     geometry: Geometry
@@ -102,6 +100,7 @@ class ExportFrames:
     shown: np.ndarray
     fps: float
     name: str
+    speed: float = 1.0
 
     @property
     def count(self) -> int:
@@ -156,12 +155,14 @@ def _scene_name(attrs: dict[str, Any]) -> str:
     return value.strip() if isinstance(value, str) and value.strip() else "visviva"
 
 
-def prepare(recording: Recording, fps: float | None) -> ExportFrames:
+def prepare(recording: Recording, fps: float | None, speed: float = 1.0) -> ExportFrames:
     """Check ``recording`` and ``fps`` and choose the recorded frame of every output frame.
 
     Args:
         recording: A recording with a ``points`` field (see :meth:`Recording.geometry`).
-        fps: Output frames per second [1/s], or ``None`` for :func:`default_fps`.
+        fps: Output frames per second [1/s], or ``None`` for :func:`default_fps` of the
+            recording played at ``speed``.
+        speed: Simulated seconds per second of playback.
 
     Raises:
         ModelError: If the recording has no points or no frames, ``fps`` is not a positive
@@ -183,18 +184,12 @@ def prepare(recording: Recording, fps: float | None) -> ExportFrames:
     time = recording.time
     if time.size == 0:
         raise ModelError("the recording has no frames; there is nothing to export")
+    speed = real_number("speed", speed, positive=True, unit=" simulated s per s")
     if fps is None:
-        rate = default_fps(time)
+        rate = default_fps(time / speed)
     else:
         rate = real_number("fps", fps, positive=True, unit=" frames/s")
-    span = float(time[-1] - time[0])
-    if span * rate >= MAX_OUTPUT_FRAMES:
-        raise ModelError(
-            f"`fps` = {rate:g} frames/s over the recording's {span:g} s gives "
-            f"{math.floor(span * rate) + 1} output frames, more than {MAX_OUTPUT_FRAMES}; "
-            "pass a lower fps (frames per second, e.g. 30)"
-        )
-    shown = frames_at_rate(time, rate)
+    shown = frames_at_rate(time, rate, speed=speed)
     for k in np.unique(shown):
         bad = ~np.isfinite(points[k])
         if bad.any():
@@ -204,4 +199,4 @@ def prepare(recording: Recording, fps: float | None) -> ExportFrames:
                 f"point {point} ({points[k, point].tolist()}): the run diverged there; re-run "
                 "it with a smaller step, or export a recording that ends before that frame"
             )
-    return ExportFrames(geometry, time, shown, rate, _scene_name(recording.attrs))
+    return ExportFrames(geometry, time, shown, rate, _scene_name(recording.attrs), speed)

@@ -102,7 +102,7 @@ def _check_size(frames: ExportFrames, index_count: int) -> None:
     b = points * _VEC3_BYTES + _SCALAR_BYTES
     c = points * _VEC3_BYTES + index_count * _SCALAR_BYTES - MAX_GLTF_BYTES
     fits = math.floor((-b + math.sqrt(b * b - 16 * c)) / 8) if c <= 0 else 0
-    span = float(frames.time[-1] - frames.time[0])
+    span = float(frames.time[-1] - frames.time[0]) / frames.speed  # seconds of playback
     if fits >= 2 and span > 0.0:
         advice = f"pass fps ≤ {_round_down((fits - 1) / span):g} frames/s, or export to usd or pc2"
     else:
@@ -248,7 +248,12 @@ def write_gltf(frames: ExportFrames, path: Path, *, binary: bool) -> list[Path]:
         asset=gl.Asset(
             generator=f"visviva {__version__}",
             version="2.0",
-            extras={"fps": frames.fps, "start_time_s": float(frames.time[0]), "units": "m"},
+            extras={
+                "fps": frames.fps,
+                "speed": frames.speed,
+                "start_time_s": float(frames.time[0]),
+                "units": "m",
+            },
         ),
         scene=0,
         scenes=[gl.Scene(nodes=[0])],

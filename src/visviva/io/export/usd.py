@@ -144,8 +144,8 @@ def write_usd(frames: ExportFrames, path: Path, *, encoding: str) -> list[Path]:
     first = float(frames.time[0])
     stage.GetRootLayer().documentation = (
         f"visviva {__version__} export of {frames.name!r}: {frames.count} frames at "
-        f"{frames.fps:.9g} frames/s; time code k is {first!r} s + k/{frames.fps:.9g} s of the "
-        "simulation; metres, Y up"
+        f"{frames.fps:.9g} frames/s; time code k is {first!r} s + k·{frames.speed:.9g}/"
+        f"{frames.fps:.9g} s of the simulation; metres, Y up"
     )
     world = UsdGeom.Xform.Define(stage, "/World")
     stage.SetDefaultPrim(world.GetPrim())

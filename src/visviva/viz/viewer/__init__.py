@@ -64,17 +64,19 @@ def _recorded_rate(time: np.ndarray) -> float | None:
     return None
 
 
-def _frame_count(time: np.ndarray, fps: float) -> int:
-    return int(frames_at_rate(time[[0, -1]], fps).size)
+def _frame_count(time: np.ndarray, fps: float, speed: float) -> int:
+    return int(frames_at_rate(time[[0, -1]], fps, speed=speed).size)
 
 
-def default_fps(recording: Recording) -> float:
+def default_fps(recording: Recording, speed: float = 1.0) -> float:
     """The playback rate [frames/s] :func:`write_viewer` uses when ``fps`` is not given.
 
     The recording's own rate if its frames are evenly spaced, divided by the smallest whole
     number that brings it to at most :data:`MAX_DEFAULT_FPS` (so every n-th frame is shown,
     without jitter); :data:`FALLBACK_FPS` for uneven frames. If the frames at that rate would
     exceed :data:`MAX_POSITION_BYTES`, the rate is lowered until they fit, with a warning.
+    Played at ``speed`` simulated seconds per second, the recording's own rate is divided by
+    ``speed``.
 
     Example:
         >>> import numpy as np, visviva as vv
@@ -83,7 +85,8 @@ def default_fps(recording: Recording) -> float:
         58.824
     """
     geometry = recording.geometry()
-    time = recording.time
+    speed = real_number("speed", speed, positive=True, unit=" simulated s per s")
+    time = recording.time / speed  # playback time [s]
     if time.size == 0:
         raise ModelError("the recording has no frames: there is nothing to play")
     rate = _recorded_rate(time)
@@ -100,7 +103,7 @@ def default_fps(recording: Recording) -> float:
             f"more than the viewer's limit of {MAX_POSITION_BYTES} bytes of positions; export "
             "to USD or glTF instead"
         )
-    if _frame_count(time, fps) > budget_frames:
+    if _frame_count(time, fps, 1.0) > budget_frames:
         fps = (budget_frames - 1) / span if budget_frames > 1 else 1.0 / (2.0 * span)
         warnings.warn(
             f"the viewer plays this recording at {fps:.3g} frames/s so that its positions stay "
@@ -111,12 +114,12 @@ def default_fps(recording: Recording) -> float:
     return fps
 
 
-def _check_fps(recording: Recording, fps: float | None) -> float:
+def _check_fps(recording: Recording, fps: float | None, speed: float) -> float:
     if fps is None:
-        return default_fps(recording)
+        return default_fps(recording, speed)
     value = real_number("fps", fps, positive=True, unit=" frames/s")
     points = recording.geometry().points.shape[1]
-    size = _frame_count(recording.time, value) * max(1, points) * _BYTES_PER_POINT_FRAME
+    size = _frame_count(recording.time, value, speed) * max(1, points) * _BYTES_PER_POINT_FRAME
     if size > MAX_POSITION_BYTES:
         raise ModelError(
             f"`fps` = {value:g} frames/s embeds {size / 2**20:.0f} MiB of positions, more than "
@@ -173,6 +176,7 @@ def write_viewer(
     *,
     fps: float | None = None,
     title: str | None = None,
+    speed: float = 1.0,
 ) -> Path:
     """Write ``recording``'s animation as one self-contained HTML file.
 
@@ -188,6 +192,8 @@ def write_viewer(
         fps: Playback rate [frames/s]; output frame ``k`` shows the recorded frame nearest
             ``t0 + k/fps``. Default: :func:`default_fps`.
         title: Page title; default ``"visviva — <scene or problem name>"``.
+        speed: Simulated seconds per second of playback (1: real time); the page shows
+            simulated time.
 
     Returns:
         The path written.
@@ -209,8 +215,8 @@ def write_viewer(
         raise ModelError(f"`title` must be a string or None (got {describe(title)})")
     target = _check_target(path)
     _check_finite(geometry.points)
-    rate = _check_fps(recording, fps)
-    shown = frames_at_rate(recording.time, rate)
+    rate = _check_fps(recording, fps, speed)
+    shown = frames_at_rate(recording.time, rate, speed=speed)
     page_title = _default_title(recording) if title is None else title
     payload = encode_payload(
         geometry, recording.time, shown, fps=rate, title=page_title, attrs=recording.attrs
