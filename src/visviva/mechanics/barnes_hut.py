@@ -1,75 +1,70 @@
-"""Barnes–Hut octree gravity: far groups of bodies act through their multipoles.
+"""Barnes–Hut gravity: far groups of bodies act through their multipoles, in O(N log N).
 
 J. Barnes & P. Hut, "A hierarchical O(N log N) force-calculation algorithm", Nature 324 (1986)
-446; group walks: J. Barnes, J. Comput. Phys. 87 (1990) 161; opening criterion with the cell's
-true extent: J. K. Salmon & M. S. Warren, J. Comput. Phys. 111 (1994) 136.
+446; group walks: J. Barnes, J. Comput. Phys. 87 (1990) 161; opening test with the cell's true
+extent: J. K. Salmon & M. S. Warren, J. Comput. Phys. 111 (1994) 136. The tree itself is
+built in :mod:`visviva.mechanics.octree`.
 
-Build: the root cell is the bounding box of all bodies. A cell with more than ``LEAF_SIZE``
-bodies is split at the centre of the bounding box of *its own* bodies into up to eight
-children (an axis shorter than half the longest is not split, so flat sets such as disks get
-flat cells); each child again takes the bounding box of its bodies. Bodies are reordered so
-that every cell is a contiguous range (Morton-like order), and cells live in flat arrays.
-
-Moments: each cell keeps its mass, centre of mass and second moment
-``I = Σ m d dᵀ`` (``d`` from the centre of mass), combined bottom-up with the parallel-axis
-rule, and the radius ``b`` of the sphere about the centre of mass holding its massive bodies.
 Far cells act through the Plummer-softened expansion to second order (monopole + quadrupole;
-the dipole vanishes about the centre of mass). For ``s = r² + ε²``, ``r`` from the centre of
-mass to the body, ``T = tr I``:
+the dipole vanishes about the centre of mass). For ``s = r² + ε²``, ``r`` from the cell's
+centre of mass to the body, ``M`` its mass, ``I`` its second moment and ``T = tr I``:
 
     φ = −G [M s^{-1/2} + ½ (3 rᵀIr s^{-5/2} − T s^{-3/2})]
     a = G [−M s^{-3/2} r + 3 s^{-5/2} I r − (15/2) rᵀIr s^{-7/2} r + (3/2) T s^{-5/2} r]
 
-Walk: one walk per leaf serves all its bodies. A cell is used whole if the distance from its
-centre of mass to the leaf's bounding box exceeds ``b / theta``; otherwise it is opened, and an
-opened leaf's bodies interact directly. The leaf's own bodies interact pairwise. Leaves are
-walked in parallel (no shared writes); each walk fills a contiguous interaction list that the
-force loop then runs through at SIMD speed.
+The quadrupole costs about 2× a monopole per cell but cuts the error 3–6× at a given
+``theta``: for the same accuracy a monopole code needs ``theta`` about 0.6× as large, and so
+about 4× as many cells.
 
-Accuracy (measured, relative force error ``|a − a_direct| / |a_direct|`` over bodies, Plummer
-sphere of 10⁶ bodies in N-body units, ε = 0.01, 20,000 bodies sampled; ``docs/gravitation.md``
-has the timings and smaller N):
+Walk: one walk serves a *group* (the largest cell with at most :data:`GROUP_SIZE` bodies). A
+cell is used whole if the distance from its centre of mass to the group's bounding box exceeds
+``b / theta``, ``b`` the radius of the cell's massive bodies about their centre of mass; a cell
+whose mass sits at one point is exact at any distance (with softening). Otherwise it is opened,
+and an opened leaf's bodies interact directly, the group's own bodies included. Every body of
+the system thus appears exactly once in a group's lists. Groups are walked in parallel (each
+writes only its own bodies), and each walk fills contiguous interaction lists that the force
+loops then run through at SIMD speed.
 
-    theta   median    99th percentile
-    0.3     TBD       TBD
-    0.5     TBD       TBD
-    0.7     TBD       TBD
-    1.0     TBD       TBD
+Accuracy: relative force error ``|a − a_direct| / |a_direct|`` over bodies, Plummer spheres in
+N-body units with ε = 0.01 (10⁵ bodies, all compared; 10⁶ bodies in ``docs/gravitation.md``).
+:data:`ERROR_BOUNDS` are the documented bounds (tested):
 
-Degenerate input: coincident bodies always share a leaf. A leaf whose bodies all sit at one
-point (the whole set, at the extreme) is never split and costs no pair loop: its bodies exert
-no force on one another (with softening; without it :func:`gravity_accelerations` refuses
-them), and their mutual potential is ``−G m_i (M_leaf − m_i) / ε`` in closed form. A cell
-whose bodies are too close to split in floating point (within a few units in the last place)
-becomes a leaf whatever its size, so the build ends on any input: depth is bounded by the
-exponent range of a float64, and each level of the build is one pass over the bodies below it.
-``N = 1`` gives a zero acceleration, ``N = 2`` a single leaf (exact). Huge coordinate ranges
-cost nothing special: cells shrink to their own bodies, so a distant outlier adds one level.
+    theta   median    99th percentile    bound (median, 99th)
+    0.3     4.0e-5    3.2e-4             1e-4, 1e-3
+    0.5     2.2e-4    1.7e-3             5e-4, 5e-3
+    0.7     6.8e-4    5.3e-3             1.5e-3, 1.5e-2
+    1.0     3.0e-3    2.8e-2             6e-3, 8e-2
+
+Degenerate input (see also :mod:`~visviva.mechanics.octree`): ``N = 1`` gives a zero
+acceleration; up to :data:`GROUP_SIZE` bodies form one group, so the result is direct
+summation. Bodies at one point exert no force on one another (with softening; without it
+:func:`~visviva.mechanics.gravity_accelerations` refuses them, found from the leaves before any
+force is computed) and their mutual potential is exact.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit, prange
 
+from .octree import Octree, build_octree, cell_moments
+
 if TYPE_CHECKING:
     from .gravity import PointMasses
 
-__all__ = ["LEAF_SIZE", "Octree", "build_octree", "tree_gravity"]
+__all__ = ["ERROR_BOUNDS", "GROUP_SIZE", "tree_gravity"]
 
-#: Bodies per leaf (at most, unless they cannot be split). An opened leaf's bodies interact
-#: directly. Measured with 10⁶ Plummer bodies: 8–16 within 5% of each other.
-LEAF_SIZE = 16
+#: Documented accuracy per opening angle: bounds on the median and the 99th percentile of the
+#: relative force error against direct summation, for Plummer spheres of 10⁴–10⁶ bodies
+#: (measured values in the module docstring and docs/gravitation.md, about 1.5× below these).
+ERROR_BOUNDS = {0.3: (1e-4, 1e-3), 0.5: (5e-4, 5e-3), 0.7: (1.5e-3, 1.5e-2), 1.0: (6e-3, 8e-2)}
 
 #: Bodies per group (at most, unless a leaf is larger): one walk serves a whole group. Larger
 #: groups walk less often but must open more cells (the test is against the whole group's box):
 #: 128 was fastest at theta 0.5 and 0.7 (64: +15%, 256: +3%).
 GROUP_SIZE = 128
-
-#: An axis is split only if it is at least this fraction of the cell's longest axis.
-_SPLIT_FRACTION = 0.5
 
 #: Groups per parallel work item: enough to amortise the interaction-list buffers, few enough
 #: to balance the cores.
@@ -81,229 +76,6 @@ _LIST_CAPACITY = 2048
 # The tree force makes no exact-symmetry promise (it is an approximation), so its sums and
 # products may be re-associated; NaN and infinity stay honoured. See gravity.py.
 _FAST = {"contract", "arcp", "nsz", "afn", "reassoc"}
-
-
-class Octree(NamedTuple):
-    """The tree over ``N`` bodies with ``K`` cells; cell 0 is the root.
-
-    Attributes:
-        order: Body index at each tree position, shape ``(N,)``.
-        x, y, z: Body coordinates in tree order [m], shape ``(N,)`` each.
-        start, size: Each cell's range of tree positions, shape ``(K,)`` each.
-        first_child: Index of a cell's first child (children are contiguous), −1 for a leaf.
-        children: Number of children, shape ``(K,)``.
-        lower, upper: Bounding box of each cell's bodies [m], shape ``(K, 3)`` each.
-        depth: Largest depth below the root.
-    """
-
-    order: np.ndarray
-    x: np.ndarray
-    y: np.ndarray
-    z: np.ndarray
-    start: np.ndarray
-    size: np.ndarray
-    first_child: np.ndarray
-    children: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-    depth: int
-
-
-@njit(cache=True)
-def _bounds(x, y, z, start, count, lower, upper):  # pragma: no cover - compiled
-    """Store the bounding box of bodies ``start .. start+count-1`` into ``lower`` and ``upper``."""
-    lx, ly, lz = x[start], y[start], z[start]
-    hx, hy, hz = lx, ly, lz
-    for p in range(start + 1, start + count):
-        lx, hx = min(lx, x[p]), max(hx, x[p])
-        ly, hy = min(ly, y[p]), max(hy, y[p])
-        lz, hz = min(lz, z[p]), max(hz, z[p])
-    lower[0], lower[1], lower[2] = lx, ly, lz
-    upper[0], upper[1], upper[2] = hx, hy, hz
-
-
-@njit(cache=True)
-def _partition(columns, scratch, codes, start, count, centre, split, sizes):  # pragma: no cover
-    """Reorder the range of every column by octant about ``centre``; fill ``sizes`` (8,)."""
-    x, y, z = columns[0], columns[1], columns[2]
-    sizes[:] = 0
-    for p in range(start, start + count):
-        code = 0
-        if split[0] and x[p] > centre[0]:
-            code |= 1
-        if split[1] and y[p] > centre[1]:
-            code |= 2
-        if split[2] and z[p] > centre[2]:
-            code |= 4
-        codes[p] = code
-        sizes[code] += 1
-    # sizes[8:16] serve as the running write positions.
-    sizes[8] = start
-    for c in range(1, 8):
-        sizes[8 + c] = sizes[8 + c - 1] + sizes[c - 1]
-    for p in range(start, start + count):
-        target = sizes[8 + codes[p]]
-        sizes[8 + codes[p]] += 1
-        for column in range(columns.shape[0]):
-            scratch[column, target] = columns[column, p]
-    for column in range(columns.shape[0]):
-        for p in range(start, start + count):
-            columns[column, p] = scratch[column, p]
-
-
-@njit(cache=True)
-def _build(x, y, z, leaf_size):  # pragma: no cover - compiled
-    n = x.shape[0]
-    capacity = 2 * n  # every split makes at least two non-empty children
-    # Coordinates and original indices (as floats: exact below 2**53) are reordered together,
-    # so that every pass reads memory in order.
-    columns = np.empty((4, n))
-    columns[0], columns[1], columns[2] = x, y, z
-    columns[3] = np.arange(n)
-    scratch = np.empty((4, n))
-    codes = np.empty(n, np.int64)
-    sizes = np.empty(16, np.int64)
-    centre = np.empty(3)
-    split = np.empty(3, np.bool_)
-    start = np.empty(capacity, np.int64)
-    count = np.empty(capacity, np.int64)
-    first_child = np.full(capacity, -1, np.int64)
-    children = np.zeros(capacity, np.int64)
-    level = np.zeros(capacity, np.int64)
-    lower = np.empty((capacity, 3))
-    upper = np.empty((capacity, 3))
-    start[0], count[0] = 0, n
-    cells = 1
-    k = 0
-    while k < cells:  # breadth first: children are appended after every existing cell
-        _bounds(columns[0], columns[1], columns[2], start[k], count[k], lower[k], upper[k])
-        longest = 0.0
-        for axis in range(3):
-            longest = max(longest, upper[k, axis] - lower[k, axis])
-        if count[k] > leaf_size and longest > 0.0:
-            for axis in range(3):
-                centre[axis] = 0.5 * lower[k, axis] + 0.5 * upper[k, axis]  # no overflow
-                split[axis] = upper[k, axis] - lower[k, axis] >= _SPLIT_FRACTION * longest
-            _partition(columns, scratch, codes, start[k], count[k], centre, split, sizes)
-            if sizes[:8].max() < count[k]:  # else the bodies are too close to separate
-                first_child[k] = cells
-                offset = start[k]
-                for code in range(8):
-                    if sizes[code] > 0:
-                        start[cells], count[cells] = offset, sizes[code]
-                        level[cells] = level[k] + 1
-                        offset += sizes[code]
-                        cells += 1
-                children[k] = cells - first_child[k]
-        k += 1
-    order = columns[3].astype(np.int64)
-    return (
-        order,
-        columns[0].copy(),
-        columns[1].copy(),
-        columns[2].copy(),
-        start[:cells].copy(),
-        count[:cells].copy(),
-        first_child[:cells].copy(),
-        children[:cells].copy(),
-        lower[:cells].copy(),
-        upper[:cells].copy(),
-        level[:cells].max(),
-    )
-
-
-def build_octree(bodies: PointMasses, leaf_size: int = LEAF_SIZE) -> Octree:
-    """Build the octree over checked bodies (see the module docstring)."""
-    order, x, y, z, start, size, first_child, children, lower, upper, depth = _build(
-        bodies.x, bodies.y, bodies.z, leaf_size
-    )
-    return Octree(order, x, y, z, start, size, first_child, children, lower, upper, int(depth))
-
-
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
-def _leaf_moments(x, y, z, m, first, last):  # pragma: no cover - compiled
-    """Mass, centre of mass, second moment and radius² of bodies ``first .. last-1``."""
-    total = 0.0
-    cx = 0.0
-    cy = 0.0
-    cz = 0.0
-    for p in range(first, last):
-        total += m[p]
-        cx += m[p] * x[p]
-        cy += m[p] * y[p]
-        cz += m[p] * z[p]
-    if total > 0.0:
-        cx, cy, cz = cx / total, cy / total, cz / total
-    else:  # a massless cell acts on nothing; its centre is only a place to measure from
-        cx, cy, cz = x[first], y[first], z[first]
-    second = np.zeros(6)
-    radius2 = 0.0
-    for p in range(first, last):
-        dx, dy, dz = x[p] - cx, y[p] - cy, z[p] - cz
-        _add_second_moment(second, m[p], dx, dy, dz)
-        if m[p] > 0.0:
-            radius2 = max(radius2, dx * dx + dy * dy + dz * dz)
-    return total, (cx, cy, cz), second, radius2
-
-
-@njit(cache=True, fastmath=_FAST, error_model="numpy")
-def _moments(tree, m):  # pragma: no cover - compiled
-    """Mass, centre of mass, second moment (xx yy zz xy xz yz) and radius² of every cell.
-
-    ``m`` holds the masses in tree order. Cells are combined bottom-up: children always come
-    after their parent.
-    """
-    x, y, z, start, count, first_child, children, lower, upper = tree
-    cells = start.shape[0]
-    mass = np.zeros(cells)
-    centre = np.empty((cells, 3))
-    second = np.zeros((cells, 6))
-    radius2 = np.zeros(cells)
-    for k in range(cells - 1, -1, -1):
-        if first_child[k] < 0:
-            total, c, moment, r2 = _leaf_moments(x, y, z, m, start[k], start[k] + count[k])
-            mass[k], radius2[k] = total, r2
-            centre[k, 0], centre[k, 1], centre[k, 2] = c
-            second[k] = moment
-            continue
-        children_of = range(first_child[k], first_child[k] + children[k])
-        total = 0.0
-        for child in children_of:
-            total += mass[child]
-        for axis in range(3):
-            weighted = 0.0
-            for child in children_of:
-                weighted += mass[child] * centre[child, axis]
-            middle = 0.5 * lower[k, axis] + 0.5 * upper[k, axis]
-            centre[k, axis] = weighted / total if total > 0.0 else middle
-        radius = 0.0
-        for child in children_of:
-            dx = centre[child, 0] - centre[k, 0]
-            dy = centre[child, 1] - centre[k, 1]
-            dz = centre[child, 2] - centre[k, 2]
-            second[k] += second[child]  # parallel-axis rule
-            _add_second_moment(second[k], mass[child], dx, dy, dz)
-            if mass[child] > 0.0:
-                reach = np.sqrt(dx * dx + dy * dy + dz * dz) + np.sqrt(radius2[child])
-                radius = max(radius, reach)
-        mass[k] = total
-        # The farthest corner of the cell's box bounds it too; keep the tighter bound.
-        corner = 0.0
-        for axis in range(3):
-            far = max(centre[k, axis] - lower[k, axis], upper[k, axis] - centre[k, axis])
-            corner += far * far
-        radius2[k] = min(radius * radius, corner)
-    return mass, centre, second, radius2
-
-
-@njit(cache=True, fastmath=_FAST)
-def _add_second_moment(moment, m, dx, dy, dz):  # pragma: no cover - compiled
-    moment[0] += m * dx * dx
-    moment[1] += m * dy * dy
-    moment[2] += m * dz * dz
-    moment[3] += m * dx * dy
-    moment[4] += m * dx * dz
-    moment[5] += m * dy * dz
 
 
 # Interaction lists, structure of arrays. Cell rows: centre of mass (3), mass, 1.5 T and
@@ -496,7 +268,7 @@ def tree_gravity(
     acc: np.ndarray,
     potential: np.ndarray | None,
     *,
-    leaf_size: int = LEAF_SIZE,
+    leaf_size: int | None = None,
     group_size: int = GROUP_SIZE,
 ) -> bool:
     """Barnes–Hut accelerations ``factor · Σ_j m_j (x_j − x_i) / r³`` into ``acc`` ``(N, 3)``.
@@ -505,12 +277,12 @@ def tree_gravity(
     those of ``bodies`` (scaled). Returns ``False`` without computing anything if two bodies
     coincide and there is no softening (the caller turns that into an error).
     """
-    tree = build_octree(bodies, leaf_size)
+    tree = build_octree(bodies) if leaf_size is None else build_octree(bodies, leaf_size)
     arrays = tuple(tree)[1:-1]
     if bodies.eps2 == 0.0 and _coincident_bodies(arrays):
         return False
     ms = bodies.mass[tree.order]
-    moments = _moments(arrays, ms)
+    moments = cell_moments(arrays, ms)
     target = np.empty(0) if potential is None else potential  # empty: not wanted
     _tree_forces(
         _groups(tree, group_size),

@@ -156,7 +156,7 @@ def disk_galaxy(
         radius: Outer radius of the disk [m].
         G: Constant of gravitation [m³/(kg s²)].
         softening: The Plummer softening the simulation will use [m] (enters ``v``).
-        center, velocity: Position [m] and velocity [m/s] of the whole galaxy.
+        center, velocity: Centre of mass [m] and its velocity [m/s] of the whole galaxy.
         normal: Axis of rotation (the disk's normal); +y by default (Y up).
         seed: Seed or generator for ``numpy.random.default_rng``.
     """
@@ -179,7 +179,9 @@ def disk_galaxy(
     masses = np.concatenate([[centre_mass], np.full(count, disk / count)])
     positions = np.vstack([np.zeros(3), positions])
     velocities = np.vstack([np.zeros(3), velocities])
-    # The disk's momentum is zero only on average: hand it back to the centre.
+    # The disk's mass centre and momentum are zero only on average: move the central body so
+    # that the galaxy's centre of mass is exactly `center` and its momentum exactly M·velocity.
+    positions[0] -= masses[1:] @ positions[1:] / centre_mass
     velocities[0] -= masses[1:] @ velocities[1:] / centre_mass
     return Bodies(
         positions + _vector("center", center),

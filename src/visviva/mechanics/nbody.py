@@ -42,7 +42,7 @@ __all__ = ["COMPILED_MAX_BODIES", "Bodies", "nbody_problem"]
 #: acceleration: below it, the cost of a step is Python overhead, not arithmetic.
 COMPILED_MAX_BODIES = 8
 
-_COMPILED: dict[tuple[Any, ...], Callable[..., None]] = {}
+_COMPILED: dict[tuple[Any, ...], tuple[Callable[..., None], Callable[..., float]]] = {}
 
 
 @dataclass(frozen=True)
@@ -153,19 +153,23 @@ def _checked_state(
     return checked, velocity, mass, batched
 
 
-def _compiled_acceleration(masses: np.ndarray, G: float, eps2: float) -> Callable[..., None]:
-    """``acceleration(t, q, out)`` for one system of few bodies, compiled with Numba.
+def _compiled_functions(
+    masses: np.ndarray, G: float, eps2: float
+) -> tuple[Callable[..., None], Callable[..., float]]:
+    """``acceleration(t, q, out)`` and ``energy(t, q, v)`` for one system of few bodies.
 
-    Each pair is visited once and its force applied to both bodies (Newton's third law). With
-    ``eps2 = 0`` two bodies meeting exactly give a non-finite acceleration, which the
-    simulation's divergence watch reports.
+    Compiled with Numba, the masses frozen in as constants (one compilation per set of masses,
+    kept for the session). Each pair is visited once and its force applied to both bodies
+    (Newton's third law). With ``eps2 = 0`` two bodies meeting exactly give a non-finite
+    acceleration, which the simulation's divergence watch reports.
     """
     key = (tuple(float(m) for m in masses), G, eps2)
     if key not in _COMPILED:
         import numba
 
-        gm = G * np.array(key[0])  # frozen into the compiled code as a constant
-        n = gm.shape[0]
+        m = np.array(key[0])
+        gm = G * m
+        n = m.shape[0]
 
         @numba.njit(error_model="numpy")
         def acceleration(t, q, out):  # pragma: no cover - compiled
@@ -182,7 +186,20 @@ def _compiled_acceleration(masses: np.ndarray, G: float, eps2: float) -> Callabl
                         out[3 * i + axis] += gm[j] * inverse_cube * d
                         out[3 * j + axis] -= gm[i] * inverse_cube * d
 
-        _COMPILED[key] = acceleration
+        @numba.njit(error_model="numpy")
+        def energy(t, q, v):  # pragma: no cover - compiled
+            total = 0.0
+            for i in range(n):
+                speed2 = v[3 * i] ** 2 + v[3 * i + 1] ** 2 + v[3 * i + 2] ** 2
+                total += 0.5 * m[i] * speed2
+                for j in range(i + 1, n):
+                    dx = q[3 * j] - q[3 * i]
+                    dy = q[3 * j + 1] - q[3 * i + 1]
+                    dz = q[3 * j + 2] - q[3 * i + 2]
+                    total -= gm[i] * m[j] / np.sqrt(dx * dx + dy * dy + dz * dz + eps2)
+            return total
+
+        _COMPILED[key] = (acceleration, energy)
     return _COMPILED[key]
 
 
@@ -236,14 +253,15 @@ def nbody_problem(
     if compiled:
         for system in x:  # the compiled acceleration cannot name coincident bodies itself
             gravity_accelerations(system, m, G=gravity, softening=epsilon)
-        acceleration: Callable[..., Any] = _compiled_acceleration(m, gravity, epsilon**2)
+        acceleration, energy = _compiled_functions(m, gravity, epsilon**2)
     else:
         acceleration = _kernel_acceleration(m, gravity, epsilon, method, theta)
+        energy = _energy_function(m, gravity, epsilon, method, theta)
     return SecondOrderProblem(
         acceleration,
         x.reshape(shape),
         v.reshape(shape),
-        energy=_energy_function(m, gravity, epsilon, method, theta),
+        energy=energy,
         name=str(name),
     )
 
