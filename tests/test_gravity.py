@@ -193,6 +193,29 @@ def test_barnes_hut_within_its_documented_error():
         assert np.percentile(error, 99) <= p99, theta
 
 
+def test_tree_force_error_measures_against_direct_summation():
+    """All bodies compared: the same figures as comparing the two methods by hand; a sample of
+    them: close to those figures (the median of 1500 draws is within a few percent)."""
+    cluster = mech.plummer_sphere(3000, total_mass=1.0, scale_radius=1.0, G=1.0, seed=16)
+    args = (cluster.positions, cluster.masses)
+    options = {"G": 1.0, "softening": 0.01, "theta": 0.7}
+    exact = mech.gravity_accelerations(*args, G=1.0, softening=0.01)
+    tree = mech.gravity_accelerations(*args, method="barnes_hut", **options)
+    by_hand = np.linalg.norm(tree - exact, axis=1) / np.linalg.norm(exact, axis=1)
+    everything = mech.tree_force_error(*args, sample=10**6, **options)
+    assert everything.compared == 3000 and everything.theta == 0.7
+    assert everything.median == pytest.approx(np.median(by_hand), rel=1e-9)
+    assert everything.p99 == pytest.approx(np.percentile(by_hand, 99), rel=1e-9)
+    assert everything.largest == pytest.approx(by_hand.max(), rel=1e-9)
+    sampled = mech.tree_force_error(*args, sample=1500, seed=2, **options)
+    assert sampled.compared == 1500
+    assert sampled.median == pytest.approx(everything.median, rel=0.1)
+    with pytest.raises(ModelError, match=r"`sample` must be at least 1"):
+        mech.tree_force_error(*args, sample=0)
+    with pytest.raises(ModelError, match=r"no compared body feels any force"):
+        mech.tree_force_error([[0.0, 0.0, 0.0]], [1.0])
+
+
 def test_barnes_hut_potential_energy_is_close_to_direct():
     cluster = mech.plummer_sphere(5000, total_mass=1.0, scale_radius=1.0, G=1.0, seed=7)
     args = (cluster.positions, cluster.masses)

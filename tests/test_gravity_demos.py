@@ -47,6 +47,9 @@ def test_galaxy_demo_runs(tmp_path):
     data = summary(tmp_path)
     assert data["bodies"] == 3002
     assert data["max_energy_change_over_initial_kinetic"] < 1e-3
+    tree = data["barnes_hut_force_error"]
+    assert tree["theta"] == 0.5
+    assert 0.0 < tree["median"] <= vv.mechanics.barnes_hut.ERROR_BOUNDS[0.5][0]
 
 
 def scene(system: str, parameters: str, duration: float = 1.0) -> str:

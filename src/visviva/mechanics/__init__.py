@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from . import chaos, classic
+from .barnes_hut import TreeError, tree_force_error
 from .classic import (
     constrained_pendulum,
     damped_oscillator,
@@ -27,6 +28,7 @@ __all__: list[str] = [
     "Bodies",
     "KeplerOrbit",
     "LagrangianSystem",
+    "TreeError",
     "chaos",
     "classic",
     "colliding_disks",
@@ -45,4 +47,5 @@ __all__: list[str] = [
     "rock",
     "spring_pendulum",
     "sun_earth_moon",
+    "tree_force_error",
 ]

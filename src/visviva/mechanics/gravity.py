@@ -72,8 +72,9 @@ def _pair_weight(row_mass, mass, r2):  # pragma: no cover - compiled
 
 
 @njit(cache=True, parallel=True, fastmath=_SUMS, error_model="numpy")
-def _direct_accelerations(x, y, z, mass, row_mass, eps2, factor, out):  # pragma: no cover
-    """Fill ``out[i] = factor Σ_j F_ij / row_mass[i]``; return the number of zero-distance pairs.
+def _direct_accelerations(x, y, z, mass, row_mass, eps2, factor, targets, out):  # pragma: no cover
+    """Fill ``out[k] = factor Σ_j F_ij / row_mass[i]`` for ``i = targets[k]``; return the number
+    of zero-distance pairs.
 
     ``row_mass`` is ``mass`` except 1 for massless bodies (test particles), whose acceleration
     is then ``factor Σ_j m_j (x_j − x_i) / r³`` as it should be. The self term has a zero
@@ -82,7 +83,8 @@ def _direct_accelerations(x, y, z, mass, row_mass, eps2, factor, out):  # pragma
     """
     n = x.shape[0]
     zero_pairs = 0
-    for i in prange(n):
+    for k in prange(targets.shape[0]):
+        i = targets[k]
         xi, yi, zi, mi = x[i], y[i], z[i], row_mass[i]
         fx = 0.0
         fy = 0.0
@@ -99,9 +101,9 @@ def _direct_accelerations(x, y, z, mass, row_mass, eps2, factor, out):  # pragma
             fy += w * dy
             fz += w * dz
         scale = factor / mi
-        out[i, 0] = scale * fx
-        out[i, 1] = scale * fy
-        out[i, 2] = scale * fz
+        out[k, 0] = scale * fx
+        out[k, 1] = scale * fy
+        out[k, 2] = scale * fz
         zero_pairs += zeros
     return zero_pairs
 
@@ -262,6 +264,18 @@ def coincidence_error(bodies: PointMasses) -> ModelError:
     )
 
 
+def direct_accelerations_of(
+    targets: np.ndarray, bodies: PointMasses, factor: float, out: np.ndarray
+) -> int:
+    """Exact accelerations of the bodies ``targets`` (indices) into ``out`` ``(len(targets), 3)``,
+    in units of ``factor`` (``G`` times the mass scale); return the number of zero-distance pairs.
+    """
+    b = bodies
+    return int(
+        _direct_accelerations(b.x, b.y, b.z, b.mass, b.row_mass, b.eps2, factor, targets, out)
+    )
+
+
 def accelerations_into(
     bodies: PointMasses, G: float, method: str, theta: float, out: np.ndarray
 ) -> np.ndarray:
@@ -272,9 +286,7 @@ def accelerations_into(
     """
     factor = G * bodies.mass_scale
     if method == "direct":
-        zero_pairs = _direct_accelerations(
-            bodies.x, bodies.y, bodies.z, bodies.mass, bodies.row_mass, bodies.eps2, factor, out
-        )
+        zero_pairs = direct_accelerations_of(np.arange(bodies.count), bodies, factor, out)
         # Without softening each body's own term is one zero-distance pair.
         coincident = zero_pairs > (bodies.count if bodies.eps2 == 0.0 else 0)
     else:
