@@ -267,6 +267,18 @@ def test_barnes_hut_with_a_huge_coordinate_range():
     assert np.median(error) <= barnes_hut.ERROR_BOUNDS[0.5][0]
 
 
+def test_barnes_hut_with_masses_beyond_single_precision():
+    """Masses over 45 decades, so that some cells are lighter (relative to the heaviest body)
+    than float32 can hold: forces stay within the documented error."""
+    x, _ = random_bodies(5000, seed=17)
+    m = 10.0 ** np.random.default_rng(18).uniform(-45.0, 0.0, 5000)
+    exact = numpy_accelerations(x, m, 1.0, 0.01)
+    got = mech.gravity_accelerations(x, m, G=1.0, softening=0.01, method="barnes_hut")
+    error = np.linalg.norm(got - exact, axis=1) / np.linalg.norm(exact, axis=1)
+    assert np.median(error) <= barnes_hut.ERROR_BOUNDS[0.5][0]
+    assert np.percentile(error, 99) <= barnes_hut.ERROR_BOUNDS[0.5][1]
+
+
 def test_octree_keeps_every_body_once_and_orders_cells():
     x, m = random_bodies(5000, seed=10)
     tree = octree.build_octree(PointMasses(x, m, 0.0))

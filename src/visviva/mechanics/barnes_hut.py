@@ -25,6 +25,12 @@ the system thus appears exactly once in a group's lists. Groups are walked in pa
 writes only its own bodies), and each walk fills contiguous interaction lists that the force
 loops then run through at SIMD speed.
 
+Precision: bodies interact in double precision; far cells in single precision, relative to the
+group's centre and in units of a power of two near the system's size, which adds ~1e-7 to the
+relative error of each term (the expansion's own error is ≥ 3e-5 at any theta) and makes the
+far field 2.5× faster. Cells too near the group for that, or with masses or distances near the
+limits of float32, stay in double precision.
+
 Accuracy: relative force error ``|a − a_direct| / |a_direct|`` over bodies, Plummer spheres in
 N-body units with ε = 0.01 (10⁵ bodies, all compared; 10⁶ bodies in ``docs/gravitation.md``).
 :data:`ERROR_BOUNDS` are the documented bounds (tested):
@@ -44,6 +50,7 @@ force is computed) and their mutual potential is exact.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -70,15 +77,21 @@ ERROR_BOUNDS = {0.3: (1e-4, 1e-3), 0.5: (5e-4, 5e-3), 0.7: (1.5e-3, 1.5e-2), 1.0
 
 #: Bodies per group (at most, unless a leaf is larger): one walk serves a whole group. Larger
 #: groups walk less often but must open more cells (the test is against the whole group's box):
-#: 128 was fastest at theta 0.5 and 0.7 (64: +15%, 256: +3%).
+#: with 10⁶ Plummer bodies 128 was fastest at theta 0.5 and 1 (64: +10%, 192: within 5%).
 GROUP_SIZE = 128
 
 #: Groups per parallel work item: enough to amortise the interaction-list buffers, few enough
 #: to balance the cores.
 _GROUPS_PER_BLOCK = 16
 
-#: Initial interaction-list capacity (grows by doubling when a walk needs more).
-_LIST_CAPACITY = 2048
+#: Initial capacity of the far-cell list (θ = 0.5 with 10⁶ bodies needs ~2200 entries); the
+#: lists grow to twice what a walk needed when it needs more.
+_LIST_CAPACITY = 4096
+
+#: Extra entries per list row. A walk writes one column of 12 rows at a time; with a row
+#: length a multiple of 4 KiB all 12 would map to one set of the 8-way L1 cache and evict
+#: each other on every write (the walk ran 3× slower).
+_ROW_PADDING = 16
 
 # The tree force makes no exact-symmetry promise (it is an approximation), so its sums and
 # products may be re-associated; NaN and infinity stay honoured. See gravity.py.
@@ -89,24 +102,72 @@ _FAST = {"contract", "arcp", "nsz", "afn", "reassoc"}
 # 0.5 T (T the trace of the second moment), then J = 3 I as xx yy zz xy xz yz: the factors
 # of the expansion are folded in once per cell instead of once per interaction.
 _CELL_ROWS = 12
+
+# Far cells are evaluated in single precision (8 SIMD lanes instead of 4, and a faster square
+# root and division: 2.5× the interactions per second), lengths in units of a power of two
+# `L` near the size of the system and centres relative to the group's centre. Rounding a
+# body's and a cell's offsets costs ~6e-8 of each relative to their distance, so a term's error
+# is ~1e-7 for most cells and at most ~1e-5 for a cell 1/64 of the group's half-diagonal away,
+# below the expansion's own error (≥ 3e-5 at any theta). A cell enters the single-precision
+# list if its distance d from the group's box satisfies d ≥ (group half-diagonal) / _NEAR_RATIO
+# and d ≥ _SMALLEST_DISTANCE L (so r⁻⁵ stays within float32's range), and its mass in units of
+# the largest body's is at least _SMALLEST_MASS; other cells go to a double-precision list.
+_NEAR_RATIO = 64.0
+_SMALLEST_DISTANCE = 2.0**-20
+_SMALLEST_MASS = 2.0**-100
 # Body rows: position (3), mass.
 _BODY_ROWS = 4
 
 
 @njit(cache=True, fastmath=_FAST, error_model="numpy")
-def _walk(group, tree, moments, ms, theta2, eps2, cells, bodies, stack):  # pragma: no cover
+def _cell_records(moments, scale):  # pragma: no cover - compiled
+    """What a walk reads of each cell, packed: ``nodes`` ``(K, 5)`` (centre of mass, radius²,
+    mass) for the opening test, and ``records`` ``(K, 9)`` float32, the single-precision list's
+    rows 3–11 in units of ``scale`` (copied whole when the cell is used)."""
+    mass, centre, second, radius2 = moments
+    cells = mass.shape[0]
+    nodes = np.empty((cells, 5))
+    records = np.empty((cells, _CELL_ROWS - 3), np.float32)
+    unit2 = 1.0 / (scale * scale)
+    for k in range(cells):
+        for axis in range(3):
+            nodes[k, axis] = centre[k, axis]
+        nodes[k, 3] = radius2[k]
+        nodes[k, 4] = mass[k]
+        trace = (second[k, 0] + second[k, 1] + second[k, 2]) * unit2
+        records[k, 0] = mass[k]
+        records[k, 1] = 1.5 * trace
+        records[k, 2] = 0.5 * trace
+        for c in range(6):
+            records[k, 3 + c] = 3.0 * second[k, c] * unit2
+    return nodes, records, second
+
+
+@njit(cache=True, fastmath=_FAST, error_model="numpy")
+def _walk(group, tree, cells, ms, theta2, eps2, scale, lists, stack):  # pragma: no cover
     """Fill the interaction lists of ``group``; return their lengths.
 
-    Every body of the system ends up exactly once in the lists: inside a cell used whole, or
-    as a body (the group's own bodies included). Entries beyond a list's capacity are counted
-    but not written: the caller then grows the list and walks again. (Growing inside the loop
-    would make the lists loop-carried references, whose reference counting costs more than the
-    walk itself.)
+    ``cells`` is :func:`_cell_records`' output and the second moments; ``lists`` holds the
+    single- and double-precision cell lists and the body list; ``scale`` is
+    the length unit ``L`` of the single-precision list. Every body of the system ends up exactly
+    once in the lists: inside a cell used whole, or as a body (the group's own bodies included).
+    Entries beyond a list's capacity are counted but not written: the caller then grows the
+    list and walks again. (Growing inside the loop would make the lists loop-carried
+    references, whose reference counting costs more than the walk itself.)
     """
     xs, ys, zs, start, count, first_child, children, lower, upper = tree
-    mass, centre, second, radius2 = moments
+    nodes, records, second = cells
+    single, double, bodies = lists
     lo, hi = lower[group], upper[group]
-    n_cells = 0
+    reference = np.empty(3)
+    half_diagonal2 = 0.0
+    for axis in range(3):
+        reference[axis] = 0.5 * lo[axis] + 0.5 * hi[axis]
+        half_diagonal2 += (0.5 * hi[axis] - 0.5 * lo[axis]) ** 2
+    single_floor2 = max(half_diagonal2 / _NEAR_RATIO**2, (_SMALLEST_DISTANCE * scale) ** 2)
+    unit = 1.0 / scale
+    n_single = 0
+    n_double = 0
     n_bodies = 0
     stack[0] = 0
     top = 1
@@ -116,21 +177,32 @@ def _walk(group, tree, moments, ms, theta2, eps2, cells, bodies, stack):  # prag
         # Distance from the cell's centre of mass to the nearest point of the group's box.
         d2 = 0.0
         for axis in range(3):
-            gap = max(lo[axis] - centre[k, axis], 0.0, centre[k, axis] - hi[axis])
+            gap = max(lo[axis] - nodes[k, axis], 0.0, nodes[k, axis] - hi[axis])
             d2 += gap * gap
+        radius2, mass = nodes[k, 3], nodes[k, 4]
         # A cell whose mass sits at one point is exact as a monopole at any distance (with
         # softening; without it, only away from the point).
-        if d2 * theta2 > radius2[k] or (radius2[k] == 0.0 and eps2 > 0.0):
-            if n_cells < cells.shape[1]:
-                for axis in range(3):
-                    cells[axis, n_cells] = centre[k, axis]
-                trace = second[k, 0] + second[k, 1] + second[k, 2]
-                cells[3, n_cells] = mass[k]
-                cells[4, n_cells] = 1.5 * trace
-                cells[5, n_cells] = 0.5 * trace
-                for c in range(6):
-                    cells[6 + c, n_cells] = 3.0 * second[k, c]
-            n_cells += 1
+        if d2 * theta2 > radius2 or (radius2 == 0.0 and eps2 > 0.0):
+            if mass == 0.0:  # test particles only: nothing to pull with
+                pass
+            elif d2 >= single_floor2 and mass >= _SMALLEST_MASS:
+                if n_single < single.shape[1]:
+                    for axis in range(3):
+                        single[axis, n_single] = (nodes[k, axis] - reference[axis]) * unit
+                    for row in range(_CELL_ROWS - 3):
+                        single[3 + row, n_single] = records[k, row]
+                n_single += 1
+            else:
+                if n_double < double.shape[1]:
+                    trace = second[k, 0] + second[k, 1] + second[k, 2]
+                    for axis in range(3):
+                        double[axis, n_double] = nodes[k, axis]
+                    double[3, n_double] = mass
+                    double[4, n_double] = 1.5 * trace
+                    double[5, n_double] = 0.5 * trace
+                    for c in range(6):
+                        double[6 + c, n_double] = 3.0 * second[k, c]
+                n_double += 1
         elif first_child[k] < 0:
             if n_bodies + count[k] <= bodies.shape[1]:
                 for p in range(start[k], start[k] + count[k]):
@@ -145,21 +217,27 @@ def _walk(group, tree, moments, ms, theta2, eps2, cells, bodies, stack):  # prag
             for child in range(first_child[k], first_child[k] + children[k]):
                 stack[top] = child
                 top += 1
-    return n_cells, n_bodies
+    return n_single, n_double, n_bodies
 
 
 @njit(cache=True, fastmath=_FAST, error_model="numpy")
-def _far_field(xi, yi, zi, cells, n_cells, eps2, with_potential):  # pragma: no cover
-    """Acceleration and ``Σ`` (potential / −G) at a body from the cells of its list."""
-    ax = 0.0
-    ay = 0.0
-    az = 0.0
-    pot = 0.0
+def _far_field(xi, yi, zi, cells, n_cells, eps2, with_potential, one):  # pragma: no cover
+    """Acceleration and ``Σ`` (potential / −G) at a body from the cells of its list.
+
+    Computed in the precision of ``cells`` (float32 or float64): every scalar argument comes in
+    that precision and ``one`` is 1 in it, so no constant widens the arithmetic.
+    """
+    ax = one - one
+    ay = ax
+    az = ax
+    pot = ax
+    half = one / (one + one)  # (a float literal would be float64 and widen everything)
+    two_and_half = one + one + half
     for k in range(n_cells):
         rx = xi - cells[0, k]
         ry = yi - cells[1, k]
         rz = zi - cells[2, k]
-        inv = 1.0 / np.sqrt(rx * rx + ry * ry + rz * rz + eps2)
+        inv = one / np.sqrt(rx * rx + ry * ry + rz * rz + eps2)
         inv2 = inv * inv
         inv3 = inv * inv2
         inv5 = inv3 * inv2
@@ -167,12 +245,12 @@ def _far_field(xi, yi, zi, cells, n_cells, eps2, with_potential):  # pragma: no 
         jy = cells[9, k] * rx + cells[7, k] * ry + cells[11, k] * rz
         jz = cells[10, k] * rx + cells[11, k] * ry + cells[8, k] * rz
         rjr = rx * jx + ry * jy + rz * jz
-        radial = (cells[4, k] - 2.5 * rjr * inv2) * inv5 - cells[3, k] * inv3
+        radial = (cells[4, k] - two_and_half * rjr * inv2) * inv5 - cells[3, k] * inv3
         ax += radial * rx + inv5 * jx
         ay += radial * ry + inv5 * jy
         az += radial * rz + inv5 * jz
         if with_potential:  # loop-invariant: the compiler makes two loops
-            pot += cells[3, k] * inv + (0.5 * rjr * inv2 - cells[5, k]) * inv3
+            pot += cells[3, k] * inv + (half * rjr * inv2 - cells[5, k]) * inv3
     return ax, ay, az, pot
 
 
@@ -200,46 +278,87 @@ def _near_field(xi, yi, zi, bodies, n_bodies, eps2, with_potential):  # pragma: 
 
 
 @njit(cache=True, fastmath=_FAST, error_model="numpy")
-def _group_forces(group, tree, ms, order, lists, eps2, factor, acc, potential):  # pragma: no cover
+def _group_forces(
+    group, tree, ms, order, lists, counts, eps2, scale, factor, acc, potential
+):  # pragma: no cover
     """Forces on the bodies of ``group`` from its lists, written at the bodies' own indices."""
-    xs, ys, zs, start, count = tree[0], tree[1], tree[2], tree[3], tree[4]
-    cells, n_cells, bodies, n_bodies = lists
+    xs, ys, zs, start, count, lower, upper = (
+        tree[0],
+        tree[1],
+        tree[2],
+        tree[3],
+        tree[4],
+        tree[7],
+        tree[8],
+    )
+    single, double, bodies = lists
+    n_single, n_double, n_bodies = counts
     with_potential = potential.shape[0] > 0
     # Each body met itself once in the lists: at zero distance it added no force, and with
     # softening it added m/ε to the potential sum, taken off here.
     self_term = 1.0 / np.sqrt(eps2) if eps2 > 0.0 else 0.0
+    # The single-precision list's frame: centre of the group's box, lengths in units of `scale`.
+    unit = 1.0 / scale
+    one = np.float32(1.0)
+    eps2_single = np.float32(eps2 * unit * unit)
+    reference = 0.5 * lower[group] + 0.5 * upper[group]
     for p in range(start[group], start[group] + count[group]):
         xi, yi, zi = xs[p], ys[p], zs[p]
-        ax, ay, az, far = _far_field(xi, yi, zi, cells, n_cells, eps2, with_potential)
+        fx, fy, fz, far = _far_field(
+            np.float32((xi - reference[0]) * unit),
+            np.float32((yi - reference[1]) * unit),
+            np.float32((zi - reference[2]) * unit),
+            single,
+            n_single,
+            eps2_single,
+            with_potential,
+            one,
+        )
+        ax, ay, az, close = _far_field(xi, yi, zi, double, n_double, eps2, with_potential, 1.0)
         bx, by, bz, near = _near_field(xi, yi, zi, bodies, n_bodies, eps2, with_potential)
         b = order[p]
-        acc[b, 0] = factor * (ax + bx)
-        acc[b, 1] = factor * (ay + by)
-        acc[b, 2] = factor * (az + bz)
+        acc[b, 0] = factor * (unit * unit * fx + ax + bx)
+        acc[b, 1] = factor * (unit * unit * fy + ay + by)
+        acc[b, 2] = factor * (unit * unit * fz + az + bz)
         if with_potential:
-            potential[b] = -factor * (far + near - ms[p] * self_term)
+            potential[b] = -factor * (unit * far + close + near - ms[p] * self_term)
 
 
 @njit(cache=True, parallel=True)
 def _tree_forces(
-    groups, tree, moments, ms, order, depth, eps2, theta2, factor, acc, potential
+    groups, tree, cells, ms, order, depth, eps2, theta2, scale, factor, acc, potential
 ):  # pragma: no cover - compiled
     blocks = (groups.shape[0] + _GROUPS_PER_BLOCK - 1) // _GROUPS_PER_BLOCK
     for block in prange(blocks):
-        cells = np.empty((_CELL_ROWS, _LIST_CAPACITY))
-        bodies = np.empty((_BODY_ROWS, _LIST_CAPACITY))
+        single = np.empty((_CELL_ROWS, _row(_LIST_CAPACITY)), np.float32)
+        double = np.empty((_CELL_ROWS, _row(_LIST_CAPACITY // 8)))
+        bodies = np.empty((_BODY_ROWS, _row(_LIST_CAPACITY // 4)))
         stack = np.empty(8 * (depth + 1), np.int64)  # pending siblings: at most 7 per level
         last = min((block + 1) * _GROUPS_PER_BLOCK, groups.shape[0])
         for index in range(block * _GROUPS_PER_BLOCK, last):
             group = groups[index]
-            walk = (group, tree, moments, ms, theta2, eps2)
-            n_cells, n_bodies = _walk(*walk, cells, bodies, stack)
-            if n_cells > cells.shape[1] or n_bodies > bodies.shape[1]:
-                cells = np.empty((_CELL_ROWS, 2 * max(n_cells, cells.shape[1])))
-                bodies = np.empty((_BODY_ROWS, 2 * max(n_bodies, bodies.shape[1])))
-                _walk(*walk, cells, bodies, stack)
-            lists = (cells, n_cells, bodies, n_bodies)
-            _group_forces(group, tree, ms, order, lists, eps2, factor, acc, potential)
+            walk = (group, tree, cells, ms, theta2, eps2, scale)
+            counts = _walk(*walk, (single, double, bodies), stack)
+            n_single, n_double, n_bodies = counts
+            if (
+                n_single > single.shape[1]
+                or n_double > double.shape[1]
+                or n_bodies > bodies.shape[1]
+            ):
+                single = np.empty((_CELL_ROWS, _row(2 * n_single)), np.float32)
+                double = np.empty((_CELL_ROWS, _row(2 * n_double)))
+                bodies = np.empty((_BODY_ROWS, _row(2 * n_bodies)))
+                _walk(*walk, (single, double, bodies), stack)
+            lists = (single, double, bodies)
+            _group_forces(
+                group, tree, ms, order, lists, counts, eps2, scale, factor, acc, potential
+            )
+
+
+@njit(cache=True)
+def _row(entries):  # pragma: no cover - compiled
+    """Length of a list row with room for ``entries``: padded so that rows do not alias."""
+    return max(entries, _LIST_CAPACITY // 8) + _ROW_PADDING
 
 
 @njit(cache=True)
@@ -289,17 +408,20 @@ def tree_gravity(
     if bodies.eps2 == 0.0 and _coincident_bodies(arrays):
         return False
     ms = bodies.mass[tree.order]
-    moments = cell_moments(arrays, ms)
     target = np.empty(0) if potential is None else potential  # empty: not wanted
+    # The single-precision length unit: a power of two (exact scaling) near the system's size.
+    extent = float((tree.upper[0] - tree.lower[0]).max())
+    scale = math.ldexp(1.0, math.frexp(extent)[1]) if extent > 0.0 else 1.0
     _tree_forces(
         _groups(tree, group_size),
         arrays,
-        moments,
+        _cell_records(cell_moments(arrays, ms), scale),
         ms,
         tree.order,
         tree.depth,
         bodies.eps2,
         theta * theta,
+        scale,
         factor,
         acc,
         target,

@@ -23,7 +23,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 if TYPE_CHECKING:
     from .gravity import PointMasses
@@ -110,55 +110,65 @@ def _partition(columns, scratch, codes, start, count, centre, split, sizes):  # 
             columns[column, p] = scratch[column, p]
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _build(columns, leaf_size):  # pragma: no cover - compiled
-    """Split cells breadth first, reordering ``columns`` (x, y, z, index) in place.
+    """Split cells level by level, reordering ``columns`` (x, y, z, index) in place.
 
-    Returns the cell arrays at full capacity, the number of cells used and the depth.
+    The cells of one level own disjoint ranges of bodies, so they are split in parallel; their
+    children are then numbered in order, after every existing cell (breadth first). Returns
+    the cell arrays at full capacity, the number of cells used and the depth.
     """
     n = columns.shape[1]
     capacity = 2 * n  # every split makes at least two non-empty children
     scratch = np.empty((columns.shape[0], n))
     codes = np.empty(n, np.int64)
-    sizes = np.empty(16, np.int64)
-    centre = np.empty(3)
-    split = np.empty(3, np.bool_)
     start = np.empty(capacity, np.int64)
     count = np.empty(capacity, np.int64)
     first_child = np.full(capacity, -1, np.int64)
     children = np.zeros(capacity, np.int64)
-    level = np.zeros(capacity, np.int64)
     lower = np.empty((capacity, 3))
     upper = np.empty((capacity, 3))
     start[0], count[0] = 0, n
     cells = 1
     depth = 0
-    k = 0
-    while k < cells:  # breadth first: children are appended after every existing cell
-        _bounds(columns[0], columns[1], columns[2], start[k], count[k], lower[k], upper[k])
-        longest = 0.0
-        for axis in range(3):
-            longest = max(longest, upper[k, axis] - lower[k, axis])
-        if count[k] > leaf_size and longest > 0.0:
+    level_start, level_end = 0, 1
+    while level_start < level_end:
+        width = level_end - level_start
+        sizes = np.zeros((width, 16), np.int64)  # per cell: bodies per octant, write positions
+        centre = np.empty((width, 3))
+        split = np.empty((width, 3), np.bool_)
+        divided = np.zeros(width, np.bool_)
+        for w in prange(width):
+            k = level_start + w
+            _bounds(columns[0], columns[1], columns[2], start[k], count[k], lower[k], upper[k])
+            longest = 0.0
             for axis in range(3):
-                centre[axis] = 0.5 * lower[k, axis] + 0.5 * upper[k, axis]  # no overflow
-                split[axis] = upper[k, axis] - lower[k, axis] >= _SPLIT_FRACTION * longest
-            _partition(columns, scratch, codes, start[k], count[k], centre, split, sizes)
-            largest = 0
-            for code in range(8):
-                largest = max(largest, sizes[code])
-            if largest < count[k]:  # else the bodies are too close to separate
+                longest = max(longest, upper[k, axis] - lower[k, axis])
+            if count[k] > leaf_size and longest > 0.0:
+                for axis in range(3):
+                    centre[w, axis] = 0.5 * lower[k, axis] + 0.5 * upper[k, axis]  # no overflow
+                    split[w, axis] = upper[k, axis] - lower[k, axis] >= _SPLIT_FRACTION * longest
+                _partition(
+                    columns, scratch, codes, start[k], count[k], centre[w], split[w], sizes[w]
+                )
+                largest = 0
+                for code in range(8):
+                    largest = max(largest, sizes[w, code])
+                divided[w] = largest < count[k]  # else the bodies are too close to separate
+        for w in range(width):
+            if divided[w]:
+                k = level_start + w
                 first_child[k] = cells
                 offset = start[k]
                 for code in range(8):
-                    if sizes[code] > 0:
-                        start[cells], count[cells] = offset, sizes[code]
-                        level[cells] = level[k] + 1
-                        depth = max(depth, level[cells])
-                        offset += sizes[code]
+                    if sizes[w, code] > 0:
+                        start[cells], count[cells] = offset, sizes[w, code]
+                        offset += sizes[w, code]
                         cells += 1
                 children[k] = cells - first_child[k]
-        k += 1
+        if cells > level_end:
+            depth += 1
+        level_start, level_end = level_end, cells
     return start, count, first_child, children, lower, upper, cells, depth
 
 
