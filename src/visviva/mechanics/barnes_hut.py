@@ -37,9 +37,9 @@ N-body units with ε = 0.01 (10⁵ bodies, all compared; 10⁶ bodies in ``docs/
 
     theta   median    99th percentile    bound (median, 99th)
     0.3     4.0e-5    3.2e-4             1e-4, 1e-3
-    0.5     2.2e-4    1.7e-3             5e-4, 5e-3
-    0.7     6.8e-4    5.3e-3             1.5e-3, 1.5e-2
-    1.0     3.0e-3    2.8e-2             6e-3, 8e-2
+    0.5     2.1e-4    1.5e-3             5e-4, 5e-3
+    0.7     6.8e-4    4.9e-3             1.5e-3, 1.5e-2
+    1.0     3.0e-3    2.5e-2             6e-3, 8e-2
 
 Degenerate input (see also :mod:`~visviva.mechanics.octree`): ``N = 1`` gives a zero
 acceleration; up to :data:`GROUP_SIZE` bodies form one group, so the result is direct
