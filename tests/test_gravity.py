@@ -270,8 +270,8 @@ def test_barnes_hut_with_a_huge_coordinate_range():
 def test_barnes_hut_with_masses_beyond_single_precision():
     """Masses over 45 decades, so that some cells are lighter (relative to the heaviest body)
     than float32 can hold: forces stay within the documented error."""
-    x, _ = random_bodies(5000, seed=17)
-    m = 10.0 ** np.random.default_rng(18).uniform(-45.0, 0.0, 5000)
+    x, _ = random_bodies(2000, seed=17)
+    m = 10.0 ** np.random.default_rng(18).uniform(-45.0, 0.0, 2000)
     exact = numpy_accelerations(x, m, 1.0, 0.01)
     got = mech.gravity_accelerations(x, m, G=1.0, softening=0.01, method="barnes_hut")
     error = np.linalg.norm(got - exact, axis=1) / np.linalg.norm(exact, axis=1)
