@@ -217,6 +217,22 @@ def direct_row(label: str, threads: int, timing, pairs: float) -> list[str]:
 # --------------------------------------------------------------------------------------------
 
 
+def time_tree(cluster: vv.mechanics.Bodies, theta: float, repeats: int, label: str):
+    """Timing of one Barnes–Hut evaluation over ``cluster`` (its result: the accelerations)."""
+    return measure(
+        lambda: vv.mechanics.gravity_accelerations(
+            cluster.positions,
+            cluster.masses,
+            G=1.0,
+            softening=SOFTENING,
+            method="barnes_hut",
+            theta=theta,
+        ),
+        repeats,
+        label,
+    )
+
+
 def bench_tree_small(args: argparse.Namespace) -> None:
     n = args.direct_n
     heading(f"(b) Barnes–Hut, N = {n:,}: visviva and REBOUND, per evaluation")
@@ -226,18 +242,7 @@ def bench_tree_small(args: argparse.Namespace) -> None:
     )
     rows = []
     for theta in args.small_thetas:
-        timing = measure(
-            lambda theta=theta: vv.mechanics.gravity_accelerations(
-                cluster.positions,
-                cluster.masses,
-                G=1.0,
-                softening=SOFTENING,
-                method="barnes_hut",
-                theta=theta,
-            ),
-            args.repeats,
-            f"(b) visviva tree θ={theta}",
-        )
+        timing = time_tree(cluster, theta, args.repeats, f"(b) visviva tree θ={theta}")
         median, p99 = relative_errors(timing.result, exact)
         rows.append(["visviva `barnes_hut`, 2 threads", f"{theta:g}", fmt_time(timing.median)])
         rows[-1] += [f"{median:.1e}", f"{p99:.1e}", timing.busy]
@@ -270,18 +275,7 @@ def bench_tree_large(args: argparse.Namespace) -> None:
     print(f"  tree: {tree.start.size:,} cells, depth {tree.depth}, built in {fmt_time(built)}")
     rows = []
     for theta in args.large_thetas:
-        timing = measure(
-            lambda theta=theta: vv.mechanics.gravity_accelerations(
-                cluster.positions,
-                cluster.masses,
-                G=1.0,
-                softening=SOFTENING,
-                method="barnes_hut",
-                theta=theta,
-            ),
-            max(1, args.repeats // 2),
-            f"(c) visviva tree θ={theta}",
-        )
+        timing = time_tree(cluster, theta, max(1, args.repeats // 2), f"(c) visviva tree θ={theta}")
         median, p99 = relative_errors(timing.result[sample], exact)
         meets = (
             "yes" if timing.median <= TARGET_TREE else f"no ({timing.median / TARGET_TREE:.2f}×)"
