@@ -115,6 +115,7 @@ _CELL_ROWS = 12
 _NEAR_RATIO = 64.0
 _SMALLEST_DISTANCE = 2.0**-20
 _SMALLEST_MASS = 2.0**-100
+
 # Body rows: position (3), mass.
 _BODY_ROWS = 4
 
@@ -330,9 +331,9 @@ def _tree_forces(
 ):  # pragma: no cover - compiled
     blocks = (groups.shape[0] + _GROUPS_PER_BLOCK - 1) // _GROUPS_PER_BLOCK
     for block in prange(blocks):
-        single = np.empty((_CELL_ROWS, _row(_LIST_CAPACITY)), np.float32)
-        double = np.empty((_CELL_ROWS, _row(_LIST_CAPACITY // 8)))
-        bodies = np.empty((_BODY_ROWS, _row(_LIST_CAPACITY // 4)))
+        single = np.empty((_CELL_ROWS, _LIST_CAPACITY + _ROW_PADDING), np.float32)
+        double = np.empty((_CELL_ROWS, _LIST_CAPACITY // 8 + _ROW_PADDING))
+        bodies = np.empty((_BODY_ROWS, _LIST_CAPACITY // 4 + _ROW_PADDING))
         stack = np.empty(8 * (depth + 1), np.int64)  # pending siblings: at most 7 per level
         last = min((block + 1) * _GROUPS_PER_BLOCK, groups.shape[0])
         for index in range(block * _GROUPS_PER_BLOCK, last):
@@ -345,9 +346,9 @@ def _tree_forces(
                 or n_double > double.shape[1]
                 or n_bodies > bodies.shape[1]
             ):
-                single = np.empty((_CELL_ROWS, _row(2 * n_single)), np.float32)
-                double = np.empty((_CELL_ROWS, _row(2 * n_double)))
-                bodies = np.empty((_BODY_ROWS, _row(2 * n_bodies)))
+                single = np.empty((_CELL_ROWS, _row(n_single, single)), np.float32)
+                double = np.empty((_CELL_ROWS, _row(n_double, double)))
+                bodies = np.empty((_BODY_ROWS, _row(n_bodies, bodies)))
                 _walk(*walk, (single, double, bodies), stack)
             lists = (single, double, bodies)
             _group_forces(
@@ -356,9 +357,10 @@ def _tree_forces(
 
 
 @njit(cache=True)
-def _row(entries):  # pragma: no cover - compiled
-    """Length of a list row with room for ``entries``: padded so that rows do not alias."""
-    return max(entries, _LIST_CAPACITY // 8) + _ROW_PADDING
+def _row(needed, current):  # pragma: no cover - compiled
+    """Row length of a list that must hold ``needed`` entries: twice that, never less than the
+    ``current`` list's, padded so that rows do not alias."""
+    return max(2 * needed, current.shape[1]) + _ROW_PADDING
 
 
 @njit(cache=True)
