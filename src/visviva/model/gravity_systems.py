@@ -1,4 +1,4 @@
-"""Gravitating bodies as named scene systems: a Kepler orbit, the Sun–Earth–Moon, galaxies.
+"""Gravitating bodies as named scene systems: Kepler orbit, Sun–Earth–Moon, star cluster, galaxies.
 
 The state is the bodies' positions flattened (see :func:`visviva.mechanics.nbody_problem`), so
 the picture is those positions, lifted above the video's ground plane: orbits lie in the
@@ -32,6 +32,18 @@ def _kepler_bodies(p: Mapping[str, float]) -> Any:
         p["semi_major_axis"], p["eccentricity"], masses=(p["mass1"], p["mass2"]), G=p["G"]
     )
     return orbit.bodies()
+
+
+def _cluster(p: Mapping[str, float]) -> Any:
+    from ..mechanics import plummer_sphere
+
+    return plummer_sphere(
+        int(p["bodies"]),
+        total_mass=p["total_mass"],
+        scale_radius=p["scale_radius"],
+        G=p["G"],
+        seed=int(p["seed"]),
+    )
 
 
 def _sun_earth_moon(p: Mapping[str, float]) -> Any:
@@ -112,6 +124,36 @@ GRAVITY_SYSTEMS: dict[str, SystemType] = {
             lambda p: 0.3 * ASTRONOMICAL_UNIT,
         ),
         _gravity(
+            "cluster",
+            "a star cluster: Plummer's sphere in virial equilibrium (Aarseth, Hénon & Wielen 1974)",
+            {
+                "bodies": Parameter(
+                    1000.0,
+                    "",
+                    "number of stars",
+                    positive=True,
+                    integer=True,
+                    maximum=2 * MAX_BODIES_PER_DISK,
+                ),
+                "total_mass": Parameter(1.0, "kg", "mass of the cluster", positive=True),
+                "scale_radius": Parameter(1.0, "m", "Plummer radius a", positive=True),
+                "softening": Parameter(0.01, "m", "Plummer softening length"),
+                "theta": Parameter(
+                    0.5,
+                    "",
+                    "Barnes-Hut opening angle, in (0, 1] (above 4000 bodies)",
+                    positive=True,
+                    maximum=1.0,
+                ),
+                "G": Parameter(
+                    1.0, _G_UNIT, "constant of gravitation (1: N-body units)", positive=True
+                ),
+                "seed": Parameter(0.0, "", "random seed", integer=True),
+            },
+            _cluster,
+            lambda p: 3.0 * p["scale_radius"],
+        ),
+        _gravity(
             "galaxy",
             "two disk galaxies colliding on a parabolic orbit (Toomre & Toomre 1972)",
             {
@@ -130,7 +172,11 @@ GRAVITY_SYSTEMS: dict[str, SystemType] = {
                 "pericenter": Parameter(1.5, "m", "closest approach of the centres", positive=True),
                 "softening": Parameter(0.05, "m", "Plummer softening length"),
                 "theta": Parameter(
-                    0.5, "", "Barnes-Hut opening angle (above 4000 bodies)", positive=True
+                    0.5,
+                    "",
+                    "Barnes-Hut opening angle, in (0, 1] (above 4000 bodies)",
+                    positive=True,
+                    maximum=1.0,
                 ),
                 "G": Parameter(
                     1.0, _G_UNIT, "constant of gravitation (1: N-body units)", positive=True
