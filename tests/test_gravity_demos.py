@@ -72,10 +72,16 @@ def test_kepler_scene_follows_the_ellipse(tmp_path):
 
 def test_galaxy_scene_counts_are_checked_before_allocation():
     with pytest.raises(SceneError) as error:
-        build_model(parse_scene(scene("galaxy", "bodies_per_disk = 1e9, seed = 0.5")))
+        build_model(
+            parse_scene(
+                scene("galaxy", "bodies_per_disk = 1e9, seed = 0.5, softening = -1, theta = 1.5")
+            )
+        )
     message = str(error.value)
     assert "bodies_per_disk: must be at most 5e+06 (got 1000000000.0)" in message
     assert "seed: must be a whole number (got 0.5)" in message
+    assert "softening: must be at least 0 (got -1.0)" in message
+    assert "theta: must be at most 1 (got 1.5)" in message
 
 
 def test_large_galaxy_scene_runs_on_the_tree_and_follows_direct_summation(tmp_path):

@@ -175,6 +175,10 @@ def _check_system(entity: System, where: str) -> list[SceneProblem]:
             problems.append(SceneProblem(path, f"must be positive [{parameter.unit}]", repr(value)))
         if parameter.integer and value != int(value):
             problems.append(SceneProblem(path, "must be a whole number", repr(value)))
+        if parameter.minimum is not None and value < parameter.minimum:
+            problems.append(
+                SceneProblem(path, f"must be at least {parameter.minimum:g}", repr(value))
+            )
         if parameter.maximum is not None and value > parameter.maximum:
             problems.append(
                 SceneProblem(path, f"must be at most {parameter.maximum:g}", repr(value))

@@ -187,7 +187,7 @@ CLASSIC_SYSTEMS: dict[str, SystemType] = {
             {
                 "mass": _MASS,
                 "stiffness": Parameter(4.0, "N/m", "spring constant", positive=True),
-                "damping": Parameter(0.4, "N s/m", "damping coefficient"),
+                "damping": Parameter(0.4, "N s/m", "damping coefficient", minimum=0.0),
                 "x0": Parameter(1.0, "m", "initial displacement"),
                 "v0": Parameter(0.0, "m/s", "initial velocity"),
             },
@@ -221,7 +221,7 @@ CLASSIC_SYSTEMS: dict[str, SystemType] = {
                 "mass": _MASS,
                 "theta0": _angle("initial angle from the downward vertical", 0.5),
                 "omega0": _rate("initial angular velocity"),
-                "stabilization": Parameter(0.0, "1/s", "Baumgarte rate (0: none)"),
+                "stabilization": Parameter(0.0, "1/s", "Baumgarte rate (0: none)", minimum=0.0),
             },
             _constrained_pendulum,
             _draw_constrained,

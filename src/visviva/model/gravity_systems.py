@@ -98,6 +98,23 @@ def _gravity(
 
 _G_UNIT = "m^3/(kg s^2)"
 
+
+def _many_body_parameters(softening: float) -> dict[str, Parameter]:
+    """The parameters every many-body system shares: softening, tree, units and seed."""
+    return {
+        "softening": Parameter(softening, "m", "Plummer softening length", minimum=0.0),
+        "theta": Parameter(
+            0.5,
+            "",
+            f"Barnes-Hut opening angle, in (0, 1] (above {DIRECT_MAX_BODIES} bodies)",
+            positive=True,
+            maximum=1.0,
+        ),
+        "G": Parameter(1.0, _G_UNIT, "constant of gravitation (1: N-body units)", positive=True),
+        "seed": Parameter(0.0, "", "random seed", integer=True),
+    }
+
+
 GRAVITY_SYSTEMS: dict[str, SystemType] = {
     system.name: system
     for system in (
@@ -106,7 +123,7 @@ GRAVITY_SYSTEMS: dict[str, SystemType] = {
             "two bodies on a Kepler ellipse about their centre of mass, from periapsis",
             {
                 "semi_major_axis": Parameter(1.0, "m", "semi-major axis a", positive=True),
-                "eccentricity": Parameter(0.5, "", "eccentricity e, in [0, 1)"),
+                "eccentricity": Parameter(0.5, "", "eccentricity e, in [0, 1)", minimum=0.0),
                 "mass1": Parameter(1.0, "kg", "first mass", positive=True),
                 "mass2": Parameter(0.001, "kg", "second mass", positive=True),
                 "G": Parameter(
@@ -137,18 +154,7 @@ GRAVITY_SYSTEMS: dict[str, SystemType] = {
                 ),
                 "total_mass": Parameter(1.0, "kg", "mass of the cluster", positive=True),
                 "scale_radius": Parameter(1.0, "m", "Plummer radius a", positive=True),
-                "softening": Parameter(0.01, "m", "Plummer softening length"),
-                "theta": Parameter(
-                    0.5,
-                    "",
-                    "Barnes-Hut opening angle, in (0, 1] (above 4000 bodies)",
-                    positive=True,
-                    maximum=1.0,
-                ),
-                "G": Parameter(
-                    1.0, _G_UNIT, "constant of gravitation (1: N-body units)", positive=True
-                ),
-                "seed": Parameter(0.0, "", "random seed", integer=True),
+                **_many_body_parameters(softening=0.01),
             },
             _cluster,
             lambda p: 3.0 * p["scale_radius"],
@@ -166,22 +172,13 @@ GRAVITY_SYSTEMS: dict[str, SystemType] = {
                     maximum=MAX_BODIES_PER_DISK,
                 ),
                 "central_mass": Parameter(1.0, "kg", "mass at each centre", positive=True),
-                "disk_mass": Parameter(0.0, "kg", "mass of each disk (0: test particles)"),
+                "disk_mass": Parameter(
+                    0.0, "kg", "mass of each disk (0: test particles)", minimum=0.0
+                ),
                 "radius": Parameter(1.0, "m", "disk radius", positive=True),
                 "separation": Parameter(6.0, "m", "initial distance of the centres", positive=True),
                 "pericenter": Parameter(1.5, "m", "closest approach of the centres", positive=True),
-                "softening": Parameter(0.05, "m", "Plummer softening length"),
-                "theta": Parameter(
-                    0.5,
-                    "",
-                    "Barnes-Hut opening angle, in (0, 1] (above 4000 bodies)",
-                    positive=True,
-                    maximum=1.0,
-                ),
-                "G": Parameter(
-                    1.0, _G_UNIT, "constant of gravitation (1: N-body units)", positive=True
-                ),
-                "seed": Parameter(0.0, "", "random seed", integer=True),
+                **_many_body_parameters(softening=0.05),
             },
             _galaxy,
             lambda p: 2.0 * p["radius"],

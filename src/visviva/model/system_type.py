@@ -22,6 +22,7 @@ class Parameter:
         description: One line.
         positive: The value must be > 0.
         integer: The value must be a whole number (a count).
+        minimum: Smallest value accepted (e.g. 0 for a length that may vanish).
         maximum: Largest value accepted (counts are capped before anything is allocated).
     """
 
@@ -30,6 +31,7 @@ class Parameter:
     description: str
     positive: bool = False
     integer: bool = False
+    minimum: float | None = None
     maximum: float | None = None
 
 
