@@ -45,7 +45,9 @@ def test_sun_earth_moon_year_and_month_with_a_video_a_week_per_second(tmp_path):
 def test_galaxy_demo_runs(tmp_path):
     run_demo("galaxy", tmp_path, duration=0.5)
     data = summary(tmp_path)
-    assert data["bodies"] == 3002
+    assert data["bodies"] == 6002
+    # Tree forces are not the gradient of the tree potential: the energy wanders at about the
+    # force error (1.7e-3 of the initial kinetic energy over the demo's full 15 time units).
     assert data["max_energy_change_over_initial_kinetic"] < 1e-3
     tree = data["barnes_hut_force_error"]
     assert tree["theta"] == 0.5
