@@ -148,10 +148,10 @@ def _cell_records(moments, scale):  # pragma: no cover - compiled
 def _walk(group, tree, cells, ms, theta2, eps2, scale, lists, stack):  # pragma: no cover
     """Fill the interaction lists of ``group``; return their lengths.
 
-    ``cells`` is :func:`_cell_records`' output and the second moments; ``lists`` holds the
-    single- and double-precision cell lists and the body list; ``scale`` is
-    the length unit ``L`` of the single-precision list. Every body of the system ends up exactly
-    once in the lists: inside a cell used whole, or as a body (the group's own bodies included).
+    ``cells`` is :func:`_cell_records`' output; ``lists`` holds the single- and double-precision
+    cell lists and the body list; ``scale`` is the length unit ``L`` of the single-precision
+    list. Every body of the system ends up exactly once in the lists: inside a cell used whole,
+    or as a body (the group's own bodies included).
     Entries beyond a list's capacity are counted but not written: the caller then grows the
     list and walks again. (Growing inside the loop would make the lists loop-carried
     references, whose reference counting costs more than the walk itself.)
