@@ -96,7 +96,7 @@ def _gravity(
     return SystemType(name, summary, parameters, build, draw)
 
 
-_G_UNIT = "m^3/(kg s^2)"
+_G = Parameter(1.0, "m^3/(kg s^2)", "constant of gravitation (1: N-body units)", positive=True)
 
 
 def _many_body_parameters(softening: float) -> dict[str, Parameter]:
@@ -110,7 +110,7 @@ def _many_body_parameters(softening: float) -> dict[str, Parameter]:
             positive=True,
             maximum=1.0,
         ),
-        "G": Parameter(1.0, _G_UNIT, "constant of gravitation (1: N-body units)", positive=True),
+        "G": _G,
         "seed": Parameter(0.0, "", "random seed", integer=True),
     }
 
@@ -126,9 +126,7 @@ GRAVITY_SYSTEMS: dict[str, SystemType] = {
                 "eccentricity": Parameter(0.5, "", "eccentricity e, in [0, 1)", minimum=0.0),
                 "mass1": Parameter(1.0, "kg", "first mass", positive=True),
                 "mass2": Parameter(0.001, "kg", "second mass", positive=True),
-                "G": Parameter(
-                    1.0, _G_UNIT, "constant of gravitation (1: N-body units)", positive=True
-                ),
+                "G": _G,
             },
             _kepler_bodies,
             lambda p: 0.5 * p["semi_major_axis"],
