@@ -256,7 +256,7 @@ def test_demo_summary_has_one_run_per_method(oscillator_run):
     assert set(summary["runs"]) == set(vv.integrators.names())
     assert summary["steps"] == sum(run["steps"] for run in summary["runs"].values())
     assert summary["wall_time_s"] > 0.0
-    assert isinstance(summary["warnings"], dict)
+    assert isinstance(summary["warnings"], list)
     drifts = [run["energy_drift"] for run in summary["runs"].values()]
     assert summary["energy_drift"] == max(drifts, key=abs)
 

@@ -78,7 +78,7 @@ def test_every_output_is_written_with_the_summary(run):
         (*OUTPUTS, "recording.h5", "summary.json")
     )
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["steps"] == 100 and summary["warnings"] == {}
+    assert summary["steps"] == 100 and summary["warnings"] == []
     assert recording.attrs["success"] is True
     # 0.5 s at 20 frames/s: frames at t = 0, 0.05, …, 0.5.
     assert frames_at_rate(recording.time, FPS).size == 11

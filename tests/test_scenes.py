@@ -97,7 +97,7 @@ def test_example_scenes_validate_and_run_shortened(tmp_path):
         model = vv.load_model(path)
         kinds |= {type(e).__name__ for e in load_scene(path)[0].entities}
         duration = 5 * model.integration.dt * model.integration.record_every
-        written = vv.run_scene(model, tmp_path / path.stem, duration=duration, formats=())
+        written = vv.run_scene(model, tmp_path / path.stem, duration=duration).files
         summary = json.loads((tmp_path / path.stem / "summary.json").read_text())
         assert summary["success"] is True
         assert summary["steps"] == round(duration / model.integration.dt)

@@ -13,16 +13,20 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from collections import Counter
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from ._validation import real_number
 from ._version import __version__
 from .errors import ModelError, SceneError, SceneProblem, SimulationError
+from .io.job import JobReport, python_warnings
 from .model import Model
 from .model.build import build_model
+
+if TYPE_CHECKING:
+    from .simulation.interrupt import Interrupted, StopOnSignal
 
 __all__ = ["DryRun", "dry_run", "load_model", "run_scene"]
 
@@ -110,7 +114,8 @@ def run_scene(
     formats: Iterable[str] = (),
     force: bool = False,
     progress: bool | None = None,
-) -> list[Path]:
+    energy_tolerance: float | None = None,
+) -> JobReport:
     """Run ``model`` and write its outputs into ``directory``.
 
     Args:
@@ -121,25 +126,82 @@ def run_scene(
             ``glb``, ``obj``, ``pc2``).
         force: Replace outputs that already exist.
         progress: Progress bar (default: when stderr is a terminal).
+        energy_tolerance: Relative energy change of a conservative scene beyond which the run
+            ends with a warning (default: the scene's ``energy_tolerance``, 1 %).
 
     Returns:
-        The files written.
+        The files written and the summary (also in ``summary.json``).
 
     Raises:
-        ModelError: Bad arguments or existing outputs, before anything runs.
-        SimulationError: If the run failed; its recording and summary were written first.
+        ModelError: Bad arguments, existing outputs or an unwritable directory, before anything
+            runs.
+        SimulationError: If the run failed; its recording and summary were written first
+            (``error.report``).
+        Interrupted: On SIGINT/SIGTERM: the run stopped after the current step and the
+            recording (marked incomplete), the summary and the outputs finished before the
+            signal were written (``error.report``).
     """
     from .io.job import JobOutput
-    from .io.writer import RecordingWriter
-    from .simulation.loop import simulate
+    from .io.outputs import write_output
+    from .simulation.interrupt import Interrupted, StopOnSignal
 
     seconds = _duration(model, duration)
+    tolerance = (
+        model.integration.energy_tolerance
+        if energy_tolerance is None
+        else real_number("energy_tolerance", energy_tolerance, nonnegative=True)
+    )
     planned = _planned(model, formats)
     extra = [name for name in planned if name not in ("recording.h5", "summary.json")]
-    job = JobOutput(directory, force=force)
-    job.check_target(planned)
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        StopOnSignal() as stops,
+        JobOutput(directory, force=force) as job,
+    ):
+        warnings.simplefilter("always")
+        job.check_target(planned)
+        problem = model.problem()
+        started = time.perf_counter()
+        recording, failure = _simulate_streaming(
+            model, problem, job.stage("recording.h5"), seconds, progress, stops
+        )
+        summary = _summary(model, problem, recording, failure, seconds, tolerance)
+        for name in extra if failure is None else ():
+            try:
+                with job.writing(name) as path:
+                    write_output(recording, path, model.output_fps, model.output_speed)
+            except KeyboardInterrupt:
+                failure = Interrupted(stops.requested or "SIGINT", float(recording.time[-1]))
+                summary["interrupted"] = failure.signal
+                summary["message"] = f"{failure.signal} while writing {name}; not written"
+                break
+        summary["wall_time_s"] = time.perf_counter() - started
+        summary["warnings"] += python_warnings(caught)
+        report = job.write(summary)
+    if failure is not None:
+        failure.report = report  # type: ignore[union-attr]
+        raise failure
+    return report
+
+
+def _simulate_streaming(
+    model: Model,
+    problem: Any,
+    path: Path,
+    seconds: float,
+    progress: bool | None,
+    stops: StopOnSignal,
+) -> tuple[Any, SimulationError | Interrupted | None]:
+    """Run the scene's problem, streaming each frame into the recording at ``path``.
+
+    Returns the scene recording (``None`` if a second signal cut the run short before the
+    loop could hand it over) and the failure or interrupt that ended the run early, if any.
+    """
+    from .io.writer import RecordingWriter
+    from .simulation.interrupt import Interrupted
+    from .simulation.loop import simulate
+
     settings = model.integration
-    problem = model.problem()
     attrs = {
         "scene": model.source or "",
         "scene_name": model.name,
@@ -147,60 +209,111 @@ def run_scene(
         "method": settings.method,
         "dt": settings.dt,
     }
-    started = time.perf_counter()
-    failure: SimulationError | None = None
-    with (
-        warnings.catch_warnings(record=True) as caught,
-        RecordingWriter(
-            job.stage("recording.h5"), units=model.units(), attrs=attrs, static=model.static()
-        ) as writer,
-    ):
-        warnings.simplefilter("always")
+    failure: SimulationError | Interrupted | None = None
+    with RecordingWriter(path, units=model.units(), attrs=attrs, static=model.static()) as writer:
         try:
-            recording = simulate(
-                problem,
-                settings.method,
-                dt=settings.dt,
-                t_end=problem.t0 + seconds,
-                substeps=settings.substeps,
-                record_every=settings.record_every,
-                progress=progress,
-                on_frame=lambda t, parts: writer.append(t, _frame(model, parts)),
-            )
-        except SimulationError as error:
+            with stops.polled():
+                loop_recording = simulate(
+                    problem,
+                    settings.method,
+                    dt=settings.dt,
+                    t_end=problem.t0 + seconds,
+                    substeps=settings.substeps,
+                    record_every=settings.record_every,
+                    progress=progress,
+                    on_frame=lambda t, parts: writer.append(t, _frame(model, parts)),
+                )
+        except (SimulationError, Interrupted) as error:
             failure = error
-            recording = error.recording  # type: ignore[attr-defined]
-        recording = _as_scene_recording(model, recording)
-        series = {"energy": recording["energy"]} if "energy" in recording else {}
-        writer.finish(recording.attrs | {"scene": model.source or ""}, series)
+            loop_recording = error.recording  # type: ignore[union-attr]
+        except KeyboardInterrupt:
+            # A second signal: the user wants out now; keep the frames already streamed.
+            failure = Interrupted(stops.requested or "SIGINT", writer.last_time)
+            loop_recording = None
+        recording = None if loop_recording is None else _as_scene_recording(model, loop_recording)
+        final: dict[str, Any] = {"complete": failure is None}
+        if isinstance(failure, Interrupted):
+            final |= {
+                "success": False,
+                "message": str(failure),
+                "interrupted": failure.signal,
+            }
+        if recording is not None:
+            series = {"energy": recording["energy"]} if "energy" in recording else {}
+            writer.finish(recording.attrs | {"scene": model.source or ""} | final, series)
+        else:
+            writer.finish(final)
+    return recording, failure
+
+
+def _summary(
+    model: Model,
+    problem: Any,
+    recording: Any,
+    failure: Exception | None,
+    seconds: float,
+    tolerance: float,
+) -> dict[str, Any]:
+    """``summary.json`` of a scene run (wall time and Python warnings are added after)."""
     from .io.job import run_summary
+    from .simulation.interrupt import Interrupted
 
-    summary = {
+    settings = model.integration
+    reached = float(recording.time[-1]) if recording is not None else None
+    summary: dict[str, Any] = {
         "scene": model.name,
+        "counts": _counts(model, problem, recording),
+        "method": settings.method,
+        "dt": settings.dt,
         "duration_s": seconds,
-        "particles": model.particle_count,
-        "steps": int(recording.attrs.get("steps", 0)),
-        "wall_time_s": time.perf_counter() - started,
-        "warnings": dict(Counter(w.category.__name__ for w in caught)),
+        "t_reached_s": reached,
+        "complete": failure is None,
         "success": failure is None,
-        "message": recording.attrs.get("message", ""),
-    } | {"energy_drift": run_summary(recording)["energy_drift"]}
-    if failure is None:
-        from .io.outputs import write_output
+        "message": "completed" if failure is None else str(failure),
+        "steps": 0,
+        "energy_drift": None,
+        "energy_tolerance": tolerance,
+        "warnings": [],
+    }
+    if isinstance(failure, Interrupted):
+        summary["interrupted"] = failure.signal
+    if recording is None:
+        return summary
+    work = run_summary(recording)
+    summary["steps"] = int(work.get("steps", 0))
+    summary["energy_drift"] = drift = work["energy_drift"]
+    if model.conservative and drift is not None and abs(drift) > tolerance:
+        summary["warnings"].append(
+            {"kind": "energy_drift", "message": _energy_warning(model, problem, drift, tolerance)}
+        )
+    return summary
 
-        for name in extra:
-            write_output(recording, job.stage(name), model.output_fps, model.output_speed)
-    else:
-        job.staged = [name for name in job.staged if name == "recording.h5"]
-    written = job.write(summary)
-    if failure is not None:
-        raise failure
-    return written
+
+def _energy_warning(model: Model, problem: Any, drift: float, tolerance: float) -> str:
+    from .integrators import get
+    from .simulation.loop import initial_state
+    from .simulation.watch import energy_drift_advice, suggested_dt
+
+    method = get(model.integration.method)
+    suggestion = suggested_dt(problem.system(), method, initial_state(problem))
+    return (
+        f"the energy of this conservative scene changed by {100 * drift:+.3g} % (tolerance "
+        f"{100 * tolerance:.3g} %, [integration] energy_tolerance). "
+        + energy_drift_advice(method, model.integration.dt, suggestion)
+    )
+
+
+def _counts(model: Model, problem: Any, recording: Any) -> dict[str, int]:
+    """What the scene holds: particles, or a system's degrees of freedom and drawn points."""
+    if model.system is None:
+        return {"particles": model.particle_count}
+    counts = {"degrees_of_freedom": int(problem.size)}
+    if recording is not None and "points" in recording:
+        counts["points"] = int(recording["points"].shape[1])
+    return counts
 
 
 def _duration(model: Model, duration: float | None) -> float:
-    from ._validation import real_number
-
     if duration is None:
         return model.integration.duration
     seconds = real_number("duration", duration, positive=True, unit=" s")

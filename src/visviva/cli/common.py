@@ -27,20 +27,51 @@ def print_json(data: Any) -> None:
     typer.echo(json.dumps(plain_json(data), indent=2, allow_nan=False))
 
 
-def check_new_file(path: Path, force: bool) -> None:
-    from ..errors import ModelError
+#: File types a figure may be saved as (matplotlib's Agg back end writes them all).
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".webp", ".eps", ".tif", ".tiff")
 
-    if path.is_dir():
-        raise ModelError(f"output {path} is a directory; give a file name such as {path}/plot.png")
-    if path.exists() and not force:
-        raise ModelError(f"{path} already exists; pass --force to replace it")
-    if not path.parent.exists():
-        raise ModelError(f"directory {path.parent} does not exist")
+
+def check_figure_file(path: Path, force: bool) -> None:
+    """Refuse, before any work, a figure file that cannot or must not be written."""
+    from ..io.files import check_new_file
+
+    check_new_file(path, force=force, suffixes=FIGURE_SUFFIXES, what="figure")
 
 
 def save_figure(figure: Any, path: Path) -> None:
-    """Save so that the file appears complete or not at all."""
+    """Save (creating missing directories) so that the file appears complete or not at all."""
     from ..io.files import atomic_path
 
+    path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as temporary:
-        figure.savefig(temporary, dpi=110, format=path.suffix.lstrip(".") or "png")
+        figure.savefig(temporary, dpi=110, format=path.suffix.lstrip(".").lower())
+
+
+def print_report(report: Any) -> None:
+    """The few lines that end ``run`` and ``demo``: what ran, how long, energy, warnings, files.
+
+    Args:
+        report: A :class:`~visviva.io.job.JobReport`.
+    """
+    summary = report.summary
+    what = summary.get("scene") or summary.get("demo")
+    method = f" of {summary['method']} (dt = {summary['dt']:g} s)" if "method" in summary else ""
+    typer.echo(f"{what}: {summary['steps']} steps{method} in {summary['wall_time_s']:.3g} s")
+    if "interrupted" in summary:
+        reached = summary.get("t_reached_s")
+        at = f" at t = {reached:.6g} s of {summary['duration_s']:.6g} s" if reached else ""
+        typer.echo(f"interrupted by {summary['interrupted']}{at}; kept what was finished")
+    elif not summary.get("success", True):
+        typer.echo(f"failed: {summary['message']}")
+    drift = summary.get("energy_drift")
+    if drift is not None:
+        typer.echo(f"energy drift: {100 * drift:+.3g} % of the initial energy")
+    for warning in summary.get("warnings", []):
+        count = f" ({warning['count']}×)" if warning.get("count", 1) > 1 else ""
+        typer.echo(f"warning: {warning['message']}{count}")
+    for stale in report.removed_stale:
+        typer.echo(f"removed {stale}, left by a run that was killed")
+    if report.files:
+        folder = report.files[0].parent
+        names = ", ".join(f.name + ("/" if f.is_dir() else "") for f in report.files)
+        typer.echo(f"wrote {names} into {folder}{'/' if str(folder) != '/' else ''}")

@@ -15,7 +15,15 @@ from typing import Annotated
 
 import typer
 
-from .common import ForceOption, JsonOption, app, check_new_file, print_json, save_figure
+from .common import (
+    ForceOption,
+    JsonOption,
+    app,
+    check_figure_file,
+    print_json,
+    print_report,
+    save_figure,
+)
 
 
 @app.command("integrators")
@@ -70,7 +78,7 @@ def stability_command(
 
     instances = [get(name) for name in methods]
     if output is not None:
-        check_new_file(output, force)
+        check_figure_file(output, force)
     intervals = {
         m.name: {
             # `+ 0.0` turns a computed -0.0 into 0.0.
@@ -122,7 +130,7 @@ def convergence_command(
     levels = whole_number("levels", levels, minimum=3)
     t_end = real_number("t_end", t_end, positive=True, unit=" s")
     if output is not None:
-        check_new_file(output, force)
+        check_figure_file(output, force)
     test = reference_problem(problem)
     studies = [
         convergence_order(
@@ -235,7 +243,7 @@ def compare_command(
     job.figures["convergence"] = comparison.convergence_figure()
     table = comparison.table()
     typer.echo(table)
-    for path in job.write({"target": target, "table": table} | comparison.as_dict()):
+    for path in job.write({"target": target, "table": table} | comparison.as_dict()).files:
         typer.echo(f"wrote {path}")
 
 
@@ -261,11 +269,10 @@ def demo_command(
             typer.echo(f"{demo.name:16s} {demo.summary}")
         return
     directory = output if output is not None else Path("out") / name
-    written = run_demo(
+    report = run_demo(
         name, directory, duration=duration, formats=formats or (), fps=fps, force=force
     )
-    for path in written:
-        typer.echo(f"wrote {path}")
+    print_report(report)
 
 
 # After the commands above, so that `visviva --help` lists them first.
@@ -273,8 +280,11 @@ from . import scenes as _scene_commands  # noqa: E402, F401 - registers run, val
 
 
 def main() -> None:
-    """Entry point: run the app; user errors exit 2 with one line, failures exit 1."""
+    """Entry point: run the app; user errors exit 2 with one line, failures exit 1, a run
+    stopped by SIGINT/SIGTERM exits 128 + the signal's number (130 for Ctrl-C) after saying
+    what it kept."""
     from ..errors import ModelError, SimulationError
+    from ..simulation.interrupt import Interrupted, exit_status
 
     try:
         app()
@@ -282,5 +292,20 @@ def main() -> None:
         typer.echo(f"error: {error}", err=True)
         sys.exit(2)
     except SimulationError as error:
+        _print_kept(error)
         typer.echo(f"simulation failed: {error}", err=True)
         sys.exit(1)
+    except Interrupted as error:
+        _print_kept(error)
+        typer.echo(f"{error}; stopped cleanly", err=True)
+        sys.exit(exit_status(error.signal))
+    except KeyboardInterrupt:
+        typer.echo("interrupted; no partial file was left", err=True)
+        sys.exit(130)
+
+
+def _print_kept(error: Exception) -> None:
+    """The report of the files a failed or interrupted job wrote before it stopped."""
+    report = getattr(error, "report", None)
+    if report is not None:
+        print_report(report)

@@ -8,7 +8,14 @@ from typing import Annotated
 
 import typer
 
-from .common import ForceOption, app, check_new_file, print_json, save_figure
+from .common import (
+    ForceOption,
+    app,
+    check_figure_file,
+    print_json,
+    print_report,
+    save_figure,
+)
 
 SceneArgument = Annotated[Path, typer.Argument(help="Scene file (.toml or .json).")]
 RecordingArgument = Annotated[Path, typer.Argument(help="Recording file (recording.h5).")]
@@ -40,6 +47,13 @@ def run_command(
     dry_run: Annotated[
         bool, typer.Option("--dry-run", help="Validate and print counts; write nothing.")
     ] = False,
+    energy_tolerance: Annotated[
+        float | None,
+        typer.Option(
+            help="Warn when a conservative scene's energy changes by more than this fraction "
+            "(default: the scene's, 0.01)."
+        ),
+    ] = None,
     force: ForceOption = False,
 ) -> None:
     """Run a scene: recording.h5, summary.json and the requested outputs into a directory."""
@@ -61,8 +75,15 @@ def run_command(
         typer.echo(f"recording: {report.frames} frames; {advice}")
         typer.echo(f"would write: {', '.join(report.outputs)} into {output}")
         return
-    for path in run_scene(model, output, duration=duration, formats=formats or (), force=force):
-        typer.echo(f"wrote {path}")
+    report = run_scene(
+        model,
+        output,
+        duration=duration,
+        formats=formats or (),
+        force=force,
+        energy_tolerance=energy_tolerance,
+    )
+    print_report(report)
 
 
 @app.command("validate")
@@ -103,7 +124,7 @@ def plot_command(
         raise ModelError("choose one of --energy and --momentum per plot")
     kind = "momentum" if momentum else "energy"
     target = output or recording.with_name(f"{kind}.png")
-    check_new_file(target, force)
+    check_figure_file(target, force)
     if kind == "momentum":
         figure = plot_momentum(Recording.load(recording, run))
     else:
@@ -127,11 +148,12 @@ def view_command(
     force: ForceOption = False,
 ) -> None:
     """Write the single-file web viewer of a recording (open it in any browser)."""
+    from ..io.files import check_new_file
     from ..io.recording import Recording
     from ..viz.viewer import write_viewer
 
     target = output or recording.with_name("viewer.html")
-    check_new_file(target, force)
+    check_new_file(target, force=force)
     written = write_viewer(Recording.load(recording, run), target, fps=fps, speed=speed)
     typer.echo(f"wrote {written}; open it in a browser (file://{written.resolve()})")
 
@@ -155,6 +177,7 @@ def export_command(
     """Export a recording for Blender/Houdini (USD, glTF, OBJ, PC2) or as a video."""
     from .._validation import did_you_mean
     from ..errors import ModelError
+    from ..io.files import check_new_file
     from ..io.outputs import OUTPUT_FILES
     from ..io.recording import Recording
 
@@ -173,7 +196,7 @@ def export_command(
         if any(target.glob("*.obj")) and not force:
             raise ModelError(f"{target} already holds OBJ files; pass --force to replace them")
     else:
-        check_new_file(target, force)
+        check_new_file(target, force=force)
     source = Recording.load(recording, run)
     if video:
         from ..viz.video import render_video

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import time
 import warnings
-from collections import Counter
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,8 +16,9 @@ from typing import Any
 
 from .._validation import did_you_mean, real_number
 from ..errors import ModelError
-from ..io.job import JobOutput, run_summary
+from ..io.job import JobOutput, JobReport, python_warnings, run_summary
 from ..io.outputs import output_names, write_output
+from ..simulation.interrupt import Interrupted, StopOnSignal
 
 __all__ = ["Demo", "demos", "register_demo", "run_demo"]
 
@@ -69,7 +69,7 @@ def run_demo(
     formats: Iterable[str] = (),
     fps: float = 30.0,
     force: bool = False,
-) -> list[Path]:
+) -> JobReport:
     """Run demo ``name`` and write its outputs into ``directory``.
 
     Args:
@@ -82,7 +82,12 @@ def run_demo(
         force: Replace outputs that already exist.
 
     Returns:
-        The files written.
+        The files written and the summary (also in ``summary.json``).
+
+    Raises:
+        ModelError: Bad arguments or existing outputs, before anything runs.
+        Interrupted: On SIGINT/SIGTERM: the runs finished so far, the one cut short (marked
+            ``-interrupted``) and the summary were written (``error.report``).
     """
     available = demos()
     if name not in available:
@@ -104,29 +109,75 @@ def run_demo(
             f"{', '.join(d.name for d in available.values() if d.picture)}"
         )
     fps = real_number("fps", fps, positive=True, unit=" frames/s")
-    output = JobOutput(directory, force=force)
-    output.check_target(["recording.h5", "summary.json", *extras])
-    started = time.perf_counter()
-    with warnings.catch_warnings(record=True) as caught:
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        StopOnSignal() as stops,
+        JobOutput(directory, force=force) as output,
+    ):
         warnings.simplefilter("always")
-        extra = demo.run(output, seconds)
+        output.check_target(["recording.h5", "summary.json", *extras])
+        started = time.perf_counter()
+        interrupted: Interrupted | None = None
+        extra: dict[str, Any] = {}
+        try:
+            with stops.polled():
+                extra = demo.run(output, seconds)
+        except Interrupted as error:
+            interrupted = error
+            if error.recording is not None:
+                output.recordings[_interrupted_run_name(output, error)] = error.recording
+        if interrupted is None and stops.requested:
+            interrupted = Interrupted(stops.requested, seconds)
+        summary = _summary(demo, output, seconds, interrupted) | extra
+        if extras and interrupted is None:
+            run, primary = next(iter(output.recordings.items()))
+            summary["outputs_show_run"] = run
+            for file_name in extras:
+                try:
+                    with output.writing(file_name) as path:
+                        write_output(primary, path, fps, demo.speed)
+                except KeyboardInterrupt:
+                    interrupted = Interrupted(stops.requested or "SIGINT", seconds)
+                    summary["interrupted"] = interrupted.signal
+                    summary["message"] = f"{interrupted.signal} while writing {file_name}"
+                    break
+        summary["wall_time_s"] = time.perf_counter() - started
+        summary["warnings"] = python_warnings(caught)
+        report = output.write(summary)
+    if interrupted is not None:
+        interrupted.report = report  # type: ignore[attr-defined]
+        raise interrupted
+    return report
+
+
+def _summary(
+    demo: Demo, output: JobOutput, seconds: float, interrupted: Interrupted | None
+) -> dict[str, Any]:
     runs = {run: run_summary(recording) for run, recording in output.recordings.items()}
     drifts = [r["energy_drift"] for r in runs.values() if r["energy_drift"] is not None]
-    summary = {
+    summary: dict[str, Any] = {
         "demo": demo.name,
         "description": demo.summary,
         "duration_s": seconds,
+        "complete": interrupted is None,
         "steps": sum(int(r.get("steps", 0)) for r in runs.values()),
-        "wall_time_s": time.perf_counter() - started,
         "energy_drift": max(drifts, key=abs) if drifts else None,
-        "warnings": dict(Counter(w.category.__name__ for w in caught)),
         "runs": runs,
-    } | extra
-    if extras:
-        primary = next(iter(output.recordings.values()))
-        for file_name in extras:
-            write_output(primary, output.stage(file_name), fps, demo.speed)
-    return output.write(summary)
+    }
+    if interrupted is not None:
+        summary["interrupted"] = interrupted.signal
+        summary["message"] = str(interrupted)
+    return summary
+
+
+def _interrupted_run_name(output: JobOutput, error: Interrupted) -> str:
+    """A name for the run a signal cut short: its method, marked, unique in the job."""
+    base = f"{error.recording.attrs.get('method', 'run')}-interrupted"
+    name, k = base, 1
+    while name in output.recordings:
+        k += 1
+        name = f"{base}-{k}"
+    return name
 
 
 def _load_builtins() -> None:

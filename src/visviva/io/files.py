@@ -10,11 +10,14 @@ from __future__ import annotations
 
 import contextlib
 import os
+import stat
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-__all__ = ["atomic_path"]
+from ..errors import ModelError
+
+__all__ = ["atomic_path", "check_directory", "check_new_file"]
 
 
 def _default_mode() -> int:
@@ -50,3 +53,73 @@ def atomic_path(target: str | os.PathLike[str]) -> Iterator[Path]:
     except BaseException:
         temporary.unlink(missing_ok=True)
         raise
+
+
+def check_directory(path: str | os.PathLike[str], what: str = "output directory") -> None:
+    """Refuse, before any work, a directory that cannot be created or written.
+
+    ``path`` may not exist yet: then its nearest existing ancestor must be a directory in which
+    files can be created (checked by creating and removing a probe file), so that ``-o
+    afile/out`` or ``-o /proc/out`` fail at once instead of after the simulation.
+    """
+    target = Path(path)
+    if target.exists() and not target.is_dir():
+        raise ModelError(f"{what} {os.fspath(target)!r} is a file, not a directory")
+    _check_creatable(target if target.exists() else target.parent, target, what)
+
+
+def check_new_file(
+    path: str | os.PathLike[str],
+    *,
+    force: bool,
+    suffixes: tuple[str, ...] | None = None,
+    what: str = "output",
+) -> None:
+    """Refuse, before any work, an output file that cannot or must not be written.
+
+    Args:
+        path: The file to write; missing parent directories will be created.
+        force: Allow replacing an existing file.
+        suffixes: Accepted file name endings (lower case, with the dot), or ``None``.
+        what: What the file is, for messages.
+    """
+    target = Path(path)
+    if suffixes is not None and target.suffix.lower() not in suffixes:
+        raise ModelError(
+            f"{what} {os.fspath(target)!r} must end in {', '.join(suffixes)} "
+            f"(got {target.suffix or 'no suffix'!r})"
+        )
+    if target.is_dir():
+        raise ModelError(
+            f"{what} {os.fspath(target)!r} is a directory; give a file name such as "
+            f"{os.fspath(target / ('output' + (suffixes[0] if suffixes else '')))}"
+        )
+    if target.exists() or target.is_symlink():
+        if not force:
+            raise ModelError(f"{os.fspath(target)} already exists; pass --force to replace it")
+        if not stat.S_ISREG(target.stat().st_mode):
+            raise ModelError(f"{what} {os.fspath(target)!r} is not a regular file")
+    _check_creatable(target.parent, target, what)
+
+
+def _check_creatable(directory: Path, target: Path, what: str) -> None:
+    """``directory`` (or its nearest existing ancestor) accepts new files."""
+    ancestor = directory
+    while not ancestor.exists() and ancestor != ancestor.parent:
+        if ancestor.is_symlink():
+            break  # a dangling link: the probe below reports it
+        ancestor = ancestor.parent
+    if ancestor.exists() and not ancestor.is_dir():
+        raise ModelError(
+            f"cannot create {what} {os.fspath(target)!r}: {os.fspath(ancestor)!r} is a file, "
+            "not a directory"
+        )
+    try:
+        handle, name = tempfile.mkstemp(prefix=".visviva-probe-", dir=ancestor)
+    except OSError as exc:
+        raise ModelError(
+            f"cannot create {what} {os.fspath(target)!r}: {exc.strerror or exc} in "
+            f"{os.fspath(ancestor)!r}; choose another location"
+        ) from None
+    os.close(handle)
+    os.unlink(name)

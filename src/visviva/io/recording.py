@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validation import describe
 from .._version import __version__
 from ..errors import ModelError
 from .files import atomic_path
@@ -220,8 +221,8 @@ class Recording:
         if run is None:
             if len(runs) != 1:
                 raise ModelError(
-                    f"{os.fspath(path)} holds {len(runs)} runs ({', '.join(runs)}); "
-                    "pass run=NAME to choose one"
+                    f"{os.fspath(path)} holds {len(runs)} runs ({', '.join(runs)}); choose one "
+                    "with --run NAME (in Python: run=NAME)"
                 )
             return next(iter(runs.values()))
         if run not in runs:
@@ -305,30 +306,49 @@ def read_recordings(path: str | os.PathLike[str]) -> dict[str, Recording]:
     with file:
         if file.attrs.get("format") != FORMAT:
             raise ModelError(f"{os.fspath(path)} is not a visviva recording")
-        version = int(file.attrs["format_version"])
+        version = file.attrs.get("format_version")
+        if not isinstance(version, (int, np.integer)) or version < 1:
+            raise ModelError(f"{os.fspath(path)} has no valid format_version (got {version!r})")
         if version > FORMAT_VERSION:
             raise ModelError(
                 f"{os.fspath(path)} has recording format {version}; this visviva reads up to "
                 f"{FORMAT_VERSION} (upgrade visviva)"
             )
-        runs = {}
-        for name in json.loads(file.attrs["runs"]):
-            group = file[name]
-            attrs: dict[str, Any] = {}
-            for key, value in group.attrs.items():
-                if key.startswith("json:"):
-                    attrs[key[5:]] = json.loads(value)
-                else:
-                    attrs[key] = value.item() if isinstance(value, np.generic) else value
-            fields = {k: d[()] for k, d in group["fields"].items()}
-            static = {k: d[()] for k, d in group["static"].items()} if "static" in group else {}
-            units = {
-                k: str(d.attrs.get("units", ""))
-                for part in ("fields", "static")
-                if part in group
-                for k, d in group[part].items()
-            }
-            runs[name] = Recording(
-                group["time"][()], fields, units=units, attrs=attrs, static=static
-            )
+        try:
+            return _read_runs(file)
+        except _DAMAGE as exc:
+            raise ModelError(
+                f"{os.fspath(path)} is a damaged visviva recording ({type(exc).__name__}: "
+                f"{exc}); run the simulation again to rewrite it"
+            ) from None
+
+
+#: What a recording file with missing or malformed parts raises while it is read.
+_DAMAGE = (KeyError, ValueError, TypeError, IndexError, AttributeError, OSError)
+
+
+def _read_runs(file: Any) -> dict[str, Recording]:
+    names = json.loads(file.attrs["runs"])
+    if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
+        raise ValueError(f"the list of runs is {describe(names)}")
+    runs = {}
+    for name in names:
+        group = file[name]
+        attrs: dict[str, Any] = {}
+        for key, value in group.attrs.items():
+            if key.startswith("json:"):
+                attrs[key[5:]] = json.loads(value)
+            else:
+                attrs[key] = value.item() if isinstance(value, np.generic) else value
+        fields = {k: d[()] for k, d in group["fields"].items()}
+        static = {k: d[()] for k, d in group["static"].items()} if "static" in group else {}
+        units = {
+            k: str(d.attrs.get("units", ""))
+            for part in ("fields", "static")
+            if part in group
+            for k, d in group[part].items()
+        }
+        runs[name] = Recording(
+            group["time"][()], fields, units=units, attrs=attrs, static=static
+        )
     return runs

@@ -71,6 +71,11 @@ class Integration(_Strict):
     record_every: Annotated[int, Field(ge=1)] | None = Field(
         None, description="record every k-th step (default: about 60 frames per second)"
     )
+    energy_tolerance: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+        0.01,
+        description="warn when the energy of a conservative scene changes by more than this "
+        "fraction of its initial value",
+    )
 
     @field_validator("method")
     @classmethod

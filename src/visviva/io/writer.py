@@ -68,6 +68,7 @@ class RecordingWriter:
         self.units = dict(units or {})
         self.flush_every = flush_every
         self.frames = 0
+        self.last_time = float("nan")
         self._file = h5py.File(self.path, "w")
         self._file.attrs["format"] = FORMAT
         self._file.attrs["format_version"] = FORMAT_VERSION
@@ -91,10 +92,12 @@ class RecordingWriter:
         self._file.flush()
 
     def append(self, t: float, fields: Mapping[str, np.ndarray]) -> None:
-        """Add one frame: its time [s] and one array per field (same shapes every frame)."""
+        """Add one frame: its time [s] and one array per field (same shapes every frame).
+
+        The frame counts once every array is written: an append cut short (by a signal) is
+        dropped by :meth:`finish`.
+        """
         index = self.frames
-        self._time.resize((index + 1,))
-        self._time[index] = t
         for name, value in fields.items():
             value = np.asarray(value)
             if name not in self._fields:
@@ -109,7 +112,10 @@ class RecordingWriter:
             dataset = self._fields[name]
             dataset.resize((index + 1, *value.shape))
             dataset[index] = value
+        self._time.resize((index + 1,))
+        self._time[index] = t
         self.frames += 1
+        self.last_time = float(t)
         if self.frames % self.flush_every == 0:
             self._file.flush()
 
@@ -122,6 +128,9 @@ class RecordingWriter:
             attrs: Attributes to add or replace.
             series: Fields computed after the run (such as ``energy``), one row per frame.
         """
+        self._time.resize((self.frames,))
+        for dataset in self._fields.values():
+            dataset.resize((self.frames, *dataset.shape[1:]))
         for name, values in (series or {}).items():
             values = np.asarray(values)
             if values.shape[:1] != (self.frames,):

@@ -53,6 +53,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
             substeps=integration.substeps,
             record_every=integration.record_every
             or Integration.default_record_every(integration.dt),
+            energy_tolerance=integration.energy_tolerance,
         ),
         particle_position=position,
         particle_velocity=velocity,

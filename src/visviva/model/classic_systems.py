@@ -37,6 +37,7 @@ def _lagrangian(
     start: Callable[[Mapping[str, float]], tuple[list[float], list[float]]],
     lift: Callable[[Mapping[str, float]], float],
     edges: tuple[tuple[int, int], ...] | None,
+    dissipation: str | None = None,
 ) -> SystemType:
     """A named system from a Lagrangian system factory ``make(values, g)``."""
 
@@ -55,7 +56,7 @@ def _lagrangian(
         points[..., 1] += lift(values)
         return points
 
-    return SystemType(name, summary, parameters, build, draw, edges)
+    return SystemType(name, summary, parameters, build, draw, edges, dissipation=dissipation)
 
 
 def _pendulum(values: Mapping[str, float], g: float) -> Any:
@@ -195,6 +196,7 @@ CLASSIC_SYSTEMS: dict[str, SystemType] = {
             lambda p: ([p["x0"]], [p["v0"]]),
             lambda p: 0.5,
             ((0, 1),),
+            dissipation="damping",
         ),
         _lagrangian(
             "rock",
@@ -226,6 +228,7 @@ CLASSIC_SYSTEMS: dict[str, SystemType] = {
             _constrained_pendulum,
             _draw_constrained,
             ((0, 1),),
+            dissipation="stabilization",  # Baumgarte's correction removes energy too
         ),
     )
 }

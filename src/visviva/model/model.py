@@ -43,6 +43,8 @@ class Integration:
         duration: Simulated time [s].
         substeps: Integrator steps per step.
         record_every: Record every k-th step.
+        energy_tolerance: Relative energy change beyond which a run of a conservative scene
+            ends with a warning, ``max |E(t) − E(0)| / |E(0)|``.
     """
 
     method: str
@@ -50,6 +52,7 @@ class Integration:
     duration: float
     substeps: int
     record_every: int
+    energy_tolerance: float = 0.01
 
     @staticmethod
     def default_record_every(dt: float) -> int:
@@ -119,6 +122,14 @@ class Model:
     def particle_count(self) -> int:
         """Number of particles."""
         return self.particle_position.shape[0]
+
+    @property
+    def conservative(self) -> bool:
+        """True if the scene's energy is conserved by the exact dynamics (so a change in it
+        measures the integrator's error): particles under gravity, undamped systems."""
+        if self.system is None:
+            return True
+        return SYSTEMS[self.system.system].conservative(self.system.parameters)
 
     @property
     def has_geometry(self) -> bool:

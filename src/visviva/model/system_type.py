@@ -53,6 +53,8 @@ class SystemType:
         edges: Point-index pairs drawn as lines, or ``None``.
         energy_unit: Unit of the recorded energy (``"J/kg"`` for systems written per unit
             mass).
+        dissipation: Name of the parameter that makes the system lose energy when it is not
+            zero (a damping coefficient), or ``None`` if it always conserves energy.
     """
 
     name: str
@@ -62,3 +64,8 @@ class SystemType:
     draw: Drawing | None = None
     edges: tuple[tuple[int, int], ...] | None = None
     energy_unit: str = "J"
+    dissipation: str | None = None
+
+    def conservative(self, values: Mapping[str, float]) -> bool:
+        """True if the system with these parameter values conserves its energy."""
+        return self.dissipation is None or values[self.dissipation] == 0.0

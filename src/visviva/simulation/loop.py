@@ -9,7 +9,10 @@ whole number of steps, the last step is shortened to end exactly at ``t_end``.
 Every ``record_every``-th step (and the last) becomes a frame of the :class:`Recording`. After
 every integrator step the divergence watch checks the state; a blow-up stops the run with
 :class:`~visviva.errors.SimulationDiverged`, whose ``recording`` attribute holds the frames
-recorded before it.
+recorded before it. Inside :class:`~visviva.simulation.interrupt.StopOnSignal`, a Ctrl-C or
+SIGTERM ends the run after the current step (compiled: after the current chunk of frames): that
+state becomes the last frame and :class:`~visviva.simulation.interrupt.Interrupted` carries the
+recording to the caller.
 
 When the problem's functions are Numba functions and the method has a compiled step, the whole
 loop runs compiled (:mod:`visviva.integrators.compiled`) with the same schedule, frames and
@@ -32,6 +35,7 @@ from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get
 from ..io.recording import Recording
 from ..ode.state import FirstOrderState, SecondOrderState
+from .interrupt import Interrupted, stop_requested
 from .progress import Progress
 from .watch import DivergenceWatch
 
@@ -208,6 +212,8 @@ def simulate(
         ModelError: For invalid arguments, before any step.
         SimulationDiverged: If the state blows up; ``error.recording`` holds the frames so far.
         NewtonConvergenceError: If an implicit step fails; ``error.recording`` likewise.
+        Interrupted: If a stop was requested by a signal (see
+            :mod:`~visviva.simulation.interrupt`); ``error.recording`` likewise.
     """
     check_problem(problem)
     integrator = get(method)
@@ -249,7 +255,7 @@ def simulate(
         "visviva_version": __version__,
     }
     started = time.perf_counter()
-    error: SimulationError | None = None
+    error: SimulationError | Interrupted | None = None
     with Progress(schedule.steps, f"{integrator.name}", progress) as bar:
         try:
             if compiled_step is None:
@@ -266,13 +272,15 @@ def simulate(
                     watch,
                     bar,
                 )
-        except SimulationError as failure:
+        except (SimulationError, Interrupted) as failure:
             error = failure
     attrs["wall_time_s"] = time.perf_counter() - started
     attrs["steps"] = system.counters.accepted_steps
     attrs |= system.counters.as_dict()
-    attrs["success"] = error is None
+    attrs["success"] = attrs["complete"] = error is None
     attrs["message"] = "completed" if error is None else str(error)
+    if isinstance(error, Interrupted):
+        attrs["interrupted"] = error.signal
     recording = recorder.recording(attrs)
     add_energy(recording, system)
     if error is not None:
@@ -337,9 +345,12 @@ def _run_numpy(
             system.counters.accepted_steps += 1
             if not watch.healthy(state):
                 raise watch.diverged(state, step * substeps + sub, previous)
-        if (step + 1) % record_every == 0 or step + 1 == schedule.steps:
+        last = step + 1 == schedule.steps
+        if (step + 1) % record_every == 0 or last or stop_requested():
             recorder.append(state)
         bar.advance(1)
+        if not last:
+            _stop_if_requested(recorder)
 
 
 def _stack(state: State) -> np.ndarray:
@@ -422,6 +433,8 @@ def _run_compiled(
         advance(schedule.t0, h, first, steps * substeps, every, frames, first, done == 0)
         done += steps
         bar.advance(steps)
+        if done < schedule.full_steps or schedule.last_dt > 0.0:
+            _stop_if_requested(recorder)
     if schedule.last_dt > 0.0:
         start = schedule.t0 + schedule.full_steps * substeps * h
         advance(
@@ -435,6 +448,13 @@ def _run_compiled(
             schedule.full_steps == 0,
         )
         bar.advance(1)
+
+
+def _stop_if_requested(recorder: FrameRecorder) -> None:
+    """Raise :class:`Interrupted` at the last recorded frame if a signal asked to stop."""
+    name = stop_requested()
+    if name is not None:
+        raise Interrupted(name, recorder.times[-1])
 
 
 def _unstack(y: np.ndarray, n: int, batch: bool, template: State) -> tuple[np.ndarray, ...]:

@@ -20,7 +20,13 @@ if TYPE_CHECKING:
     from ..ode.state import State
     from ..ode.system import System
 
-__all__ = ["DEFAULT_DIVERGENCE_LIMIT", "DivergenceWatch"]
+__all__ = [
+    "DEFAULT_DIVERGENCE_LIMIT",
+    "DivergenceWatch",
+    "divergence_advice",
+    "energy_drift_advice",
+    "suggested_dt",
+]
 
 #: A state component beyond this many times the initial state's scale (at least 1) counts as
 #: diverged: 1e10 for states of order one, scaled up for, say, orbits in metres.
@@ -64,13 +70,13 @@ class DivergenceWatch:
     def diverged(self, state: State, step: int, last_good: State) -> SimulationDiverged:
         """The exception describing why ``state`` (reached by step ``step``) is not healthy."""
         component, value, system_index = self._first_offender(state)
-        suggestion = self._advice(last_good, system_index)
+        suggestion = suggested_dt(self.system, self.method, last_good, system_index)
         problem = (
             "is not finite" if not np.isfinite(value) else (f"exceeds the limit {self.limit:.3g}")
         )
         message = (
             f"simulation diverged at t={state.t:.6g} s (step {step}): {component} = {value!r} "
-            f"{problem}. {self._explain(suggestion)}"
+            f"{problem}. {divergence_advice(self.method, self.dt, suggestion)}"
         )
         return SimulationDiverged(
             message,
@@ -94,41 +100,77 @@ class DivergenceWatch:
                 return label, value, (index[0] if part.ndim == 2 else None)  # type: ignore[return-value]
         raise ValueError("state is healthy")
 
-    def _advice(self, last_good: State, system_index: int | None) -> float | None:
-        """The advisor's largest stable step at the last finite state, or None if unavailable."""
-        from ..analysis.stability import max_stable_dt, state_jacobian
 
-        try:
-            jacobian = state_jacobian(self.system, last_good)
-            if system_index is not None:
-                jacobian = jacobian[system_index]
-            return max_stable_dt(self.method, jacobian=jacobian)
-        except Exception:
-            return None
+def suggested_dt(
+    system: System, method: Integrator, state: State, system_index: int | None = None
+) -> float | None:
+    """The stability advisor's largest stable step [s] of ``method`` at ``state``.
 
-    def _explain(self, suggestion: float | None) -> str:
-        name = self.method.name
-        if suggestion is None:
-            return (
-                f"The stability advisor could not estimate a stable step. Reduce dt (now "
-                f"{self.dt:.3g} s) or try an implicit method such as 'backward_euler'."
-            )
-        if suggestion == 0.0:
-            return (
-                f"The linearized system has undamped oscillating modes, on which {name!r} is "
-                "unstable for every step; use a symplectic method ('velocity_verlet', "
-                "'symplectic_euler') or an implicit one ('implicit_midpoint', 'backward_euler')."
-            )
-        if not np.isfinite(suggestion):
-            return (
-                f"{name!r} is stable for every step on this system's linearization at the last "
-                "finite state, so the growth comes from the model itself (a growing mode or "
-                "strong nonlinearity): check its parameters, or reduce dt."
-            )
-        verdict = "above" if self.dt > suggestion else "within"
+    ``None`` if it could not be estimated, ``0`` if no step is stable, ``inf`` if every step
+    is; ``system_index`` picks one system of a batch.
+    """
+    from ..analysis.stability import max_stable_dt, state_jacobian
+
+    try:
+        jacobian = state_jacobian(system, state)
+        if system_index is not None:
+            jacobian = jacobian[system_index]
+        return max_stable_dt(method, jacobian=jacobian)
+    except Exception:
+        return None
+
+
+def divergence_advice(method: Integrator, dt: float, suggestion: float | None) -> str:
+    """What to do about a blow-up, given the advisor's ``suggestion`` at the last finite state."""
+    name = method.name
+    if suggestion is None:
         return (
-            f"The stability advisor estimates the largest stable step of {name!r} at "
-            f"dt ≈ {suggestion:.4g} s (from the Jacobian's eigenvalues at the last finite state); "
-            f"dt = {self.dt:.4g} s is {verdict} it. Use dt below {0.9 * suggestion:.3g} s or an "
-            "implicit method such as 'backward_euler'."
+            f"The stability advisor could not estimate a stable step. Reduce dt (now "
+            f"{dt:.3g} s) or try an implicit method such as 'backward_euler'."
         )
+    if suggestion == 0.0:
+        return _UNSTABLE_FOR_EVERY_STEP.format(name=name)
+    if not np.isfinite(suggestion):
+        return (
+            f"{name!r} is stable for every step on this system's linearization at the last "
+            "finite state, so the growth comes from the model itself (a growing mode or "
+            "strong nonlinearity): check its parameters, or reduce dt."
+        )
+    verdict = "above" if dt > suggestion else "within"
+    return (
+        f"The stability advisor estimates the largest stable step of {name!r} at "
+        f"dt ≈ {suggestion:.4g} s (from the Jacobian's eigenvalues at the last finite state); "
+        f"dt = {dt:.4g} s is {verdict} it. Use dt below {0.9 * suggestion:.3g} s or an "
+        "implicit method such as 'backward_euler'."
+    )
+
+
+def energy_drift_advice(method: Integrator, dt: float, suggestion: float | None) -> str:
+    """What to do about a conservative system's energy changing too much, given the advisor's
+    ``suggestion`` at the initial state."""
+    name = method.name
+    if suggestion == 0.0:
+        return _UNSTABLE_FOR_EVERY_STEP.format(name=name)
+    if suggestion is not None and np.isfinite(suggestion) and dt > suggestion:
+        return (
+            f"dt = {dt:.4g} s is above the largest stable step of {name!r}, which the "
+            f"stability advisor estimates at {suggestion:.4g} s: use dt below "
+            f"{0.9 * suggestion:.3g} s."
+        )
+    if method.symplectic:
+        return (
+            f"{name!r} keeps the energy error bounded but not small at dt = {dt:.4g} s: reduce "
+            "dt (the error shrinks as dt^order)."
+        )
+    return (
+        f"{name!r} is stable at dt = {dt:.4g} s but changes the energy steadily: reduce dt, or "
+        "use a symplectic method ('velocity_verlet') whose energy error stays bounded over "
+        "long runs."
+    )
+
+
+_UNSTABLE_FOR_EVERY_STEP = (
+    "The linearized system has undamped oscillating modes, on which {name!r} is unstable for "
+    "every step; use a symplectic method ('velocity_verlet', 'symplectic_euler') or an implicit "
+    "one ('implicit_midpoint', 'backward_euler')."
+)
