@@ -179,7 +179,7 @@ def run_scene(
         summary["warnings"] += python_warnings(caught)
         report = job.write(summary)
     if failure is not None:
-        failure.report = report  # type: ignore[union-attr]
+        failure.report = report
         raise failure
     return report
 
@@ -225,7 +225,7 @@ def _simulate_streaming(
                 )
         except (SimulationError, Interrupted) as error:
             failure = error
-            loop_recording = error.recording  # type: ignore[union-attr]
+            loop_recording = error.recording
         except KeyboardInterrupt:
             # A second signal: the user wants out now; keep the frames already streamed.
             failure = Interrupted(stops.requested or "SIGINT", writer.last_time)

@@ -9,11 +9,16 @@ numerical failures exit with status 1. The scene and output commands live in
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
+
+if TYPE_CHECKING:
+    from ..integrators import Integrator
+    from ..ode.system import System
 
 from .common import (
     ForceOption,
@@ -124,14 +129,27 @@ def convergence_command(
     from .._validation import real_number, whole_number
     from ..analysis.convergence import convergence_order
     from ..analysis.reference_problems import reference_problem
+    from ..errors import ModelError
     from ..integrators import get, names
 
-    instances = [get(name) for name in (methods or names())]
     levels = whole_number("levels", levels, minimum=3)
+    if levels > MAX_LEVELS:
+        raise ModelError(
+            f"`--levels` must be at most {MAX_LEVELS} (got {levels}): each level halves the "
+            "step and doubles the time, and beyond 14 levels round-off hides the truncation "
+            "error of every method of order 2 or more"
+        )
     t_end = real_number("t_end", t_end, positive=True, unit=" s")
+    if t_end > MAX_CONVERGENCE_TIME:
+        raise ModelError(
+            f"`--t-end` must be at most {MAX_CONVERGENCE_TIME:g} s (got {t_end!r}): the "
+            "measured error then mixes in chaos and round-off"
+        )
     if output is not None:
         check_figure_file(output, force)
     test = reference_problem(problem)
+    system = test.problem.system()
+    instances = [get(name) for name in methods] if methods else _applicable(system, names())
     studies = [
         convergence_order(
             test.problem,
@@ -168,6 +186,29 @@ def convergence_command(
         )
     if output is not None:
         typer.echo(f"wrote {output}")
+
+
+#: Most halvings `convergence` makes: at 14 levels the finest step is 2⁻¹³/10 of the span and
+#: every method of order ≥ 2 already meets round-off; each further level doubles the time.
+MAX_LEVELS = 14
+#: Longest span of a convergence measurement [s].
+MAX_CONVERGENCE_TIME = 1000.0
+
+
+def _applicable(system: System, names: list[str]) -> list[Integrator]:
+    """The registered methods that can integrate ``system`` (e.g. no Taylor on ``y' = f``)."""
+    from ..errors import ModelError
+    from ..integrators import get
+
+    methods = []
+    for name in names:
+        method = get(name)
+        try:
+            method.check(system)
+        except ModelError:
+            continue
+        methods.append(method)
+    return methods
 
 
 @app.command("equations")
@@ -212,31 +253,46 @@ def compare_command(
     force: ForceOption = False,
 ) -> None:
     """Run one system under several integrators: energy plot, convergence plot and a table."""
+    from .._validation import did_you_mean, real_number
     from ..analysis.compare import compare_methods
+    from ..errors import ModelError
     from ..io.job import JobOutput
     from ..model.builder import SceneBuilder
+    from ..model.systems import SYSTEMS
     from ..scenes import load_model
 
+    if dt is not None:
+        dt = real_number("--dt", dt, positive=True, unit=" s")
+    if duration is not None:
+        duration = real_number("--duration", duration, positive=True, unit=" s")
     if target.endswith((".toml", ".json")) or Path(target).exists():
         model = load_model(target)
-    else:
+        step, span = dt or model.integration.dt, duration or model.integration.duration
+        _check_steps(span, step)
+    elif target in SYSTEMS:
+        step, span = dt or 1e-3, duration or 10.0
+        _check_steps(span, step)
         builder = SceneBuilder(name=target)
-        builder.set_integration(method="rk4", dt=dt or 1e-3, duration=duration or 10.0)
+        builder.set_integration(method="rk4", dt=step, duration=span)
         builder.add_system(target)
         model = builder.build()
-    directory = output if output is not None else Path("out") / f"compare-{model.name}"
+    else:
+        raise ModelError(
+            f"{target!r} is neither a scene file nor a named system.{did_you_mean(target, SYSTEMS)}"
+            f" Systems: {', '.join(SYSTEMS)}"
+        )
+    directory = output if output is not None else Path("out") / f"compare-{_slug(model.name)}"
     job = JobOutput(directory, force=force)
     job.check_target(["recording.h5", "summary.json", "energy.png", "convergence.png"])
     problem = model.problem()
-    step = dt or model.integration.dt
-    end = problem.t0 + (duration or model.integration.duration)
+    end = problem.t0 + span
     comparison = compare_methods(
         problem,
         list(methods or COMPARED),
         dt=step,
         t_end=end,
         convergence_t_end=problem.t0 + min(convergence_time, end - problem.t0),
-        record_every=max(1, round((end - problem.t0) / step / 2000)),
+        record_every=max(1, round(span / step / 2000)),
     )
     job.recordings.update(comparison.runs)
     job.figures["energy"] = comparison.energy_figure(f"{model.name}: energy, h = {step:g} s")
@@ -245,6 +301,25 @@ def compare_command(
     typer.echo(table)
     for path in job.write({"target": target, "table": table} | comparison.as_dict()).files:
         typer.echo(f"wrote {path}")
+
+
+def _check_steps(span: float, step: float) -> None:
+    """Refuse a comparison whose runs would take more steps than any run may."""
+    from ..errors import ModelError
+    from ..simulation.loop import MAX_STEPS
+
+    if span / step > MAX_STEPS:
+        raise ModelError(
+            f"a duration of {span!r} s at dt = {step!r} s would take {span / step:.3g} steps per "
+            f"method; the limit is {MAX_STEPS:.0e} (use --duration and --dt)"
+        )
+
+
+def _slug(name: str) -> str:
+    """``name`` as one safe file name: letters, digits, ``-`` and ``_`` only (no ``..``, no
+    ``/``), so a scene's name can never place output outside ``out/``."""
+    slug = re.sub(r"[^A-Za-z0-9_-]+", "-", name).strip("-")[:80]
+    return slug or "scene"
 
 
 @app.command("demo")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -62,18 +62,18 @@ def run_command(
 
     model = load_model(scene)
     if dry_run:
-        report = plan(model, duration=duration, formats=formats or ())
-        what = f"system {report.system}" if report.system else f"{report.particles} particles"
-        limit = report.max_stable_dt
+        estimate = plan(model, duration=duration, formats=formats or ())
+        what = f"system {estimate.system}" if estimate.system else f"{estimate.particles} particles"
+        limit = estimate.max_stable_dt
         advice = (
             "no step limit from the linearization"
             if math.isinf(limit)
             else f"largest stable dt for {model.integration.method} ≈ {limit:.4g} s"
             + (" (dt is above it!)" if model.integration.dt > limit else "")
         )
-        typer.echo(f"{scene}: {what}, {report.steps} steps of dt = {model.integration.dt} s")
-        typer.echo(f"recording: {report.frames} frames; {advice}")
-        typer.echo(f"would write: {', '.join(report.outputs)} into {output}")
+        typer.echo(f"{scene}: {what}, {estimate.steps} steps of dt = {model.integration.dt} s")
+        typer.echo(f"recording: {estimate.frames} frames; {advice}")
+        typer.echo(f"would write: {', '.join(estimate.outputs)} into {output}")
         return
     report = run_scene(
         model,
@@ -115,24 +115,45 @@ def plot_command(
     run: RunOption = None,
     force: ForceOption = False,
 ) -> None:
-    """Plot a recording: energy (default) or momenta over time."""
+    """Plot a recording: energy or momenta over time (default: energy if it was recorded)."""
     from ..errors import ModelError
     from ..io.recording import Recording, read_recordings
     from ..viz.plots import plot_energy, plot_momentum
 
     if energy and momentum:
         raise ModelError("choose one of --energy and --momentum per plot")
-    kind = "momentum" if momentum else "energy"
+    runs = read_recordings(recording)
+    if run is not None:
+        runs = {run: Recording.load(recording, run)}
+    with_energy = {name: r for name, r in runs.items() if "energy" in r and r.frames > 0}
+    kind = "momentum" if momentum or (not energy and not with_energy) else "energy"
+    if kind == "energy" and not with_energy:
+        raise ModelError(
+            f"{recording} has no energy to plot (fields: {_fields(runs)}); "
+            "try --momentum for a particle recording"
+        )
+    if kind == "momentum":
+        if len(runs) > 1:
+            raise ModelError(
+                f"{recording} holds {len(runs)} runs ({', '.join(runs)}); choose one with "
+                "--run NAME for --momentum"
+            )
+        (chosen,) = runs.values()
+        if not {"points", "velocities"} <= set(chosen.fields) or "mass" not in chosen.static:
+            raise ModelError(
+                f"{recording} has neither energy nor momenta to plot (fields: {_fields(runs)}); "
+                "momenta need the points, velocities and masses of a particle recording"
+            )
     target = output or recording.with_name(f"{kind}.png")
     check_figure_file(target, force)
-    if kind == "momentum":
-        figure = plot_momentum(Recording.load(recording, run))
-    else:
-        runs = read_recordings(recording)
-        chosen = runs if run is None else {run: Recording.load(recording, run)}
-        figure = plot_energy(chosen)
+    figure = plot_momentum(chosen) if kind == "momentum" else plot_energy(with_energy)
     save_figure(figure, target)
     typer.echo(f"wrote {target}")
+
+
+def _fields(runs: dict[str, Any]) -> str:
+    names = dict.fromkeys(name for r in runs.values() for name in r.fields)
+    return ", ".join(names) or "none"
 
 
 @app.command("view")

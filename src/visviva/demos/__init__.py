@@ -48,6 +48,10 @@ class Demo:
 
 _DEMOS: dict[str, Demo] = {}
 
+#: A demo runs at most this many times its default duration: demos pick their steps and frame
+#: counts for their default, and 1000× is already minutes of computing for most of them.
+MAX_DURATION_FACTOR = 1000
+
 
 def register_demo(demo: Demo) -> Demo:
     """Add a demo to the list shown by ``visviva demo``."""
@@ -101,6 +105,12 @@ def run_demo(
         if duration is None
         else real_number("duration", duration, positive=True, unit=" s")
     )
+    if seconds > MAX_DURATION_FACTOR * demo.duration:
+        raise ModelError(
+            f"`duration` of demo {name!r} must be at most {MAX_DURATION_FACTOR} times its "
+            f"default of {demo.duration:g} s (got {seconds!r} s); for longer runs write a scene "
+            "file and use `visviva run`"
+        )
     extras = output_names(formats)
     if extras and not demo.picture:
         raise ModelError(
@@ -145,7 +155,7 @@ def run_demo(
         summary["warnings"] = python_warnings(caught)
         report = output.write(summary)
     if interrupted is not None:
-        interrupted.report = report  # type: ignore[attr-defined]
+        interrupted.report = report
         raise interrupted
     return report
 

@@ -213,7 +213,7 @@ class JobOutput:
 
 def remove_stale_staging(directory: Path) -> list[Path]:
     """Remove staging directories in ``directory`` whose job's process no longer exists."""
-    removed = []
+    removed: list[Path] = []
     if not directory.is_dir():
         return removed
     for entry in directory.glob(f"{STAGING_PREFIX}*"):

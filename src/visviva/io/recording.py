@@ -348,7 +348,5 @@ def _read_runs(file: Any) -> dict[str, Recording]:
             if part in group
             for k, d in group[part].items()
         }
-        runs[name] = Recording(
-            group["time"][()], fields, units=units, attrs=attrs, static=static
-        )
+        runs[name] = Recording(group["time"][()], fields, units=units, attrs=attrs, static=static)
     return runs

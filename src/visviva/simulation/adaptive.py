@@ -220,6 +220,6 @@ def integrate_adaptive(
     recording = recorder.recording(attrs)
     add_energy(recording, system)
     if error is not None:
-        error.recording = recording  # type: ignore[attr-defined]
+        error.recording = recording
         raise error
     return recording, (DenseOutput(steps) if dense_output else None)

@@ -41,6 +41,7 @@ class Interrupted(VisvivaError):
         signal: The signal's name, ``"SIGINT"`` or ``"SIGTERM"``.
         t: Simulation time reached [s] (the last recorded frame).
         recording: The frames recorded up to ``t`` (set by the loop that stopped).
+        report: What the job (``run_scene``, ``run_demo``) wrote before raising, if any.
     """
 
     def __init__(self, signal_name: str, t: float) -> None:
@@ -48,6 +49,7 @@ class Interrupted(VisvivaError):
         self.signal = signal_name
         self.t = t
         self.recording: Any = None
+        self.report: Any = None
 
 
 def stop_requested() -> str | None:

@@ -284,7 +284,7 @@ def simulate(
     recording = recorder.recording(attrs)
     add_energy(recording, system)
     if error is not None:
-        error.recording = recording  # type: ignore[attr-defined]
+        error.recording = recording
         raise error
     return recording
 

@@ -206,7 +206,7 @@ def solve(
         )
         return Solution(recording, True, "completed")
     except SimulationError as failure:
-        return Solution(failure.recording, False, str(failure), failure)  # type: ignore[attr-defined]
+        return Solution(failure.recording, False, str(failure), failure)
 
 
 def _solve_adaptive(
