@@ -1,0 +1,147 @@
+"""Commands that behave: sensible defaults, help that reads right, and refusals that say why.
+
+Each test is one finding of the end-to-end trial of the command line (issue: "Commands that
+behave"), run in-process through the entry point ``main()`` so the exit status is the real one.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import visviva as vv
+from visviva.cli.main import main
+
+
+def run_main(monkeypatch, capsys, *args) -> tuple[int, str, str]:
+    monkeypatch.setattr(sys, "argv", ["visviva", *map(str, args)])
+    try:
+        main()
+        status = 0
+    except SystemExit as exit_:
+        status = 0 if exit_.code is None else exit_.code
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def refused(monkeypatch, capsys, *args) -> str:
+    """Run a command that must exit 2 with one ``error:`` line; return that line."""
+    status, _, err = run_main(monkeypatch, capsys, *args)
+    assert "Traceback" not in err
+    assert status == 2, err
+    (line,) = err.strip().splitlines()[-1:]
+    assert line.startswith("error: ")
+    return line
+
+
+def test_convergence_of_a_first_order_problem_uses_the_methods_that_apply(monkeypatch, capsys):
+    status, out, err = run_main(
+        monkeypatch, capsys, "convergence", "--problem", "first-order", "--levels", "4", "--json"
+    )
+    assert status == 0, err
+    methods = {row["method"] for row in json.loads(out)["methods"]}
+    assert "taylor" not in methods and "velocity_verlet" not in methods
+    assert {"explicit_euler", "rk4", "backward_euler"} <= methods
+
+
+@pytest.mark.parametrize("levels", ["25", "2000"])
+def test_convergence_levels_are_bounded(monkeypatch, capsys, levels):
+    assert "at most 14" in refused(monkeypatch, capsys, "convergence", "--levels", levels)
+
+
+def test_did_you_mean_ignores_case(monkeypatch, capsys):
+    assert "Did you mean 'rk4'?" in refused(monkeypatch, capsys, "stability", "RK4")
+
+
+def test_help_shows_units_and_no_type_tags_on_flags(monkeypatch, capsys):
+    for command in ("run", "demo", "export", "compare"):
+        status, out, _ = run_main(monkeypatch, capsys, command, "--help")
+        assert status == 0
+        assert "<bool>" not in out and not re.search(r"\w \.(\s|$)", out)
+    _, out, _ = run_main(monkeypatch, capsys, "demo", "--help")
+    assert "Simulated duration [s]" in " ".join(out.split())
+
+
+def _recording(tmp_path: Path, **fields) -> Path:
+    time = np.linspace(0.0, 1.0, 5)
+    recording = vv.Recording(time, fields)
+    return recording.save(tmp_path / "recording.h5")
+
+
+def test_plot_refuses_a_recording_without_energy_or_momenta(monkeypatch, capsys, tmp_path):
+    path = _recording(tmp_path, points=np.zeros((5, 2, 3)))
+    line = refused(monkeypatch, capsys, "plot", path, "--energy")
+    assert "no energy to plot" in line and "(fields: points)" in line
+    for flags in ((), ("--momentum",)):
+        line = refused(monkeypatch, capsys, "plot", path, *flags)
+        assert "neither energy nor momenta" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["recording.h5"]
+
+
+def test_plot_draws_what_the_recording_has(monkeypatch, capsys, tmp_path):
+    recording = vv.Recording(
+        np.linspace(0.0, 1.0, 5),
+        {"points": np.zeros((5, 2, 3)), "velocities": np.ones((5, 2, 3))},
+        static={"mass": np.ones(2)},
+    )
+    path = recording.save(tmp_path / "recording.h5")
+    status, out, err = run_main(monkeypatch, capsys, "plot", path)
+    assert status == 0 and "momentum.png" in out, err
+    assert (tmp_path / "momentum.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_several_runs_are_chosen_with_the_run_flag(monkeypatch, capsys, tmp_path):
+    time = np.linspace(0.0, 1.0, 3)
+    runs = {name: vv.Recording(time, {"points": np.zeros((3, 1, 3))}) for name in ("a", "b")}
+    path = vv.io.write_recordings(tmp_path / "recording.h5", runs)
+    line = refused(monkeypatch, capsys, "view", path)
+    assert "--run NAME" in line and "run=" not in line.replace("(in Python: run=NAME)", "")
+
+
+def test_compare_names_what_is_wrong_with_its_own_options(monkeypatch, capsys):
+    line = refused(monkeypatch, capsys, "compare", "pendulm")
+    assert "Did you mean 'pendulum'?" in line and "problem in the scene" not in line
+    assert "--dt" in refused(monkeypatch, capsys, "compare", "pendulum", "--dt", "nan")
+    assert "--duration" in refused(monkeypatch, capsys, "compare", "pendulum", "--duration", "inf")
+    assert "limit" in refused(monkeypatch, capsys, "compare", "pendulum", "--duration", "1e308")
+
+
+def test_compare_keeps_a_hostile_scene_name_inside_out(monkeypatch, capsys, tmp_path):
+    builder = vv.SceneBuilder(name="../../escape")
+    builder.set_integration(method="rk4", dt=0.01, duration=0.2)
+    builder.add_system("oscillator")
+    scene = tmp_path / "work" / "escape.toml"
+    scene.parent.mkdir()
+    scene.write_text(builder.dump())
+    monkeypatch.chdir(scene.parent)
+    status, _, err = run_main(
+        monkeypatch, capsys, "compare", scene, "rk4", "--convergence-time", "0.1"
+    )
+    assert status == 0, err
+    assert (scene.parent / "out" / "compare-escape" / "summary.json").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["work"]
+
+
+@pytest.mark.parametrize("target", ["afile/x", "/proc/visviva-out"])
+def test_an_unwritable_output_is_refused_before_the_run(monkeypatch, capsys, tmp_path, target):
+    (tmp_path / "afile").write_text("not a directory")
+    monkeypatch.chdir(tmp_path)
+    scene = Path(__file__).parents[1] / "examples" / "scenes" / "pendulum.toml"
+    line = refused(monkeypatch, capsys, "run", scene, "-o", target, "--duration", "1000")
+    assert "cannot create" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
+
+
+def test_a_figure_needs_an_image_suffix_and_may_go_into_a_new_folder(
+    monkeypatch, capsys, tmp_path
+):
+    assert ".png" in refused(monkeypatch, capsys, "stability", "rk4", "-o", tmp_path / "s.txt")
+    target = tmp_path / "out" / "figures" / "regions.png"
+    status, _, err = run_main(monkeypatch, capsys, "stability", "rk4", "-o", target)
+    assert status == 0, err
+    assert target.read_bytes()[:4] == b"\x89PNG"
