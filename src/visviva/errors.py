@@ -27,7 +27,15 @@ __all__ = [
 
 
 class VisvivaError(Exception):
-    """Base class of every exception raised by visviva."""
+    """Base class of every exception raised by visviva.
+
+    Attributes:
+        recording: The frames recorded before a run stopped (set by the simulation loop).
+        report: What a job (``run_scene``, ``run_demo``) wrote before raising, if anything.
+    """
+
+    recording: Any = None
+    report: Any = None
 
 
 class ModelError(VisvivaError, ValueError):
@@ -83,16 +91,12 @@ class SimulationError(VisvivaError, RuntimeError):
         t: Simulation time of the failure [s].
         step: Index of the step that failed (0 is the first step), or ``None`` when the failure
             was raised outside a simulation loop (a direct ``Integrator.step`` call).
-        recording: The frames recorded before the failure (set by the simulation loop).
-        report: What a job (``run_scene``, ``run_demo``) wrote before raising, if any.
     """
 
     def __init__(self, message: str, *, t: float, step: int | None) -> None:
         super().__init__(message)
         self.t = t
         self.step = step
-        self.recording: Any = None
-        self.report: Any = None
 
 
 class SimulationDiverged(SimulationError):

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 from ._validation import real_number
 from ._version import __version__
-from .errors import ModelError, SceneError, SceneProblem, SimulationError
+from .errors import ModelError, SceneError, SceneProblem, SimulationError, VisvivaError
 from .io.job import JobReport, python_warnings
 from .model import Model
 from .model.build import build_model
@@ -37,10 +37,14 @@ def load_model(path: str | os.PathLike[str]) -> Model:
 
     scene, text = load_scene(path)
     try:
-        return build_model(scene, source=text)
+        model = build_model(scene, source=text)
+        problems = output_problems(model, (), model.integration.duration)
     except SceneError as error:
-        located = [_with_line(p, text, os.fspath(path)) for p in error.problems]
+        problems = error.problems
+    if problems:
+        located = [_with_line(p, text, os.fspath(path)) for p in problems]
         raise SceneError(located, os.fspath(path)) from None
+    return model
 
 
 def _with_line(problem: SceneProblem, text: str, path: str) -> SceneProblem:
@@ -102,7 +106,7 @@ def dry_run(model: Model, *, duration: float | None = None, formats: Iterable[st
         steps=steps,
         frames=steps // settings.record_every + 1 + (1 if steps % settings.record_every else 0),
         max_stable_dt=limit,
-        outputs=tuple(_planned(model, formats)),
+        outputs=tuple(_planned(model, formats, seconds)),
     )
 
 
@@ -146,12 +150,12 @@ def run_scene(
     from .simulation.interrupt import Interrupted, StopOnSignal
 
     seconds = _duration(model, duration)
+    planned = _planned(model, formats, seconds)
     tolerance = (
         model.integration.energy_tolerance
         if energy_tolerance is None
         else real_number("energy_tolerance", energy_tolerance, nonnegative=True)
     )
-    planned = _planned(model, formats)
     extra = [name for name in planned if name not in ("recording.h5", "summary.json")]
     with (
         warnings.catch_warnings(record=True) as caught,
@@ -162,14 +166,20 @@ def run_scene(
         job.check_target(planned)
         problem = model.problem()
         started = time.perf_counter()
-        recording, failure = _simulate_streaming(
+        recording, stopped = _simulate_streaming(
             model, problem, job.stage("recording.h5"), seconds, progress, stops
         )
+        failure: VisvivaError | None = stopped
         summary = _summary(model, problem, recording, failure, seconds, tolerance)
+        unwritten: list[str] = []
         for name in extra if failure is None else ():
             try:
                 with job.writing(name) as path:
                     write_output(recording, path, model.output_fps, model.output_speed)
+            except ModelError as error:
+                # The simulation is done: keep it, and say which output could not be made.
+                unwritten.append(f"{name} was not written: {error}")
+                summary["warnings"].append({"kind": "output", "message": unwritten[-1]})
             except KeyboardInterrupt:
                 failure = Interrupted(stops.requested or "SIGINT", float(recording.time[-1]))
                 summary["interrupted"] = failure.signal
@@ -178,6 +188,8 @@ def run_scene(
         summary["wall_time_s"] = time.perf_counter() - started
         summary["warnings"] += python_warnings(caught)
         report = job.write(summary)
+    if unwritten and failure is None:
+        failure = ModelError("; ".join(unwritten) + " (the recording and summary were kept)")
     if failure is not None:
         failure.report = report
         raise failure
@@ -324,17 +336,62 @@ def _duration(model: Model, duration: float | None) -> float:
     return seconds
 
 
-def _planned(model: Model, formats: Iterable[str]) -> list[str]:
+def _planned(model: Model, formats: Iterable[str], seconds: float) -> list[str]:
+    """The files a run writes, after checking that its outputs can be written."""
     from .io.outputs import output_names
 
-    chosen = [*model.output_formats, *formats]
-    names = output_names(chosen)
-    if names and not model.has_geometry:
-        raise ModelError(
-            f"the {model.system.system if model.system else ''} system has no picture, so it "
-            f"cannot be written as {', '.join(dict.fromkeys(chosen))}; drop the output formats"
-        )
+    names = output_names([*model.output_formats, *formats])
+    problems = output_problems(model, formats, seconds)
+    if problems:
+        raise SceneError(problems)
     return ["recording.h5", "summary.json", *names]
+
+
+def output_problems(model: Model, formats: Iterable[str], seconds: float) -> list[SceneProblem]:
+    """What stops the scene's outputs (its own and ``formats``) from being written for a run
+    of ``seconds`` [s]: no picture, too many frames, a GIF rate players cannot keep."""
+    from .io.timeline import MAX_OUTPUT_FRAMES
+    from .viz.video import MAX_GIF_FPS
+
+    chosen = list(dict.fromkeys([*model.output_formats, *formats]))
+    if not chosen:
+        return []
+    problems = []
+    if not model.has_geometry:
+        name = model.system.system if model.system else ""
+        problems.append(
+            SceneProblem(
+                "output.formats",
+                f"the {name} system has no picture, so it cannot be written as "
+                f"{', '.join(chosen)}; drop the output formats",
+            )
+        )
+    fps, speed = model.output_fps, model.output_speed
+    frames = seconds * fps / speed
+    if frames >= MAX_OUTPUT_FRAMES:
+        problems.append(
+            SceneProblem(
+                "output.speed",
+                f"{seconds:g} s at {fps:g} frames/s is {frames:.3g} output frames, more than "
+                f"{MAX_OUTPUT_FRAMES}; play faster (speed is simulated seconds per second; "
+                f"{seconds / 60:.3g} gives a one-minute clip)",
+                repr(speed),
+            )
+        )
+    if "gif" in chosen and not MIN_GIF_FPS <= fps <= MAX_GIF_FPS:
+        problems.append(
+            SceneProblem(
+                "output.fps",
+                f"a GIF plays between {MIN_GIF_FPS:.4f} and {MAX_GIF_FPS:g} frames/s (its delays "
+                "are whole hundredths of a second, at most 65535); use mp4 for other rates",
+                repr(fps),
+            )
+        )
+    return problems
+
+
+#: The slowest GIF: its frame delay is a 16-bit count of hundredths of a second [frames/s].
+MIN_GIF_FPS = 100.0 / 65535
 
 
 def _frame(model: Model, parts: tuple[Any, ...]) -> dict[str, Any]:

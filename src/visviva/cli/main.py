@@ -364,6 +364,7 @@ def main() -> None:
     try:
         app()
     except ModelError as error:
+        _print_kept(error)
         typer.echo(f"error: {error}", err=True)
         sys.exit(2)
     except SimulationError as error:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import stat
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -29,6 +30,9 @@ __all__ = ["MAX_SCENE_BYTES", "dump_scene", "load_scene", "parse_scene"]
 
 #: Largest scene file read [bytes]: scenes are descriptions, not data dumps.
 MAX_SCENE_BYTES = 16 * 2**20
+#: Deepest nesting of tables and arrays a scene may have: the schema needs 5 (entity
+#: parameters, positions); deeper is a mistake, and unbounded depth would exhaust the stack.
+MAX_DEPTH = 16
 
 #: Names pydantic gives the branches of a union in error locations (never scene keys).
 _UNION_BRANCH = re.compile(r"^(float|int|str|list|tuple|dict|[a-z]+(-[a-z]+)+)$|\[")
@@ -60,24 +64,7 @@ def load_scene(path: str | os.PathLike[str]) -> tuple[Scene, str]:
         raise SceneError(
             [SceneProblem("", "scene files end in .toml or .json", repr(file.suffix))], source
         )
-    try:
-        size = file.stat().st_size
-    except OSError as exc:
-        raise SceneError(
-            [SceneProblem("", f"cannot read the file: {exc.strerror}")], source
-        ) from None
-    if size > MAX_SCENE_BYTES:
-        raise SceneError(
-            [
-                SceneProblem(
-                    "",
-                    f"the file is {size} bytes; scene files may be at most {MAX_SCENE_BYTES} "
-                    '(generate large particle sets with type = "particle_cloud")',
-                )
-            ],
-            source,
-        )
-    data = file.read_bytes()
+    data = _read_limited(file, source)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -96,10 +83,44 @@ def load_scene(path: str | os.PathLike[str]) -> tuple[Scene, str]:
     return parse_scene(text, "json" if file.suffix.lower() == ".json" else "toml", source), text
 
 
+def _read_limited(file: Path, source: str) -> bytes:
+    """The bytes of a regular file of at most :data:`MAX_SCENE_BYTES`, read without blocking on
+    a FIFO and without trusting the size a special file reports (``/dev/zero`` says 0)."""
+
+    def refuse(message: str) -> SceneError:
+        return SceneError([SceneProblem("", message)], source)
+
+    try:
+        descriptor = os.open(file, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError as exc:
+        raise refuse(f"cannot read the file: {exc.strerror}") from None
+    mode = os.fstat(descriptor).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(descriptor)
+        kind = "a directory" if stat.S_ISDIR(mode) else "not a regular file"
+        raise refuse(f"this is {kind}; a scene is a .toml or .json text file")
+    with os.fdopen(descriptor, "rb") as handle:
+        try:
+            data = handle.read(MAX_SCENE_BYTES + 1)
+        except OSError as exc:
+            raise refuse(f"cannot read the file: {exc.strerror}") from None
+    if len(data) > MAX_SCENE_BYTES:
+        raise refuse(
+            f"the file is larger than {MAX_SCENE_BYTES} bytes, the most a scene file may be "
+            '(generate large particle sets with type = "particle_cloud")'
+        )
+    return data
+
+
 def parse_scene(text: str, format: str = "toml", source: str | None = None) -> Scene:
     """Parse and validate scene text; ``format`` is ``"toml"`` or ``"json"``."""
     try:
         raw = json.loads(text) if format == "json" else tomllib.loads(text)
+    except RecursionError:
+        raise SceneError(
+            [SceneProblem("", f"values are nested too deeply; scenes nest at most {MAX_DEPTH}")],
+            source,
+        ) from None
     except tomllib.TOMLDecodeError as exc:
         # Python 3.11's TOMLDecodeError has no lineno attribute; its message ends with it.
         match = re.search(r"at line (\d+)", str(exc))
@@ -110,6 +131,26 @@ def parse_scene(text: str, format: str = "toml", source: str | None = None) -> S
     except json.JSONDecodeError as exc:
         problem = f"JSON syntax error: {exc.msg} (at line {exc.lineno}, column {exc.colno})"
         raise SceneError([SceneProblem("", problem, line=exc.lineno)], source) from None
+    except ValueError:
+        # Python refuses integers of more than 4300 digits (CVE-2020-10735); no scene needs one.
+        raise SceneError(
+            [
+                SceneProblem(
+                    "", "a number has more than 4300 digits; scene numbers are at most ±1.8e308"
+                )
+            ],
+            source,
+        ) from None
+    depth = _depth(raw)
+    if depth > MAX_DEPTH:
+        raise SceneError(
+            [
+                SceneProblem(
+                    "", f"values are nested {depth} levels deep; scenes nest at most {MAX_DEPTH}"
+                )
+            ],
+            source,
+        )
     if not isinstance(raw, dict):
         raise SceneError(
             [SceneProblem("", "a scene is a table of settings", describe(raw))], source
@@ -119,6 +160,24 @@ def parse_scene(text: str, format: str = "toml", source: str | None = None) -> S
     except ValidationError as exc:
         locate = locate_json if format == "json" else locate_toml
         raise SceneError(_problems(exc, raw, lambda path: locate(text, path)), source) from None
+
+
+def _depth(data: Any) -> int:
+    """How deeply tables and arrays nest in ``data`` (without recursion, so any depth is safe)."""
+    deepest = 0
+    pending = [(data, 1)]
+    while pending:
+        value, depth = pending.pop()
+        if isinstance(value, dict):
+            children: Any = value.values()
+        elif isinstance(value, list):
+            children = value
+        else:
+            continue
+        deepest = max(deepest, depth)
+        if depth <= MAX_DEPTH:  # deeper is refused anyway: no need to walk it all
+            pending.extend((child, depth + 1) for child in children)
+    return deepest
 
 
 def _problems(exc: ValidationError, raw: dict[str, Any], line_of: Any) -> list[SceneProblem]:

@@ -1,6 +1,8 @@
 """The scene file schema: what a ``.toml`` / ``.json`` scene may hold, validated by pydantic 2.
 
-Unknown keys are errors (``extra="forbid"``), every number must be finite, and each entity
+Unknown keys are errors (``extra="forbid"``), every number must be finite, a value of the wrong
+type is refused rather than converted (``dt = "0.005"`` and ``duration = true`` are errors; an
+integer is accepted where a real number belongs), and each entity
 carries a ``type`` tag that selects its fields. ``visviva schema`` prints the JSON Schema built
 from these classes for editor completion. Cross-entity rules (unique names, what may be mixed,
 total sizes) live in :mod:`visviva.model.build`, which turns a validated :class:`Scene` into the
@@ -36,10 +38,13 @@ MAX_PARTICLES = 50_000_000
 OutputFormat = Literal["mp4", "gif", "html", "usd", "glb", "obj", "pc2"]
 OUTPUT_FORMATS: tuple[str, ...] = get_args(OutputFormat)
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Finite = Annotated[float, Field(strict=True, allow_inf_nan=False)]
+Positive = Annotated[float, Field(strict=True, gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(strict=True, ge=0, allow_inf_nan=False)]
 Vector = tuple[Finite, Finite, Finite]
-Name = Annotated[str, Field(min_length=1, max_length=200, pattern=r"^[^\x00-\x1f]*$")]
+Name = Annotated[str, Field(strict=True, min_length=1, max_length=200, pattern=r"^[^\x00-\x1f]*$")]
+#: Most steps between recorded frames: a run takes at most 1e10 steps (simulation.loop).
+MAX_RECORD_EVERY = 10**10
 
 
 class _Strict(BaseModel):
@@ -50,7 +55,7 @@ class SceneInfo(_Strict):
     """``[scene]``: what the scene is."""
 
     name: Name = "untitled"
-    description: Annotated[str, Field(max_length=10_000)] = ""
+    description: Annotated[str, Field(strict=True, max_length=10_000)] = ""
 
 
 class World(_Strict):
@@ -67,11 +72,13 @@ class Integration(_Strict):
     method: Name = Field("symplectic_euler", description="integrator (visviva integrators)")
     dt: Positive = Field(1e-3, description="time step [s]")
     duration: Positive = Field(2.0, description="simulated time [s]")
-    substeps: Annotated[int, Field(ge=1, le=10_000)] = Field(1, description="steps per dt")
-    record_every: Annotated[int, Field(ge=1)] | None = Field(
+    substeps: Annotated[int, Field(strict=True, ge=1, le=10_000)] = Field(
+        1, description="steps per dt"
+    )
+    record_every: Annotated[int, Field(strict=True, ge=1, le=MAX_RECORD_EVERY)] | None = Field(
         None, description="record every k-th step (default: about 60 frames per second)"
     )
-    energy_tolerance: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+    energy_tolerance: NonNegative = Field(
         0.01,
         description="warn when the energy of a conservative scene changes by more than this "
         "fraction of its initial value",
@@ -101,10 +108,10 @@ class Output(_Strict):
     """``[output]``: files ``visviva run`` writes besides the recording and the summary."""
 
     formats: list[OutputFormat] = Field(default_factory=list, description="extra outputs")
-    fps: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = Field(
+    fps: Annotated[float, Field(strict=True, gt=0, le=1000, allow_inf_nan=False)] = Field(
         30.0, description="frames per second of videos, viewer and exports [1/s]"
     )
-    speed: Annotated[float, Field(gt=0, allow_inf_nan=False)] = Field(
+    speed: Positive = Field(
         1.0,
         description="simulated seconds per second of playback (1: real time; 86400: a day "
         "per second)",
@@ -133,18 +140,20 @@ class ParticleCloud(_Strict):
 
     type: Literal["particle_cloud"]
     name: Name | None = None
-    count: Annotated[int, Field(ge=1, le=MAX_PARTICLES)] = Field(description="number of particles")
+    count: Annotated[int, Field(strict=True, ge=1, le=MAX_PARTICLES)] = Field(
+        description="number of particles"
+    )
     center: Vector = Field((0.0, 1.0, 0.0), description="centre of the box [m]")
     size: tuple[Positive, Positive, Positive] = Field(
         (1.0, 1.0, 1.0), description="edge lengths of the box [m]"
     )
     velocity: Vector = Field((0.0, 0.0, 0.0), description="mean initial velocity [m/s]")
-    velocity_jitter: Annotated[float, Field(ge=0, allow_inf_nan=False)] = Field(
+    velocity_jitter: NonNegative = Field(
         0.0, description="standard deviation of each velocity component [m/s]"
     )
     mass: Positive = Field(1.0, description="mass of each particle [kg]")
     radius: Positive = Field(0.02, description="radius of each particle [m]")
-    seed: Annotated[int, Field(ge=0, lt=2**63)] = Field(0, description="random seed")
+    seed: Annotated[int, Field(strict=True, ge=0, lt=2**63)] = Field(0, description="random seed")
 
 
 class System(_Strict):

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import hashlib
 import linecache
+import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -27,6 +28,8 @@ import numpy as np
 import sympy
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE
+
+from ..errors import ModelError
 
 __all__ = ["FLAVOURS", "SourceWriter", "UnrolledLDLT"]
 
@@ -42,7 +45,14 @@ class _Printer(NumPyPrinter):
     """
 
     def _print_Float(self, expr: sympy.Float) -> str:
-        return repr(float(expr))
+        value = float(expr)
+        if not math.isfinite(value):
+            # SymPy folds the parameters exactly (m L² with L = 1e200 is 1e400); a float can't.
+            raise ModelError(
+                f"the parameter values make a coefficient of the equations {expr:.4g}, beyond "
+                "the range of a float (±1.8e308): use smaller values or other units"
+            )
+        return repr(value)
 
     def _print_Pow(self, expr: sympy.Pow, rational: bool = False) -> str:
         if expr.exp.is_Integer:

@@ -8,11 +8,14 @@ the total particle count and step count — and reports every problem at once as
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from .._validation import describe, did_you_mean
-from ..errors import SceneError, SceneProblem
+from ..errors import ModelError, SceneError, SceneProblem
 from ..io.scene_schema import MAX_PARTICLES, ParticleCloud, Particles, Scene, System
+from ..ode.problems import SecondOrderProblem
 from ..simulation.loop import MAX_STEPS
 from .model import Integration, Model, ParticleGroup, SystemInstance, frozen_array
 from .systems import SYSTEMS
@@ -43,7 +46,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         kind = SYSTEMS[entity.system]
         values = {k: p.default for k, p in kind.parameters.items()} | dict(entity.parameters)
         system = SystemInstance(entity.name or entity.system, entity.system, values)
-    return Model(
+    model = Model(
         name=scene.scene.name,
         gravity=frozen_array(scene.world.gravity),
         integration=Integration(
@@ -66,6 +69,82 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         output_speed=scene.output.speed,
         source=source,
     )
+    problems = _check_start(model, scene)
+    if problems:
+        raise SceneError(problems)
+    return model
+
+
+def _check_start(model: Model, scene: Scene) -> list[SceneProblem]:
+    """Problems only the built model shows: a state that overflowed while being placed, or a
+    system whose parameters cannot give a finite start (``omega = 1e200`` squares to inf).
+
+    A named system is built and its initial acceleration and energy are evaluated once, so a
+    scene that ``visviva validate`` accepts also starts in ``visviva run``.
+    """
+    if model.system is None:
+        for name in ("particle_position", "particle_velocity"):
+            bad = ~np.isfinite(getattr(model, name))
+            if bad.any():
+                index = int(np.argwhere(bad)[0][0])
+                entity, group = next(
+                    (k, g)
+                    for k, g in enumerate(model.particle_groups)
+                    if g.start <= index < g.start + g.count
+                )
+                return [
+                    SceneProblem(
+                        f"entities[{entity}]",
+                        f"particle {index - group.start} starts with a non-finite "
+                        f"{name.removeprefix('particle_')}: the values overflow a float",
+                    )
+                ]
+        return []
+    index = next(i for i, e in enumerate(scene.entities) if isinstance(e, System))
+    where = f"entities[{index}].parameters"
+    values = model.system.parameters
+    try:
+        problem = model.problem()
+        system = problem.system()
+        parts = (
+            (problem.q0, problem.v0) if isinstance(problem, SecondOrderProblem) else (problem.y0,)
+        )
+        values_at_start = [*system.derivative(problem.t0, parts)]
+        if system.has_energy:
+            values_at_start.append(np.asarray(system.energy(problem.t0, parts)))
+    except ModelError as error:
+        return [_located(str(error), where, values)]
+    except (OverflowError, ZeroDivisionError, FloatingPointError, ValueError):
+        return [
+            SceneProblem(
+                where,
+                "these values overflow a float while the system is set up (the largest float "
+                "is 1.8e308): use smaller values or other units",
+            )
+        ]
+    if not all(np.isfinite(v).all() for v in values_at_start):
+        return [
+            SceneProblem(
+                where,
+                "these values give a non-finite initial acceleration or energy: some are too "
+                "large or too small to compute with",
+            )
+        ]
+    return []
+
+
+def _located(message: str, where: str, values: Mapping[str, float]) -> SceneProblem:
+    """A system's own refusal, at the parameter its message names ("`eccentricity` must ...");
+    the gravity a system takes from the world ("`g` must ...") is the world's."""
+    if message.startswith("`") and message.count("`") >= 2:
+        name, rest = message[1:].split("`", 1)
+        if name == "g":
+            return SceneProblem(
+                "world.gravity", "this system moves under gravity: it must not be zero"
+            )
+        if name in values:
+            return SceneProblem(f"{where}.{name}", rest.strip())
+    return SceneProblem(where, message)
 
 
 def _check(scene: Scene) -> list[SceneProblem]:

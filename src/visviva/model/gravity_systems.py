@@ -111,7 +111,7 @@ def _many_body_parameters(softening: float) -> dict[str, Parameter]:
             maximum=1.0,
         ),
         "G": _G,
-        "seed": Parameter(0.0, "", "random seed", integer=True),
+        "seed": Parameter(0.0, "", "random seed", integer=True, minimum=0.0, maximum=2.0**63 - 1),
     }
 
 

@@ -41,15 +41,12 @@ class Interrupted(VisvivaError):
         signal: The signal's name, ``"SIGINT"`` or ``"SIGTERM"``.
         t: Simulation time reached [s] (the last recorded frame).
         recording: The frames recorded up to ``t`` (set by the loop that stopped).
-        report: What the job (``run_scene``, ``run_demo``) wrote before raising, if any.
     """
 
     def __init__(self, signal_name: str, t: float) -> None:
         super().__init__(f"interrupted by {signal_name} at t = {t:.6g} s")
         self.signal = signal_name
         self.t = t
-        self.recording: Any = None
-        self.report: Any = None
 
 
 def stop_requested() -> str | None:
