@@ -43,8 +43,8 @@ Positive = Annotated[float, Field(strict=True, gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(strict=True, ge=0, allow_inf_nan=False)]
 Vector = tuple[Finite, Finite, Finite]
 Name = Annotated[str, Field(strict=True, min_length=1, max_length=200, pattern=r"^[^\x00-\x1f]*$")]
-#: Most steps between recorded frames: a run takes at most 1e10 steps (simulation.loop).
-MAX_RECORD_EVERY = 10**10
+#: Most steps between recorded frames: a run takes at most 1e9 steps (simulation.loop).
+MAX_RECORD_EVERY = 10**9
 
 
 class _Strict(BaseModel):

@@ -167,11 +167,13 @@ def _check(scene: Scene) -> list[SceneProblem]:
                 repr(dt),
             )
         )
-    elif duration / dt > MAX_STEPS:
+    elif duration / dt * scene.integration.substeps > MAX_STEPS:
+        steps = duration / dt * scene.integration.substeps
         problems.append(
             SceneProblem(
                 "integration.dt",
-                f"{duration / dt:.3g} steps to reach the duration; the limit is {MAX_STEPS:.0e}",
+                f"{steps:.3g} integrator steps (substeps included) to reach the duration; the "
+                f"limit is {MAX_STEPS:.0e}",
                 repr(dt),
             )
         )

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import ModelError
 from .batching import batched
 from .functions import UserFunction
 
@@ -106,7 +107,7 @@ class FirstOrderSystem:
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """``f(t, y)``, same shape as ``y``."""
         self.counters.f_evaluations += 1
-        return np.asarray(self._f(t, y))
+        return _same_shape("f(t, y)", np.asarray(self._f(t, y)), y, t)
 
     def derivative(self, t: float, parts: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
         """Time derivative of the state arrays: ``(f(t, y),)``."""
@@ -174,8 +175,8 @@ class SecondOrderSystem:
         """``F(t, q, v)`` (the acceleration for a problem without mass), shape of ``q``."""
         self.counters.f_evaluations += 1
         if self.velocity_dependent:
-            return np.asarray(self._force(t, q, v))
-        return np.asarray(self._force(t, q))
+            return _same_shape("the force F(t, q, v)", np.asarray(self._force(t, q, v)), q, t)
+        return _same_shape("the force F(t, q)", np.asarray(self._force(t, q)), q, t)
 
     def acceleration(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``q'' = M⁻¹ F(t, q, v)``, shape of ``q``."""
@@ -220,6 +221,16 @@ class SecondOrderSystem:
 
 
 System = FirstOrderSystem | SecondOrderSystem
+
+
+def _same_shape(what: str, value: np.ndarray, state: np.ndarray, t: float) -> np.ndarray:
+    """``value`` if it has the state's shape; else the user's function is wrong: say so."""
+    if value.shape != state.shape:
+        raise ModelError(
+            f"{what} returned shape {value.shape} at t = {float(t)!r}; it must return the state's "
+            f"shape {state.shape} at every call"
+        )
+    return value
 
 
 def _finite_difference(

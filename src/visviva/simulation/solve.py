@@ -234,6 +234,11 @@ def _solve_adaptive(
         )
     rtol = 1e-6 if rtol is None else real_number("rtol", rtol, positive=True)
     atol = 1e-9 if atol is None else real_number("atol", atol, nonnegative=True)
+    if atol == 0.0:
+        raise ModelError(
+            "`atol` must be positive (got 0.0): a component at or through zero has no relative "
+            "error scale, so the step would shrink without end; use e.g. atol=1e-12 (state units)"
+        )
     first_step = None if dt is None else real_number("dt", dt, positive=True, unit=" s")
     max_steps = whole_number("max_steps", max_steps, minimum=1)
     if divergence_limit is not None:
