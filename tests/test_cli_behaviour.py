@@ -137,9 +137,7 @@ def test_an_unwritable_output_is_refused_before_the_run(monkeypatch, capsys, tmp
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
 
 
-def test_a_figure_needs_an_image_suffix_and_may_go_into_a_new_folder(
-    monkeypatch, capsys, tmp_path
-):
+def test_a_figure_needs_an_image_suffix_and_may_go_into_a_new_folder(monkeypatch, capsys, tmp_path):
     assert ".png" in refused(monkeypatch, capsys, "stability", "rk4", "-o", tmp_path / "s.txt")
     target = tmp_path / "out" / "figures" / "regions.png"
     status, _, err = run_main(monkeypatch, capsys, "stability", "rk4", "-o", target)

@@ -158,8 +158,12 @@ def test_ctrl_c_while_writing_outputs_keeps_the_finished_ones(tmp_path, monkeypa
 
 def test_staging_left_by_a_killed_process_is_removed_by_the_next_run(tmp_path):
     out = tmp_path / "out"
-    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
-                          capture_output=True, text=True, check=True)
+    dead = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     stale = out / f"{STAGING_PREFIX}{int(dead.stdout)}-abc123"
     stale.mkdir(parents=True)
     (stale / "recording.h5").write_bytes(b"\0" * 1000)
@@ -183,9 +187,10 @@ def test_a_killed_process_leaves_a_readable_recording_in_its_staging(tmp_path):
     assert recording.frames > 0 and recording.attrs["success"] is False
     # The next run into the same directory cleans it up.
     result = subprocess.run(
-        [sys.executable, "-m", "visviva", "run", str(scene), "-o", str(out),
-         "--duration", "0.01"],
-        capture_output=True, text=True, timeout=120,
+        [sys.executable, "-m", "visviva", "run", str(scene), "-o", str(out), "--duration", "0.01"],
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert result.returncode == 0, result.stderr
     assert "left by a run that was killed" in result.stdout

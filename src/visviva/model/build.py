@@ -76,11 +76,12 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
 
 
 def _check_start(model: Model, scene: Scene) -> list[SceneProblem]:
-    """Problems only the built model shows: a state that overflowed while being placed, or a
-    system whose parameters cannot give a finite start (``omega = 1e200`` squares to inf).
+    """Problems only the built model shows: a state that overflowed while being placed, or
+    values that cannot give a finite start (``omega = 1e200`` squares to inf, a mass of 1e200
+    at 10 m/s has an infinite kinetic energy).
 
-    A named system is built and its initial acceleration and energy are evaluated once, so a
-    scene that ``visviva validate`` accepts also starts in ``visviva run``.
+    The model's problem is built and its initial acceleration and energy are evaluated once, so
+    a scene that ``visviva validate`` accepts also starts in ``visviva run``.
     """
     if model.system is None:
         for name in ("particle_position", "particle_velocity"):
@@ -99,20 +100,27 @@ def _check_start(model: Model, scene: Scene) -> list[SceneProblem]:
                         f"{name.removeprefix('particle_')}: the values overflow a float",
                     )
                 ]
-        return []
-    index = next(i for i, e in enumerate(scene.entities) if isinstance(e, System))
-    where = f"entities[{index}].parameters"
-    values = model.system.parameters
+        where = "entities"
+        values: Mapping[str, float] = {}
+    else:
+        index = next(i for i, e in enumerate(scene.entities) if isinstance(e, System))
+        where = f"entities[{index}].parameters"
+        values = model.system.parameters
     try:
-        problem = model.problem()
-        system = problem.system()
-        parts = (
-            (problem.q0, problem.v0) if isinstance(problem, SecondOrderProblem) else (problem.y0,)
-        )
-        values_at_start = [*system.derivative(problem.t0, parts)]
-        if system.has_energy:
-            values_at_start.append(np.asarray(system.energy(problem.t0, parts)))
+        with np.errstate(all="ignore"):  # overflow is judged by the results below
+            problem = model.problem()
+            system = problem.system()
+            parts = (
+                (problem.q0, problem.v0)
+                if isinstance(problem, SecondOrderProblem)
+                else (problem.y0,)
+            )
+            values_at_start = [*system.derivative(problem.t0, parts)]
+            if system.has_energy:
+                values_at_start.append(np.asarray(system.energy(problem.t0, parts)))
     except ModelError as error:
+        if model.system is None:
+            return [SceneProblem(where, _NOT_FINITE)]
         return [_located(str(error), where, values)]
     except (OverflowError, ZeroDivisionError, FloatingPointError, ValueError):
         return [
@@ -123,14 +131,14 @@ def _check_start(model: Model, scene: Scene) -> list[SceneProblem]:
             )
         ]
     if not all(np.isfinite(v).all() for v in values_at_start):
-        return [
-            SceneProblem(
-                where,
-                "these values give a non-finite initial acceleration or energy: some are too "
-                "large or too small to compute with",
-            )
-        ]
+        return [SceneProblem(where, _NOT_FINITE)]
     return []
+
+
+_NOT_FINITE = (
+    "these values give a non-finite initial acceleration or energy (a mass, speed, length or "
+    "position too large or too small to compute with, beyond ±1.8e308): use other values or units"
+)
 
 
 def _located(message: str, where: str, values: Mapping[str, float]) -> SceneProblem:

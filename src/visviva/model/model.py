@@ -24,6 +24,8 @@ __all__ = ["Integration", "Model", "ParticleGroup", "SystemInstance"]
 
 #: Default recording rate when a scene does not set ``record_every`` [frames/s].
 DEFAULT_FRAME_RATE = 60.0
+#: Largest default ``record_every``: the most steps a run may take (simulation.loop.MAX_STEPS).
+MAX_DEFAULT_RECORD_EVERY = 10**9
 
 
 def frozen_array(values: Any, dtype: Any = np.float64) -> np.ndarray:
@@ -56,8 +58,10 @@ class Integration:
 
     @staticmethod
     def default_record_every(dt: float) -> int:
-        """Steps per frame for about :data:`DEFAULT_FRAME_RATE` frames per second."""
-        return max(1, round(1.0 / (DEFAULT_FRAME_RATE * dt)))
+        """Steps per frame for about :data:`DEFAULT_FRAME_RATE` frames per second (at most
+        :data:`MAX_DEFAULT_RECORD_EVERY`, so a tiny dt never asks for more steps than a run
+        may take)."""
+        return max(1, min(MAX_DEFAULT_RECORD_EVERY, round(1.0 / (DEFAULT_FRAME_RATE * dt))))
 
 
 @dataclass(frozen=True)
