@@ -7,21 +7,22 @@ import numpy as np
 from ..io.recording import Recording
 
 
-def drawn_bodies(recording: Recording, lift: float) -> Recording:
-    """``recording`` of an n-body problem with the bodies as ``points`` [m], lifted by ``lift``
-    [m] above the video's ground plane (orbits lie in the horizontal x–z plane)."""
-    q = recording["q"]
-    points = q.reshape(q.shape[0], -1, 3).copy()
-    points[..., 1] += lift
-    return Recording(
-        recording.time,
-        dict(recording.fields) | {"points": points},
-        units=dict(recording.units) | {"points": "m"},
-        attrs=recording.attrs,
-    )
+def drawn_bodies(recording: Recording) -> Recording:
+    """``recording`` of an n-body problem (fields ``q`` and ``v``, the bodies' coordinates
+    flattened) with each quantity once: ``points`` [m] and ``velocities`` [m/s], ``(frames, N,
+    3)``, plus the recorded energy."""
+    x, v = body_states(recording)
+    fields = {"points": x, "velocities": v}
+    units = {"points": "m", "velocities": "m/s"}
+    if "energy" in recording:
+        fields["energy"] = recording["energy"]
+        units["energy"] = recording.units.get("energy", "J")
+    return Recording(recording.time, fields, units=units, attrs=recording.attrs)
 
 
 def body_states(recording: Recording) -> tuple[np.ndarray, np.ndarray]:
     """Positions and velocities per body, ``(frames, N, 3)`` each."""
+    if "points" in recording:
+        return recording["points"], recording["velocities"]
     q, v = recording["q"], recording["v"]
     return q.reshape(q.shape[0], -1, 3), v.reshape(v.shape[0], -1, 3)

@@ -49,7 +49,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
         softening=SOFTENING, method="barnes_hut", theta=THETA, name="colliding galaxies"
     )
     solution = solve(problem, "velocity_verlet", dt=DT, t_end=duration, record_every=5)
-    output.recordings["velocity_verlet"] = drawn_bodies(solution.recording, lift=2.0 * RADIUS)
+    output.recordings["velocity_verlet"] = drawn_bodies(solution.recording)
     x, _ = body_states(solution.recording)
     figure = Figure(figsize=(14, 3.8), layout="constrained")
     panels = figure.subplots(1, 4, sharex=True, sharey=True)

@@ -50,7 +50,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     solution = solve(
         bodies.problem(name="Sun-Earth-Moon"), "velocity_verlet", dt=DT, t_end=duration
     )
-    output.recordings["velocity_verlet"] = drawn_bodies(solution.recording, lift=0.3 * AU)
+    output.recordings["velocity_verlet"] = drawn_bodies(solution.recording)
     x, v = body_states(solution.recording)
     earth = x[:, 1] - x[:, 0]
     moon = x[:, 2] - x[:, 1]

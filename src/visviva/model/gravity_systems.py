@@ -1,8 +1,9 @@
 """Gravitating bodies as named scene systems: Kepler orbit, Sun–Earth–Moon, star cluster, galaxies.
 
 The state is the bodies' positions flattened (see :func:`visviva.mechanics.nbody_problem`), so
-the picture is those positions, lifted above the video's ground plane: orbits lie in the
-horizontal x–z plane. The mechanics package loads only when a scene uses one of these.
+the picture is those positions themselves: recordings store them once, as ``points`` and
+``velocities`` (orbits lie in the horizontal x–z plane; the video's ground sits below the
+lowest body). The mechanics package loads only when a scene uses one of these.
 """
 
 from __future__ import annotations
@@ -73,7 +74,6 @@ def _gravity(
     summary: str,
     parameters: dict[str, Parameter],
     bodies: Callable[[Mapping[str, float]], Any],
-    lift: Callable[[Mapping[str, float]], float],
 ) -> SystemType:
     def build(values: Mapping[str, float], gravity: np.ndarray) -> Problem:
         made = bodies(values)
@@ -85,15 +85,7 @@ def _gravity(
             name=name,
         )
 
-    def draw(
-        values: Mapping[str, float], gravity: np.ndarray, parts: tuple[np.ndarray, ...]
-    ) -> np.ndarray:
-        q = parts[0]
-        points = q.reshape(q.shape[0], -1, 3).copy()
-        points[..., 1] += lift(values)
-        return points
-
-    return SystemType(name, summary, parameters, build, draw)
+    return SystemType(name, summary, parameters, build, state_is_points=True)
 
 
 _G = Parameter(1.0, "m^3/(kg s^2)", "constant of gravitation (1: N-body units)", positive=True)
@@ -129,14 +121,12 @@ GRAVITY_SYSTEMS: dict[str, SystemType] = {
                 "G": _G,
             },
             _kepler_bodies,
-            lambda p: 0.5 * p["semi_major_axis"],
         ),
         _gravity(
             "sun-earth-moon",
             "the Sun, the Earth and the Moon at J2000.0, SI units (one year: 3.156e7 s)",
             {},
             _sun_earth_moon,
-            lambda p: 0.3 * ASTRONOMICAL_UNIT,
         ),
         _gravity(
             "cluster",
@@ -155,7 +145,6 @@ GRAVITY_SYSTEMS: dict[str, SystemType] = {
                 **_many_body_parameters(softening=0.01),
             },
             _cluster,
-            lambda p: 3.0 * p["scale_radius"],
         ),
         _gravity(
             "galaxy",
@@ -179,7 +168,6 @@ GRAVITY_SYSTEMS: dict[str, SystemType] = {
                 **_many_body_parameters(softening=0.05),
             },
             _galaxy,
-            lambda p: 2.0 * p["radius"],
         ),
     )
 }

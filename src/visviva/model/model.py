@@ -138,7 +138,10 @@ class Model:
     @property
     def has_geometry(self) -> bool:
         """True if runs of this model record drawable ``points``."""
-        return self.system is None or SYSTEMS[self.system.system].draw is not None
+        if self.system is None:
+            return True
+        kind = SYSTEMS[self.system.system]
+        return kind.state_is_points or kind.draw is not None
 
     def problem(self) -> Problem:
         """The problem the simulation loop runs: particles as one second-order system with
@@ -171,18 +174,20 @@ class Model:
     def frame_fields(self, parts: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
         """Recorded fields for frames of states: ``parts`` are ``(frames, …)`` arrays.
 
-        Particles give ``points`` [m] and ``velocities`` [m/s], ``(frames, N, 3)``; a named
-        system gives its coordinates and, if it has a picture, ``points``.
+        Particles, and systems whose coordinates are positions (n bodies), give ``points`` [m]
+        and ``velocities`` [m/s], ``(frames, N, 3)``; another named system gives its
+        coordinates and, if it has a picture, ``points``. Each quantity is recorded once.
         """
-        if self.system is None:
+        system = self.system
+        if system is None or SYSTEMS[system.system].state_is_points:
             q, v = parts
-            shape = (q.shape[0], self.particle_count, 3)
+            shape = (q.shape[0], q.shape[-1] // 3, 3)
             return {"points": q.reshape(shape), "velocities": v.reshape(shape)}
-        kind = SYSTEMS[self.system.system]
+        draw = SYSTEMS[system.system].draw
         names = ("y",) if len(parts) == 1 else ("q", "v")
         fields = dict(zip(names, parts, strict=True))
-        if kind.draw is not None:
-            fields["points"] = kind.draw(self.system.parameters, self.gravity, parts)
+        if draw is not None:
+            fields["points"] = draw(system.parameters, self.gravity, parts)
         return fields
 
     def static(self) -> dict[str, np.ndarray]:

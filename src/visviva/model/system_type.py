@@ -55,6 +55,9 @@ class SystemType:
             mass).
         dissipation: Name of the parameter that makes the system lose energy when it is not
             zero (a damping coefficient), or ``None`` if it always conserves energy.
+        state_is_points: The coordinates ``q`` are the positions of points, ``(x, y, z)`` per
+            point (n bodies): they are the picture, recorded once as ``points`` and
+            ``velocities``.
     """
 
     name: str
@@ -65,6 +68,7 @@ class SystemType:
     edges: tuple[tuple[int, int], ...] | None = None
     energy_unit: str = "J"
     dissipation: str | None = None
+    state_is_points: bool = False
 
     def conservative(self, values: Mapping[str, float]) -> bool:
         """True if the system with these parameter values conserves its energy."""
