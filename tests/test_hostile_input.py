@@ -338,3 +338,25 @@ def test_scenes_mutated_anywhere_are_refused_cleanly_or_run(tmp_path_factory, ba
 )
 def test_scenes_with_extreme_numbers_are_refused_cleanly_or_run(tmp_path_factory, base, edits):
     _refused_cleanly_or_runs(tmp_path_factory.mktemp("fuzz"), _mutated(base, edits, True))
+
+
+@pytest.mark.slow
+@settings(SETTINGS, max_examples=1500)
+@given(
+    base=st.integers(0, len(BASES) - 1),
+    edits=st.lists(st.tuples(st.integers(0, 10**6), HOSTILE_VALUES), min_size=1, max_size=4),
+)
+def test_many_scenes_mutated_anywhere(tmp_path_factory, base, edits):
+    """The property above at length (``pytest -m slow``): several minutes."""
+    _refused_cleanly_or_runs(tmp_path_factory.mktemp("fuzz"), _mutated(base, edits, False))
+
+
+@pytest.mark.slow
+@settings(SETTINGS, max_examples=1500)
+@given(
+    base=st.integers(0, len(BASES) - 1),
+    edits=st.lists(st.tuples(st.integers(0, 10**6), HOSTILE_NUMBERS), min_size=1, max_size=3),
+)
+def test_many_scenes_with_extreme_numbers(tmp_path_factory, base, edits):
+    """The property above at length (``pytest -m slow``)."""
+    _refused_cleanly_or_runs(tmp_path_factory.mktemp("fuzz"), _mutated(base, edits, True))

@@ -213,3 +213,15 @@ def test_cli_validate_schema_dry_run_and_plot(tmp_path):
         result = runner.invoke(app, ["plot", str(out / "recording.h5"), f"--{kind}"])
         assert result.exit_code == 0, result.output
         assert (out / f"{kind}.png").stat().st_size > 10_000
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_example_scenes_run_to_the_end(tmp_path, path):
+    """Every example scene at its full length (``pytest -m slow``; the star cluster's 20,000
+    stars take half a minute): it completes, its energy stays within its tolerance, and the
+    summary counts what it holds."""
+    report = vv.run_scene(vv.load_model(path), tmp_path)
+    summary = report.summary
+    assert summary["complete"] and summary["success"] and summary["counts"]
+    assert not [w for w in summary["warnings"] if w["kind"] == "energy_drift"], summary
