@@ -66,11 +66,27 @@ def print_report(report: Any) -> None:
     elif not summary.get("success", True):
         typer.echo(f"failed: {summary['message']}")
     drift = summary.get("energy_drift")
-    if drift is not None:
+    drifts = {
+        name: run["energy_drift"]
+        for name, run in summary.get("runs", {}).items()
+        if run.get("energy_drift") is not None
+    }
+    if len(drifts) > 1:
+        worst = max(drifts, key=lambda name: abs(drifts[name]))
+        typer.echo(
+            f"energy drift: up to {100 * drifts[worst]:+.3g} % of the initial energy ({worst})"
+        )
+    elif drift is not None:
         typer.echo(f"energy drift: {100 * drift:+.3g} % of the initial energy")
     for warning in summary.get("warnings", []):
         count = f" ({warning['count']}×)" if warning.get("count", 1) > 1 else ""
         typer.echo(f"warning: {warning['message']}{count}")
+    shown, runs = summary.get("outputs_show_run"), summary.get("runs", {})
+    if shown is not None and len(runs) > 1:
+        typer.echo(
+            f"the video, viewer and exports show run {shown!r} of {len(runs)} "
+            f"({', '.join(runs)}); `visviva export recording.h5 --run NAME` shows another"
+        )
     for stale in report.removed_stale:
         typer.echo(f"removed {stale}, left by a run that was killed")
     if report.files:
