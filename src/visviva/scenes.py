@@ -85,21 +85,15 @@ def dry_run(model: Model, *, duration: float | None = None, formats: Iterable[st
     """Counts and the stability advisor's estimate for a run of ``model``; nothing is written."""
     import math
 
-    import numpy as np
-
-    from .analysis.stability import max_stable_dt, state_jacobian
+    from .analysis.advisor import largest_stable_step
+    from .integrators import get
     from .simulation.loop import initial_state
 
     seconds = _duration(model, duration)
     settings = model.integration
     steps = math.ceil(seconds / settings.dt - 1e-9)
     problem = model.problem()
-    system = problem.system()
-    if model.particle_count > 1000:
-        limit = math.inf  # free particles: the Jacobian of gravity is zero, no step limit
-    else:
-        jacobian = state_jacobian(system, initial_state(problem))
-        limit = max_stable_dt(settings.method, jacobian=np.asarray(jacobian))
+    limit = largest_stable_step(problem.system(), get(settings.method), initial_state(problem))
     return DryRun(
         particles=model.particle_count,
         system=None if model.system is None else model.system.system,

@@ -56,6 +56,7 @@ def run_summary(recording: Recording) -> dict[str, Any]:
         "jacobian_evaluations",
         "linear_solves",
         "newton_iterations",
+        "krylov_iterations",
         "rejected_steps",
         "wall_time_s",
         "success",

@@ -117,6 +117,14 @@ class Mass:
             return self.values @ vector
         return (self.values @ vector[..., None])[..., 0]
 
+    def diagonal(self) -> np.ndarray:
+        """The diagonal of ``M`` [kg], shape ``(n,)`` (or broadcastable to ``q``'s shape)."""
+        if self.kind == "diagonal":
+            return np.asarray(self.values)
+        if self.kind == "sparse":
+            return np.asarray(self.values.diagonal())
+        return np.diagonal(self.values, axis1=-2, axis2=-1)
+
     def dense(self, q_shape: tuple[int, ...]) -> np.ndarray:
         """Return ``M`` as dense matrices of shape ``q_shape + (n,)``."""
         if self.kind == "sparse":

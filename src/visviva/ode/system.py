@@ -41,6 +41,8 @@ class WorkCounters:
         jacobian_evaluations: Jacobians formed (analytic or by finite differences).
         linear_solves: Linear systems solved by implicit methods.
         newton_iterations: Newton iterations of implicit methods.
+        krylov_iterations: Inner GMRES iterations of matrix-free (Newton–Krylov) linear solves;
+            each costs one evaluation of ``f``, counted in ``f_evaluations`` too.
         accepted_steps: Steps taken (for adaptive methods, the accepted ones).
         rejected_steps: Steps rejected by error control (adaptive methods only).
     """
@@ -49,6 +51,7 @@ class WorkCounters:
     jacobian_evaluations: int = 0
     linear_solves: int = 0
     newton_iterations: int = 0
+    krylov_iterations: int = 0
     accepted_steps: int = 0
     rejected_steps: int = 0
 
@@ -103,6 +106,18 @@ class FirstOrderSystem:
     def has_energy(self) -> bool:
         """True if the problem defines a monitored energy."""
         return self._energy is not None
+
+    @property
+    def has_jacobian(self) -> bool:
+        """True if the problem gives ``∂f/∂y`` (else it comes from finite differences)."""
+        return self._jacobian is not None
+
+    def jacobian_product(
+        self, t: float, y: np.ndarray, direction: np.ndarray, rate: np.ndarray
+    ) -> np.ndarray:
+        """``∂f/∂y · u`` without forming the matrix: one forward difference of ``f`` along
+        ``u`` (``rate`` = ``f(t, y)``). One system only (``y`` of shape ``(n,)``)."""
+        return directional_difference(lambda s: self.rhs(t, y + s * direction), rate, y, direction)
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """``f(t, y)``, same shape as ``y``."""
@@ -171,6 +186,30 @@ class SecondOrderSystem:
         """True if the problem defines a monitored energy."""
         return self._energy is not None
 
+    @property
+    def has_jacobian(self) -> bool:
+        """True if the problem gives ``∂F/∂q`` (and ``∂F/∂v``); else finite differences."""
+        return self._jacobian is not None
+
+    def force_product(
+        self,
+        t: float,
+        q: np.ndarray,
+        v: np.ndarray,
+        dq: np.ndarray,
+        dv: np.ndarray | None,
+        force: np.ndarray,
+    ) -> np.ndarray:
+        """``∂F/∂q · dq + ∂F/∂v · dv`` without forming a matrix: one forward difference of the
+        force along ``(dq, dv)`` (``force`` = ``F(t, q, v)``; ``dv = None`` for zero). One
+        system only (``q`` of shape ``(n,)``)."""
+        if dv is None or not self.velocity_dependent:
+            return directional_difference(lambda s: self.force(t, q + s * dq, v), force, q, dq)
+        state, direction = np.concatenate([q, v]), np.concatenate([dq, dv])
+        return directional_difference(
+            lambda s: self.force(t, q + s * dq, v + s * dv), force, state, direction
+        )
+
     def force(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``F(t, q, v)`` (the acceleration for a problem without mass), shape of ``q``."""
         self.counters.f_evaluations += 1
@@ -231,6 +270,25 @@ def _same_shape(what: str, value: np.ndarray, state: np.ndarray, t: float) -> np
             f"shape {state.shape} at every call"
         )
     return value
+
+
+def directional_difference(
+    along: Callable[[float], np.ndarray],
+    value: np.ndarray,
+    x: np.ndarray,
+    direction: np.ndarray,
+) -> np.ndarray:
+    """``(g(x + εu) − g(x)) / ε``: the derivative of ``g`` along ``u`` from one evaluation.
+
+    ``along(s)`` evaluates ``g(x + s·u)``; ``value`` is ``g(x)``. The step
+    ``ε = √ε_mach (1 + ‖x‖) / ‖u‖`` balances truncation and round-off for any scale of ``u``
+    (Knoll & Keyes, "Jacobian-free Newton–Krylov methods", J. Comput. Phys. 193, 2004, §2.2).
+    """
+    norm = float(np.linalg.norm(direction))
+    if norm == 0.0:
+        return np.zeros_like(value)
+    step = FINITE_DIFFERENCE_STEP * (1.0 + float(np.linalg.norm(x))) / norm
+    return (along(step) - value) / step
 
 
 def _finite_difference(

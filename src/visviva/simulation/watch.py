@@ -109,13 +109,13 @@ def suggested_dt(
     ``None`` if it could not be estimated, ``0`` if no step is stable, ``inf`` if every step
     is; ``system_index`` picks one system of a batch.
     """
+    from ..analysis.advisor import largest_stable_step
     from ..analysis.stability import max_stable_dt, state_jacobian
 
     try:
-        jacobian = state_jacobian(system, state)
-        if system_index is not None:
-            jacobian = jacobian[system_index]
-        return max_stable_dt(method, jacobian=jacobian)
+        if system_index is None:
+            return largest_stable_step(system, method, state)
+        return max_stable_dt(method, jacobian=state_jacobian(system, state)[system_index])
     except Exception:
         return None
 
