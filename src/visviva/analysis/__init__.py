@@ -1,5 +1,6 @@
 """Analysis of integrators and runs: stability, convergence order, invariants."""
 
+from .advisor import largest_stable_step, matrix_free_eigenvalues
 from .compare import Comparison, MethodResult, compare_methods
 from .convergence import ConvergenceStudy, convergence_order
 from .invariants import (
@@ -28,8 +29,10 @@ __all__ = [
     "compare_methods",
     "convergence_order",
     "energy_drift",
+    "largest_stable_step",
     "linear_momentum",
     "max_energy_error",
+    "matrix_free_eigenvalues",
     "max_stable_dt",
     "relative_change",
     "spectrum",
