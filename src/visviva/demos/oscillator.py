@@ -56,12 +56,15 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
             solution = solve(problem, method, dt=DT, t_end=duration, record_every=every)
         output.recordings[name] = solution.recording
     output.figures["energy"] = plot_energy(
-        output.recordings, title=f"Undamped oscillator, ωh = {OMEGA * DT:.3f}: E(t)/E(0)"
+        output.recordings, title=f"Undamped oscillator, ωh = {OMEGA * DT:.3f}: energy change"
     )
     phase_time = np.linspace(0.0, 2 * np.pi, 200)
     output.figures["phase"] = plot_phase(
         output.recordings,
         exact=(np.cos(phase_time), -OMEGA * np.sin(phase_time)),
+        labels=("q [m]", "v/ω [m]"),
+        velocity_scale=OMEGA,
+        title=f"Phase portraits, ωh = {OMEGA * DT:.3f}: q against v/ω (exact: the unit circle)",
     )
     return {"omega_rad_per_s": OMEGA, "dt_s": DT, "omega_h": OMEGA * DT}
 

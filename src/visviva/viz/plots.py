@@ -12,6 +12,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..analysis.invariants import relative_change
+
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
@@ -103,38 +105,41 @@ def plot_energy(
     *,
     title: str = "Energy relative to its initial value",
 ) -> Figure:
-    """``E(t)/E(0)`` (top) and ``|E(t)/E(0) − 1|`` (bottom) of several runs, log scales.
-
-    The top panel shows growth and decay; the bottom one separates the methods that keep the
-    energy within round-off from those with a bounded oscillation or a slow drift. Runs without
-    an energy are skipped; for a batch, system 0 is shown.
+    """The relative change of the energy, ``(E(t) − E(0)) / |E(0)|``, of several runs: in
+    percent, signed (top: growth and decay, linear within ±1 % and logarithmic beyond, so a
+    method that multiplies the energy by 1000 and one that loses half of it both read plainly)
+    and its magnitude on a log axis (bottom: separates the methods that keep the energy to
+    round-off from those with a bounded oscillation or a slow drift). Runs without an energy
+    are skipped; for a batch, system 0 is shown.
     """
     from matplotlib.figure import Figure
+    from matplotlib.ticker import PercentFormatter
 
     figure = Figure(figsize=(9.0, 8.0), layout="constrained")
-    ratio_ax, error_ax = figure.subplots(2, 1, sharex=True)
+    change_ax, error_ax = figure.subplots(2, 1, sharex=True)
     runs = [(n, r) for n, r in recordings.items() if "energy" in r and r.frames > 0]
     for (name, recording), style in zip(runs, _styles(len(runs)), strict=True):
         energy = recording["energy"]
         energy = energy if energy.ndim == 1 else energy[:, 0]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = energy / energy[0]
-        ratio_ax.plot(recording.time, ratio, label=name, linewidth=1.3, **style)
+        change = relative_change(energy)
+        change_ax.plot(recording.time, change, label=name, linewidth=1.3, **style)
         # Exact zeros would vanish from a log axis; floor them at the double-precision epsilon.
         error_ax.plot(
             recording.time,
-            np.maximum(np.abs(ratio - 1.0), np.finfo(float).eps),
+            np.maximum(np.abs(change), np.finfo(float).eps),
             linewidth=1.1,
             **style,
         )
-    ratio_ax.set_yscale("log")
-    ratio_ax.set_ylabel("E(t) / E(0)")
-    ratio_ax.legend(fontsize=8, ncol=3)
-    ratio_ax.set_title(title)
+    change_ax.set_yscale("symlog", linthresh=0.01, linscale=0.5)
+    change_ax.yaxis.set_major_formatter(PercentFormatter(xmax=1.0, decimals=0))
+    change_ax.set_ylabel("(E(t) − E(0)) / |E(0)|")
+    change_ax.axhline(0.0, color="0.5", linewidth=0.8)
+    change_ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    change_ax.set_title(title)
     error_ax.set_yscale("log")
-    error_ax.set_ylabel("|E(t) / E(0) − 1|")
+    error_ax.set_ylabel("|E(t) − E(0)| / |E(0)|")
     error_ax.set_xlabel("time [s]")
-    for ax in (ratio_ax, error_ax):
+    for ax in (change_ax, error_ax):
         ax.grid(True, which="both", alpha=0.3)
     return figure
 
@@ -145,28 +150,40 @@ def plot_phase(
     exact: tuple[np.ndarray, np.ndarray] | None = None,
     columns: int = 4,
     labels: tuple[str, str] = ("q", "v"),
+    velocity_scale: float = 1.0,
+    title: str = "Phase portraits",
 ) -> Figure:
-    """Phase portraits ``(q, v)`` of the first coordinate, one panel per run.
+    """Phase portraits ``(q, v / velocity_scale)`` of the first coordinate, one panel per run,
+    on equal axes.
+
+    For an oscillator of angular frequency ω, ``velocity_scale = ω`` makes the exact orbit a
+    circle, so a method that spirals out, spirals in or keeps a slightly different ellipse is
+    seen at a glance.
 
     Args:
         recordings: Run name → recording of a second-order problem.
-        exact: Optional exact curve ``(q, v)`` drawn under every panel.
+        exact: Optional exact curve ``(q, v)`` drawn under every panel (``v`` unscaled).
         columns: Panels per row.
-        labels: Axis labels.
+        labels: Axis labels of what is drawn (``("q [m]", "v/ω [m]")`` with a scale).
+        velocity_scale: ``v`` is drawn divided by this [1/s for v/ω].
+        title: Title of the figure.
     """
     figure = _figure(len(recordings), columns=columns)
     for ax, (name, recording) in zip(figure.axes, recordings.items(), strict=False):
         q, v = recording["q"], recording["v"]
         q = q[..., 0] if q.ndim == 2 else q[:, 0, 0]
-        v = v[..., 0] if v.ndim == 2 else v[:, 0, 0]
+        v = (v[..., 0] if v.ndim == 2 else v[:, 0, 0]) / velocity_scale
         if exact is not None:
-            ax.plot(exact[0], exact[1], color="0.6", linewidth=2.5, label="exact")
-        ax.plot(q, v, color=BOUNDARY_COLOR, linewidth=0.9)
-        ax.plot(q[:1], v[:1], "o", color="#e6550d", markersize=4)
+            ax.plot(exact[0], exact[1] / velocity_scale, color="0.6", linewidth=2.5, label="exact")
+        ax.plot(q, v, color=BOUNDARY_COLOR, linewidth=0.9, label="computed")
+        ax.plot(q[:1], v[:1], "o", color="#e6550d", markersize=4, label="start")
         ax.set_title(name, fontsize=10)
         ax.set_xlabel(labels[0])
         ax.set_ylabel(labels[1])
         ax.set_aspect("equal", adjustable="datalim")
+    if recordings:
+        figure.axes[0].legend(fontsize=8, loc="upper right")
+    figure.suptitle(title)
     return figure
 
 
