@@ -1,9 +1,18 @@
 """The animation data the web viewer embeds: drawable geometry as compact, typed layers.
 
 The payload is one JSON object. Large arrays travel as base64 text of little-endian binary
-(``float32`` positions and radii, ``uint32`` indices, ``float64`` frame times) that the page
-decodes straight into ``Float32Array`` / ``Uint32Array`` / ``Float64Array`` views, which is
-~4× smaller than JSON numbers and needs no parsing per value.
+(``float32`` radii, ``uint32`` indices, ``float64`` frame times) that the page decodes straight
+into ``Float32Array`` / ``Uint32Array`` / ``Float64Array`` views, which is ~4× smaller than
+JSON numbers and needs no parsing per value.
+
+Point positions, most of the page, are quantized: each coordinate becomes a 16-bit integer
+``q`` on a grid spanning the points' box, ``x = origin + q·step`` with ``step = extent/65535``
+per axis, so a position is off by at most half a step (the galaxy demo, 20 m across: 0.15 mm;
+drawn radii are far larger). The integers are stored as differences from the previous frame
+(points move little between frames), their low and high bytes in two separate planes, and
+compressed with zlib (deflate), which the page inflates with the browser's own
+``DecompressionStream``. The galaxy demo's 6002 points × 301 frames take 8.5 MB instead of
+29 MB of float32 base64.
 
 Each kind of geometry is one *layer* with its own encoder here and its own builder in
 ``viewer.js`` (``LAYERS``): ``points`` (moving spheres), ``edges`` (lines between points) and
@@ -15,6 +24,7 @@ from __future__ import annotations
 
 import base64
 import json
+import zlib
 from typing import Any
 
 import numpy as np
@@ -24,7 +34,9 @@ from ...io.recording import Geometry
 __all__ = ["PAYLOAD_FORMAT", "PAYLOAD_VERSION", "encode_payload", "to_json"]
 
 PAYLOAD_FORMAT = "visviva.viewer"
-PAYLOAD_VERSION = 1
+PAYLOAD_VERSION = 2
+#: Quantization levels of a position coordinate: 16 bits.
+POSITION_LEVELS = 65535
 
 
 #: Recording attributes shown in the viewer's legend, with their labels and units.
@@ -42,12 +54,33 @@ def _points_layer(geometry: Geometry, shown: np.ndarray) -> dict[str, Any]:
         radius = np.full(count, geometry.default_radius())
     else:
         radius = geometry.radius
+    origin, step, data = quantized_positions(geometry.points[shown])
     return {
         "count": count,
-        # (frames shown, P, 3) [m], float32: 12 bytes per point per frame.
-        "positions": _base64(geometry.points[shown], "<f4"),
+        "origin": [float(v) for v in origin],
+        "step": [float(v) for v in step],
+        "positions": data,
         "radius": _base64(radius, "<f4"),
     }
+
+
+def quantized_positions(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, str]:
+    """Positions ``(frames, P, 3)`` [m] as the viewer stores them (module docstring).
+
+    Returns:
+        ``origin`` and ``step`` [m], each ``(3,)``, and the base64 text of the compressed
+        frame differences.
+    """
+    flat = points.reshape(-1, 3)
+    origin = flat.min(axis=0)
+    step = (flat.max(axis=0) - origin) / POSITION_LEVELS
+    inverse = np.divide(1.0, step, out=np.zeros(3), where=step > 0.0)
+    levels = np.rint((points - origin) * inverse).astype(np.uint16)
+    # Unsigned differences wrap modulo 2¹⁶, and so does the page's running sum: exact.
+    differences = np.diff(levels, axis=0, prepend=np.zeros_like(levels[:1]))
+    planes = differences.astype("<u2").view(np.uint8).reshape(-1, 2).T
+    data = base64.b64encode(zlib.compress(planes.tobytes(), 6)).decode("ascii")
+    return origin, step, data
 
 
 def _index_layer(indices: np.ndarray) -> dict[str, Any]:

@@ -8,15 +8,17 @@
  * Each kind of geometry is one entry of LAYERS (points, edges, faces): a builder that adds
  * its objects to the scene and returns an update() called after every frame change.
  */
-(function () {
+(async function () {
   "use strict";
 
   // A failure (no WebGL, corrupt data) is shown on the page, not only in the console.
-  window.addEventListener("error", (event) => {
+  function fail(message) {
     const box = document.getElementById("failure");
-    box.textContent = "The viewer could not start: " + event.message;
+    box.textContent = "The viewer could not start: " + message;
     box.style.display = "block";
-  });
+  }
+  window.addEventListener("error", (event) => fail(event.message));
+  window.addEventListener("unhandledrejection", (event) => fail(String(event.reason)));
 
   const BACKGROUND = 0xeef1f5;
   const POINT_COLOUR = 0x2f6fb3;
@@ -32,18 +34,45 @@
   const SPHERE_TRIANGLE_BUDGET = 150000;
   const POLAR_LIMIT = 0.01; // radians kept from the poles, where "up" is undefined
 
+  function base64Bytes(text) {
+    if (typeof Uint8Array.fromBase64 === "function") return Uint8Array.fromBase64(text);
+    const raw = atob(text);
+    const bytes = new Uint8Array(raw.length);
+    for (let i = 0; i < raw.length; i++) bytes[i] = raw.charCodeAt(i);
+    return bytes;
+  }
+
   /* Base64 text of little-endian binary -> typed array (typed arrays use the host's byte
    * order, little-endian on every platform browsers run on in practice). */
   function decode(text, Type) {
-    let bytes;
-    if (typeof Uint8Array.fromBase64 === "function") {
-      bytes = Uint8Array.fromBase64(text);
-    } else {
-      const raw = atob(text);
-      bytes = new Uint8Array(raw.length);
-      for (let i = 0; i < raw.length; i++) bytes[i] = raw.charCodeAt(i);
-    }
+    const bytes = base64Bytes(text);
     return new Type(bytes.buffer, bytes.byteOffset, bytes.byteLength / Type.BYTES_PER_ELEMENT);
+  }
+
+  /* Quantized positions (see _payload.py) -> Float32Array (frames, P, 3) [m]: inflate the
+   * zlib stream, join the low- and high-byte planes, add up the frame differences (Uint16Array
+   * arithmetic wraps modulo 2^16, as the encoder's differences do) and scale onto the grid. */
+  async function decodePositions(layer, frameCount, stride) {
+    const stream = new Blob([base64Bytes(layer.positions)])
+      .stream().pipeThrough(new DecompressionStream("deflate"));
+    const planes = new Uint8Array(await new Response(stream).arrayBuffer());
+    const n = frameCount * stride;
+    if (planes.length !== 2 * n) throw new Error("corrupt position data");
+    const positions = new Float32Array(n);
+    const level = new Uint16Array(stride);
+    const [ox, oy, oz] = layer.origin;
+    const [sx, sy, sz] = layer.step;
+    for (let k = 0, i = 0; k < frameCount; k++) {
+      for (let j = 0; j < stride; j += 3, i += 3) {
+        level[j] += planes[i] | (planes[n + i] << 8);
+        level[j + 1] += planes[i + 1] | (planes[n + i + 1] << 8);
+        level[j + 2] += planes[i + 2] | (planes[n + i + 2] << 8);
+        positions[i] = ox + level[j] * sx;
+        positions[i + 1] = oy + level[j + 1] * sy;
+        positions[i + 2] = oz + level[j + 2] * sz;
+      }
+    }
+    return positions;
   }
 
   const data = JSON.parse(document.getElementById("visviva-data").textContent);
@@ -52,8 +81,8 @@
   const times = decode(data.times, Float64Array);
   const pointData = data.layers.points;
   const pointCount = pointData.count;
-  const allPositions = decode(pointData.positions, Float32Array); // (frames, P, 3) [m]
   const stride = pointCount * 3;
+  const allPositions = await decodePositions(pointData, frames, stride); // (frames, P, 3) [m]
 
   const low = new THREE.Vector3().fromArray(data.bounds[0]);
   const high = new THREE.Vector3().fromArray(data.bounds[1]);
@@ -323,7 +352,7 @@
     play: () => setPlaying(true),
     pause: () => setPlaying(false),
     playing: () => playing,
-    /* Positions [m] of output frame k as a flat array (P * 3), as embedded (float32). */
+    /* Positions [m] of output frame k as a flat array (P * 3), as decoded (float32). */
     points: (k) => Array.from(allPositions.subarray(k * stride, (k + 1) * stride)),
     ready: false,
     readyTime: null, // performance.now() [ms since navigation start] at the first draw
