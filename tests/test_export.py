@@ -24,7 +24,7 @@ import visviva as vv
 from visviva.errors import ModelError
 from visviva.io.export import EXPORT_FORMATS, default_fps, export_recording
 from visviva.io.export._frames import ExportFrames
-from visviva.io.export.gltf import MAX_GLTF_BYTES, gltf_size
+from visviva.io.export.gltf import MAX_BODY_NODES, MAX_GLTF_BYTES, MAX_MORPH_FRAMES, gltf_size
 from visviva.io.timeline import frames_at_rate
 
 #: Relative accuracy of float32 storage, with margin: two roundings (glTF base + displacement).
@@ -74,31 +74,65 @@ def usd_points(path: Path, prim: str, frame: int) -> np.ndarray:
     return np.array(UsdGeom.PointBased(stage.GetPrimAtPath(prim)).GetPointsAttr().Get(frame))
 
 
-def gltf_accessor(document: pygltflib.GLTF2, blob: bytes, index: int) -> np.ndarray:
-    """Decode one accessor (float32 or uint32, SCALAR or VEC3) with NumPy."""
-    accessor = document.accessors[index]
-    view = document.bufferViews[accessor.bufferView]
-    dtype = {pygltflib.FLOAT: "<f4", pygltflib.UNSIGNED_INT: "<u4"}[accessor.componentType]
-    width = {"SCALAR": 1, "VEC3": 3}[accessor.type]
+_DTYPES = {pygltflib.FLOAT: "<f4", pygltflib.UNSIGNED_INT: "<u4"}
+
+
+def _view_values(
+    document: pygltflib.GLTF2, blob: bytes, view_index: int, dtype: str, count: int, width: int
+) -> np.ndarray:
+    view = document.bufferViews[view_index]
     stride = view.byteStride or 4 * width
-    start = (view.byteOffset or 0) + (accessor.byteOffset or 0)
+    start = view.byteOffset or 0
     rows = [
-        np.frombuffer(blob, dtype, count=width, offset=start + i * stride)
-        for i in range(accessor.count)
+        np.frombuffer(blob, dtype, count=width, offset=start + i * stride) for i in range(count)
     ]
-    return np.array(rows).reshape(accessor.count, width).squeeze(axis=1 if width == 1 else None)
+    return np.array(rows).reshape(count, width)
+
+
+def gltf_accessor(document: pygltflib.GLTF2, blob: bytes, index: int) -> np.ndarray:
+    """Decode one accessor (float32 or uint32, SCALAR or VEC3, dense or sparse, § 3.6.2.3)."""
+    accessor = document.accessors[index]
+    dtype = _DTYPES[accessor.componentType]
+    width = {"SCALAR": 1, "VEC3": 3}[accessor.type]
+    if accessor.bufferView is None:
+        values = np.zeros((accessor.count, width), dtype=dtype)
+    else:
+        values = _view_values(document, blob, accessor.bufferView, dtype, accessor.count, width)
+        values = (
+            values[(accessor.byteOffset or 0) // (4 * width) :] if accessor.byteOffset else values
+        )
+    sparse = accessor.sparse
+    if sparse is not None:
+        where = _view_values(
+            document,
+            blob,
+            sparse.indices.bufferView,
+            _DTYPES[sparse.indices.componentType],
+            sparse.count,
+            1,
+        ).ravel()
+        values = values.copy()
+        values[where] = _view_values(
+            document, blob, sparse.values.bufferView, dtype, sparse.count, width
+        )
+    return values.squeeze(axis=1) if width == 1 else values
 
 
 def gltf_frames(path: Path) -> tuple[pygltflib.GLTF2, bytes, np.ndarray]:
-    """The document, its buffer and every frame's positions: base + morph target k."""
+    """The document, its buffer and every frame's positions ``(frames, P, 3)``: base + morph
+    target k (mesh layout), or each point node's translation at keyframe k (bodies layout)."""
     document = pygltflib.GLTF2.load(str(path))
     blob = document.binary_blob()
     if blob is None:  # .gltf: the buffer is a file next to the JSON
         blob = (path.parent / document.buffers[0].uri).read_bytes()
     primitive = document.meshes[0].primitives[0]
-    base = gltf_accessor(document, blob, primitive.attributes.POSITION)
-    targets = [gltf_accessor(document, blob, t["POSITION"]) for t in primitive.targets]
-    return document, blob, np.array([base.astype(np.float64) + d for d in targets])
+    if primitive.targets:
+        base = gltf_accessor(document, blob, primitive.attributes.POSITION)
+        targets = [gltf_accessor(document, blob, t["POSITION"]) for t in primitive.targets]
+        return document, blob, np.array([base.astype(np.float64) + d for d in targets])
+    (animation,) = document.animations
+    tracks = [gltf_accessor(document, blob, s.output) for s in animation.samplers]
+    return document, blob, np.stack(tracks, axis=1).astype(np.float64)
 
 
 def read_obj(path: Path) -> tuple[np.ndarray, list[list[int]], list[list[int]]]:
@@ -219,15 +253,15 @@ def test_points_off_the_mesh_keep_a_primitive_of_their_own(tmp_path: Path) -> No
     for k in checked:
         read = usd_points(usd, "/World/points", k)
         np.testing.assert_allclose(read, positions[k][[3]], rtol=0, atol=tolerance)
-        read = usd_points(usd, "/World/mesh", k)  # the mesh holds every point, in order
-        np.testing.assert_allclose(read, positions[k], rtol=0, atol=tolerance)
+        read = usd_points(usd, "/World/mesh", k)  # the mesh holds the points its faces use
+        np.testing.assert_allclose(read, positions[k][:3], rtol=0, atol=tolerance)
         np.testing.assert_allclose(frames[k], positions[k], rtol=0, atol=tolerance)
 
 
 # --- glTF ----------------------------------------------------------------------------------
 
 
-def test_glb_points_morph_targets_and_step_animation(tmp_path: Path) -> None:
+def test_glb_bodies_are_sphere_nodes_with_translation_tracks(tmp_path: Path) -> None:
     recording = moving_points()
     positions, checked, tolerance = expected(recording)
     (path,) = export_recording(recording, tmp_path / "fall.glb", fps=FPS)
@@ -239,22 +273,56 @@ def test_glb_points_morph_targets_and_step_animation(tmp_path: Path) -> None:
     assert frames.shape == (count, 4, 3)
     for k in checked:
         np.testing.assert_allclose(frames[k], positions[k], rtol=0, atol=tolerance)
+    # A root node named after the scene, one node per point showing the unit sphere at the
+    # point's radius, starting where the point starts.
+    root, *bodies = document.nodes
+    assert root.children == [1, 2, 3, 4] and root.mesh is None
+    for node, radius, start in zip(bodies, [0.1, 0.05, 0.2, 0.1], positions[0], strict=True):
+        assert node.mesh == 0 and node.scale == [radius] * 3
+        np.testing.assert_allclose(node.translation, start, rtol=FLOAT32_RTOL)
+    sphere = gltf_accessor(document, blob, document.meshes[0].primitives[0].attributes.POSITION)
+    np.testing.assert_allclose(np.linalg.norm(sphere, axis=1), 1.0, rtol=1e-6)
+    (animation,) = document.animations
+    assert {s.interpolation for s in animation.samplers} == {"LINEAR"}
+    assert [(c.target.node, c.target.path) for c in animation.channels] == [
+        (i, "translation") for i in (1, 2, 3, 4)
+    ]
+    times = gltf_accessor(document, blob, animation.samplers[0].input)
+    np.testing.assert_array_equal(times, (np.arange(count) / FPS).astype(np.float32))
+    assert all(view.byteOffset % 4 == 0 for view in document.bufferViews)
+
+
+def test_glb_of_many_points_is_a_mesh_with_sparse_step_weights(tmp_path: Path) -> None:
+    """Above MAX_BODY_NODES points: one POINTS mesh with morph targets; the weights of the STEP
+    animation are a sparse accessor (one 1 per keyframe), not N² floats."""
+    t = np.arange(30) / RATE
+    rng = np.random.default_rng(3)
+    start = rng.standard_normal((MAX_BODY_NODES + 1, 3))
+    points = start + t[:, None, None] * np.array([0.0, 1.0, 0.0])
+    recording = vv.Recording(t, {"points": points}, static={"radius": np.full(len(start), 0.02)})
+    positions, checked, tolerance = expected(recording)
+    (path,) = export_recording(recording, tmp_path / "cloud.glb", fps=FPS)
+    document, blob, frames = gltf_frames(path)
+    count = positions.shape[0]
+    for k in checked:
+        np.testing.assert_allclose(frames[k], positions[k], rtol=0, atol=tolerance)
     (primitive,) = document.meshes[0].primitives
     assert primitive.mode == pygltflib.POINTS and primitive.indices is None
-    # Every POSITION accessor has min/max equal to its data; buffer views are 4-byte aligned.
+    radius = gltf_accessor(document, blob, primitive.attributes._RADIUS)
+    np.testing.assert_allclose(radius, 0.02, rtol=1e-7)
+    # Every POSITION accessor has min/max equal to its data.
     for index in [primitive.attributes.POSITION, *(t["POSITION"] for t in primitive.targets)]:
         values = gltf_accessor(document, blob, index)
         assert document.accessors[index].min == values.min(axis=0).tolist()
         assert document.accessors[index].max == values.max(axis=0).tolist()
-    assert all(view.byteOffset % 4 == 0 for view in document.bufferViews)
     (animation,) = document.animations
     (sampler,) = animation.samplers
-    assert sampler.interpolation == "STEP"
-    assert animation.channels[0].target.path == "weights"
-    times = gltf_accessor(document, blob, sampler.input)
-    np.testing.assert_array_equal(times, (np.arange(count) / FPS).astype(np.float32))
+    assert sampler.interpolation == "STEP" and animation.channels[0].target.path == "weights"
+    weights_accessor = document.accessors[sampler.output]
+    assert weights_accessor.bufferView is None and weights_accessor.sparse.count == count
     weights = gltf_accessor(document, blob, sampler.output).reshape(count, count)
     np.testing.assert_array_equal(weights, np.eye(count))
+    assert path.stat().st_size < gltf_size(len(start), count) + 20_000
 
 
 def test_glb_edges_are_lines_and_faces_are_triangles(tmp_path: Path) -> None:
@@ -334,11 +402,14 @@ def test_pc2_header_and_samples(tmp_path: Path) -> None:
 # --- frame rate ----------------------------------------------------------------------------
 
 
-def test_default_fps() -> None:
+def test_default_fps_is_a_whole_number() -> None:
+    """Importers play at whole frame rates: the default rounds the recording's rate up (every
+    recorded frame shown) and caps it at 60 frames/s."""
     assert default_fps(np.arange(100) / 50.0) == 50.0
     assert default_fps(np.cumsum(np.full(100, 1.0 / 60.0))) == 60.0  # accumulated round-off
     assert default_fps(np.array([0.0, 0.1, 0.2, 0.25])) == 10.0  # a shorter last interval
-    assert default_fps(np.arange(10) * 0.003) == pytest.approx(1 / 0.003, rel=1e-12)
+    assert default_fps(np.arange(84) / 16.69) == 17.0  # the Kepler demo's recording
+    assert default_fps(np.arange(10) * 0.003) == 60.0  # 333 Hz
     assert default_fps(np.array([0.0, 0.1, 0.3])) == 30.0  # uneven
     assert default_fps(np.array([0.0])) == 30.0
 
@@ -438,13 +509,13 @@ def test_glb_over_the_size_limit(tmp_path: Path) -> None:
     with pytest.raises(ModelError) as error:
         export_recording(recording, tmp_path / "big.glb", fps=90_000.0)
     message = str(error.value)
-    # (90001 + 1)·1000·12 B of positions + (90001² + 90001)·4 B of weights = 31930 MiB.
-    assert "90001 frames × 1000 points needs 31930 MiB" in message
-    assert f"limit of {MAX_GLTF_BYTES // 2**20} MiB" in message
-    assert "pass fps ≤ 14900 frames/s, or export to usd or pc2" in message
+    # (90001 + 1)·1000·12 B of positions + 1000·4 B of radii + 90001·12 B of animation.
+    assert "90001 frames × 1000 points needs 1031 MiB" in message
+    assert f"at most {MAX_GLTF_BYTES // 2**20} MiB (MAX_GLTF_BYTES)" in message
     assert list(tmp_path.iterdir()) == []
-    # The advice fits (14901 frames), one more significant digit would not (15001 frames).
-    assert gltf_size(1000, 14901) <= MAX_GLTF_BYTES < gltf_size(1000, 15001)
+    advice = float(message.split("pass fps ≤ ")[1].split(" frames/s")[0])
+    fits = math.floor(advice) + 1  # frames over 1 s at that rate
+    assert gltf_size(1000, fits) <= MAX_GLTF_BYTES and fits <= MAX_MORPH_FRAMES
 
 
 def test_existing_files_are_replaced(tmp_path: Path) -> None:

@@ -13,6 +13,7 @@ quaternion per body per frame) becomes one more field here and one more part in 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,30 +28,31 @@ __all__ = ["FALLBACK_FPS", "MAX_OUTPUT_FRAMES", "ExportFrames", "default_fps", "
 
 #: Output rate [frames/s] when the recorded frames are not evenly spaced (or there is only one).
 FALLBACK_FPS = 30.0
+#: Highest default output rate [frames/s]: faster recordings show their nearest frame.
+MAX_DEFAULT_FPS = 60.0
 #: Relative tolerance on frame spacing for a recording to count as evenly spaced, and on its
-#: rate for that rate to be rounded to a whole number of frames per second.
+#: rate for that rate to count as a whole number of frames per second.
 _EVEN_SPACING_RTOL = 1e-6
 
 
-def _output_count(time: np.ndarray, fps: float) -> int:
-    return int(frames_at_rate(time[[0, -1]], fps).size)
-
-
 def default_fps(time: np.ndarray) -> float:
-    """The output rate [frames/s] used when an export is not given ``fps``.
+    """The output rate [frames/s] used when an export is not given ``fps``: a whole number.
 
-    The recording's own rate, ``1 / median spacing``, if its frames are evenly spaced (the last
-    interval may be shorter: a run whose duration is not a whole number of frames); rounded to
-    a whole number of frames per second when it is one up to round-off (``1/(1/60)`` gives
-    ``59.999…``), provided the rounding keeps every recorded frame. :data:`FALLBACK_FPS` for
-    uneven frames or a single frame.
+    Importers play animations at their scene's rate, always a whole number of frames per second
+    in Blender and Houdini, and sample a file made at another rate at the wrong times (a glTF at
+    16.69 frames/s showed 1 frame in 84 right in Blender). So the default is the recording's own
+    rate, ``1 / median spacing``, rounded up to a whole number (every recorded frame is shown;
+    a few twice), at most :data:`MAX_DEFAULT_FPS`; :data:`FALLBACK_FPS` for uneven frames or a
+    single frame.
 
     Args:
         time: Recorded frame times [s], non-decreasing, shape ``(frames,)``.
 
     Example:
-        >>> default_fps(np.arange(61) * (1 / 60)), default_fps(np.array([0.0, 0.1, 0.3]))
-        (60.0, 30.0)
+        >>> default_fps(np.arange(61) / 60), default_fps(np.arange(5) / 16.69)
+        (60.0, 17.0)
+        >>> default_fps(np.array([0.0, 0.1, 0.3])), default_fps(np.arange(9) / 1000)
+        (30.0, 60.0)
     """
     steps = np.diff(np.asarray(time, dtype=np.float64))
     if steps.size == 0:
@@ -62,15 +64,9 @@ def default_fps(time: np.ndarray) -> float:
     body, last = steps[:-1], steps[-1]
     if not (np.all(np.abs(body - step) <= tolerance) and 0.0 < last <= step + tolerance):
         return FALLBACK_FPS
+    # 1/(1/60) is 59.999…: a rate within round-off of a whole number is that number.
     rate = 1.0 / step
-    whole = float(round(rate))
-    if (
-        whole >= 1.0
-        and abs(whole - rate) <= _EVEN_SPACING_RTOL * rate
-        and _output_count(time, whole) == _output_count(time, rate)
-    ):
-        return whole
-    return rate
+    return float(min(MAX_DEFAULT_FPS, max(1, math.ceil(rate * (1.0 - _EVEN_SPACING_RTOL)))))
 
 
 def _topology(value: np.ndarray | None) -> np.ndarray | None:

@@ -1,38 +1,40 @@
-"""glTF 2.0 export: one mesh whose morph targets are the frames, played by a STEP animation.
+"""glTF 2.0 export: moving bodies as animated sphere nodes, anything else as morph targets.
 
 Follows the Khronos glTF 2.0 specification (sections cited as § of version 2.0.1), written
-with ``pygltflib``:
+with ``pygltflib``. Two layouts, chosen by what the recording shows:
 
-* one node with one mesh (§ 3.5, § 3.7.2). Its base ``POSITION`` (float32 VEC3) is output
-  frame 0; morph target ``k`` (§ 3.7.2.2) holds the displacement of output frame ``k`` from
-  frame 0, so target 0 is all zeros and ``base + target k`` is frame ``k``. The targets'
-  names (``frame_0000`` …) are in ``mesh.extras.targetNames``, which Blender uses for shape
-  key names;
-* primitives by topology (§ 3.7.2.1): ``TRIANGLES`` for faces (counter-clockwise seen from
-  outside, as glTF's front faces are), ``LINES`` for edges, ``POINTS`` for the points used by
-  neither (all points when there is no topology). Primitives share the position accessors;
-* one animation (§ 3.11) with one ``STEP`` sampler on the node's ``weights``: keyframe ``k``
-  at ``k/fps`` seconds sets the weight vector to the one-hot vector of target ``k``. glTF time
-  starts at 0 (the recording's first frame);
-* every ``POSITION`` accessor has ``min`` and ``max`` and the animation input has them too
-  (§ 3.6.2.5, § 3.11); every buffer view starts on a 4-byte boundary (§ 3.6.2.4), and the
-  positions share one view with ``byteStride = 12`` (required when attribute accessors share a
-  view, § 3.6.2.4). Indices are ``UNSIGNED_INT``.
+* **Bodies** — points without edges or faces, at most :data:`MAX_BODY_NODES` of them (planets,
+  stars of a small cluster, the bobs of a pendulum drawn as points): one node per point
+  (§ 3.5) under a root node named after the scene, each showing one shared unit-sphere mesh
+  scaled to the point's radius, with a ``LINEAR`` animation of its ``translation`` (§ 3.11).
+  They import into Blender as spheres that move, at ``12·N`` bytes per point for ``N`` frames.
+* **Mesh** — anything else (cloth, ropes, thousands of particles): one node with one mesh
+  (§ 3.7.2) whose base ``POSITION`` is output frame 0 and whose morph target ``k``
+  (§ 3.7.2.2) holds the displacement of frame ``k`` from frame 0, played by a ``STEP``
+  animation of the node's ``weights`` that shows target ``k`` alone at ``k/fps``. The weights
+  are a sparse accessor (§ 3.6.2.3): zeros but for one 1 per keyframe, so they take ``8·N``
+  bytes instead of the ``4·N²`` of a dense one. Primitives by topology (§ 3.7.2.1):
+  ``TRIANGLES`` for faces (counter-clockwise seen from outside), ``LINES`` for edges,
+  ``POINTS`` for points used by neither, with their radii as the application-specific
+  attribute ``_RADIUS`` [m] (§ 3.7.2.1: names starting with an underscore), for instancing
+  spheres on them (Blender: Geometry Nodes → Instance on Points, radius from the attribute).
+
+Both: glTF time starts at 0 (the recording's first frame); every ``POSITION`` accessor and the
+animation input have ``min`` and ``max`` (§ 3.6.2.5, § 3.11); buffer views start on 4-byte
+boundaries (§ 3.6.2.4); the scene's rate, speed and start time are in ``asset.extras``.
+glTF carries no scene frame rate or frame range: importers sample the animation at their own
+rate (Blender: the scene's, 24 frames/s by default), so exports default to a whole number of
+frames per second and ``docs/export.md`` gives the steps to match it.
 
 Containers (§ 4.4 "GLB File Format Specification"): a ``.glb`` holds the JSON and the binary
 buffer in one file; a ``.gltf`` is the JSON, with the buffer in a ``.bin`` file of the same
 stem next to it.
-
-Size. The positions take ``(N + 1) · P · 12`` bytes and the animation's weights ``N² · 4``
-(one weight per target per keyframe), for ``N`` output frames and ``P`` points; exports above
-:data:`MAX_GLTF_BYTES` are refused before anything is allocated. Blender turns every target
-into a shape key: glTF suits hundreds of frames; USD or PC2 suit long animations.
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
+from typing import Any
 from urllib.parse import quote
 
 import numpy as np
@@ -42,15 +44,57 @@ from ...errors import ModelError
 from ._files import all_or_nothing
 from ._frames import ExportFrames
 
-__all__ = ["MAX_GLTF_BYTES", "gltf_size", "write_gltf"]
+__all__ = ["MAX_BODY_NODES", "MAX_GLTF_BYTES", "MAX_MORPH_FRAMES", "gltf_size", "write_gltf"]
 
 #: Largest glTF buffer an export may write [bytes] (1 GiB; a GLB can hold at most 4 GiB and
 #: importers hold the whole buffer, and a shape key per frame, in memory).
 MAX_GLTF_BYTES = 2**30
-#: Bytes of one float32 VEC3.
+#: Most points exported as sphere nodes; more become one mesh (an importer makes an object
+#: per node, which thousands of particles would drown in).
+MAX_BODY_NODES = 256
+#: Most frames of a morph-target export: the sparse weights address N² entries with 32-bit
+#: indices (and Blender makes a shape key per frame).
+MAX_MORPH_FRAMES = 65_535
+#: Segments around and rings of the unit sphere the bodies show.
+_SPHERE_SEGMENTS, _SPHERE_RINGS = 24, 12
+#: Bytes of one float32 VEC3, and of one float32 or uint32 scalar.
 _VEC3_BYTES = 12
-#: Bytes of one float32 or uint32 scalar.
 _SCALAR_BYTES = 4
+
+
+def _unit_sphere() -> tuple[np.ndarray, np.ndarray]:
+    """A UV sphere of radius 1: vertices (also its normals), float32 ``(V, 3)``, and
+    counter-clockwise triangles seen from outside, uint32 ``(T, 3)``."""
+    rings, segments = _SPHERE_RINGS, _SPHERE_SEGMENTS
+    polar = np.linspace(0.0, np.pi, rings + 1)[1:-1]
+    around = np.linspace(0.0, 2.0 * np.pi, segments, endpoint=False)
+    sin_p, cos_p = np.sin(polar)[:, None], np.cos(polar)[:, None]
+    body = np.stack(
+        [
+            sin_p * np.cos(around),
+            np.broadcast_to(cos_p, (rings - 1, segments)),
+            -sin_p * np.sin(around),
+        ],
+        axis=-1,
+    ).reshape(-1, 3)
+    vertices = np.concatenate([[[0.0, 1.0, 0.0]], body, [[0.0, -1.0, 0.0]]]).astype(np.float32)
+    south = len(vertices) - 1
+
+    def ring(r: int, s: int) -> int:
+        return 1 + r * segments + s % segments
+
+    triangles = [(0, ring(0, s), ring(0, s + 1)) for s in range(segments)]
+    for r in range(rings - 2):
+        for s in range(segments):
+            a, b = ring(r, s), ring(r, s + 1)
+            c, d = ring(r + 1, s), ring(r + 1, s + 1)
+            triangles += [(a, c, b), (b, c, d)]
+    triangles += [(ring(rings - 2, s), south, ring(rings - 2, s + 1)) for s in range(segments)]
+    return vertices, np.asarray(triangles, dtype=np.uint32)
+
+
+def _as_bodies(frames: ExportFrames) -> bool:
+    return frames.edges is None and frames.faces is None and frames.point_count <= MAX_BODY_NODES
 
 
 def _primitive_indices(frames: ExportFrames) -> list[tuple[int, np.ndarray | None]]:
@@ -71,7 +115,7 @@ def _primitive_indices(frames: ExportFrames) -> list[tuple[int, np.ndarray | Non
 
 
 def gltf_size(point_count: int, frame_count: int, index_count: int = 0) -> int:
-    """Bytes of the binary buffer of a glTF export.
+    """Bytes of the binary buffer of a mesh-layout glTF export (the bodies' is smaller).
 
     Args:
         point_count: Points ``P``.
@@ -80,45 +124,196 @@ def gltf_size(point_count: int, frame_count: int, index_count: int = 0) -> int:
 
     Example:
         >>> round(gltf_size(point_count=1000, frame_count=300) / 2**20, 2)   # MiB
-        3.79
+        3.45
     """
     positions = (frame_count + 1) * point_count * _VEC3_BYTES
-    animation = (frame_count * frame_count + frame_count) * _SCALAR_BYTES
-    return positions + animation + index_count * _SCALAR_BYTES
-
-
-def _round_down(value: float, digits: int = 3) -> float:
-    """``value`` > 0 cut to ``digits`` significant digits, never rounded up (advice must fit)."""
-    scale = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
-    return math.floor(value / scale) * scale
+    radii = point_count * _SCALAR_BYTES
+    animation = 3 * frame_count * _SCALAR_BYTES  # times, sparse indices, sparse values
+    return positions + radii + animation + index_count * _SCALAR_BYTES
 
 
 def _check_size(frames: ExportFrames, index_count: int) -> None:
     points, count = frames.point_count, frames.count
     size = gltf_size(points, count, index_count)
-    if size <= MAX_GLTF_BYTES:
+    if size <= MAX_GLTF_BYTES and count <= MAX_MORPH_FRAMES:
         return
-    # Largest N with 4N² + (12P + 4)N + 12P + 4I <= limit.
-    b = points * _VEC3_BYTES + _SCALAR_BYTES
-    c = points * _VEC3_BYTES + index_count * _SCALAR_BYTES - MAX_GLTF_BYTES
-    fits = math.floor((-b + math.sqrt(b * b - 16 * c)) / 8) if c <= 0 else 0
+    per_frame = points * _VEC3_BYTES + 3 * _SCALAR_BYTES
+    fits = min(MAX_MORPH_FRAMES, (MAX_GLTF_BYTES - index_count * _SCALAR_BYTES) // per_frame - 1)
     span = float(frames.time[-1] - frames.time[0]) / frames.speed  # seconds of playback
-    if fits >= 2 and span > 0.0:
-        advice = f"pass fps ≤ {_round_down((fits - 1) / span):g} frames/s, or export to usd or pc2"
-    else:
-        advice = "export to usd or pc2, which have no such limit"
+    advice = (
+        f"pass fps ≤ {(fits - 1) / span:.3g} frames/s, or export to usd or pc2"
+        if fits >= 2 and span > 0.0
+        else "export to usd or pc2, which have no such limit"
+    )
     mib = 2**20
     raise ModelError(
-        f"a glTF export of {count} frames × {points} points needs {size / mib:.0f} MiB "
-        f"({(count + 1) * points * _VEC3_BYTES / mib:.0f} MiB of morph targets, "
-        f"{count * count * _SCALAR_BYTES / mib:.0f} MiB of animation weights), more than the "
-        f"limit of {MAX_GLTF_BYTES / mib:.0f} MiB (MAX_GLTF_BYTES); {advice}"
+        f"a glTF export of {count} frames × {points} points needs {size / mib:.0f} MiB of "
+        f"morph targets; glTF exports hold at most {MAX_GLTF_BYTES / mib:.0f} MiB "
+        f"(MAX_GLTF_BYTES) and {MAX_MORPH_FRAMES} frames; {advice}"
     )
 
 
-def _bounds(values: np.ndarray) -> tuple[list[float], list[float]]:
-    """Per-component ``min`` and ``max`` of float32 rows, as exact JSON numbers."""
-    return values.min(axis=0).tolist(), values.max(axis=0).tolist()
+class _Buffer:
+    """The binary buffer with its views and accessors, filled part by part."""
+
+    def __init__(self) -> None:
+        self.parts: list[bytes] = []
+        self.views: list[Any] = []
+        self.accessors: list[Any] = []
+        self.size = 0
+
+    def view(self, data: np.ndarray, **options: Any) -> int:
+        import pygltflib as gl
+
+        raw = np.ascontiguousarray(data).tobytes()
+        self.views.append(
+            gl.BufferView(buffer=0, byteOffset=self.size, byteLength=len(raw), **options)
+        )
+        self.parts.append(raw)
+        self.size += len(raw)  # every part is whole 4-byte values: the next stays aligned
+        return len(self.views) - 1
+
+    def accessor(self, **fields: Any) -> int:
+        import pygltflib as gl
+
+        self.accessors.append(gl.Accessor(**fields))
+        return len(self.accessors) - 1
+
+    def floats(self, values: np.ndarray, kind: str, *, bounds: bool = False, **view: Any) -> int:
+        """An accessor of float32 ``values`` (``(count,)`` SCALAR or ``(count, 3)`` VEC3)."""
+        import pygltflib as gl
+
+        values = np.asarray(values, dtype="<f4")
+        extremes: dict[str, Any] = {}
+        if bounds:
+            rows = values.reshape(len(values), -1)
+            extremes = {"min": rows.min(axis=0).tolist(), "max": rows.max(axis=0).tolist()}
+        return self.accessor(
+            bufferView=self.view(values, **view),
+            componentType=gl.FLOAT,
+            count=len(values),
+            type=kind,
+            **extremes,
+        )
+
+    def indices(self, values: np.ndarray) -> int:
+        import pygltflib as gl
+
+        return self.accessor(
+            bufferView=self.view(np.asarray(values, dtype="<u4"), target=gl.ELEMENT_ARRAY_BUFFER),
+            componentType=gl.UNSIGNED_INT,
+            count=int(values.size),
+            type=gl.SCALAR,
+        )
+
+    def blob(self) -> bytes:
+        return b"".join(self.parts)
+
+
+def _bodies(frames: ExportFrames, data: _Buffer) -> tuple[list[Any], list[Any], Any]:
+    """Nodes (root first), the sphere mesh and the animation of the bodies layout."""
+    import pygltflib as gl
+
+    vertices, triangles = _unit_sphere()
+    position = data.floats(vertices, gl.VEC3, bounds=True, target=gl.ARRAY_BUFFER)
+    normal = data.floats(vertices, gl.VEC3, target=gl.ARRAY_BUFFER)
+    sphere = gl.Mesh(
+        name="sphere",
+        primitives=[
+            gl.Primitive(
+                attributes=gl.Attributes(POSITION=position, NORMAL=normal),
+                indices=data.indices(triangles.ravel()),
+                mode=gl.TRIANGLES,
+            )
+        ],
+    )
+    times = data.floats(frames.output_times(), gl.SCALAR, bounds=True)
+    tracks = np.stack([frames.points_at(k) for k in range(frames.count)], axis=1)  # (P, N, 3)
+    radius = frames.radius()
+    nodes = [gl.Node(name=frames.name, children=list(range(1, frames.point_count + 1)))]
+    samplers, channels = [], []
+    for i in range(frames.point_count):
+        nodes.append(
+            gl.Node(
+                name=f"point_{i:04d}",
+                mesh=0,
+                translation=tracks[i, 0].tolist(),
+                scale=[float(radius[i])] * 3,
+            )
+        )
+        samplers.append(
+            gl.AnimationSampler(
+                input=times, output=data.floats(tracks[i], gl.VEC3), interpolation=gl.ANIM_LINEAR
+            )
+        )
+        channels.append(
+            gl.AnimationChannel(
+                sampler=i, target=gl.AnimationChannelTarget(node=i + 1, path=gl.TRANSLATION)
+            )
+        )
+    animation = gl.Animation(name="simulation", samplers=samplers, channels=channels)
+    return nodes, [sphere], animation
+
+
+def _mesh(frames: ExportFrames, data: _Buffer) -> tuple[list[Any], list[Any], Any]:
+    """Node, mesh with morph targets and the weight animation of the mesh layout."""
+    import pygltflib as gl
+
+    primitives = _primitive_indices(frames)
+    _check_size(frames, sum(0 if i is None else i.size for _, i in primitives))
+    count = frames.count
+    first = frames.points_at(0)
+    # Displacements are rounded once, from float64: base + target k is frame k to within
+    # float32 rounding of the position and of the displacement.
+    base = data.floats(first, gl.VEC3, bounds=True, target=gl.ARRAY_BUFFER)
+    targets = [
+        gl.Attributes(POSITION=data.floats(frames.points_at(k) - first, gl.VEC3, bounds=True))
+        for k in range(count)
+    ]
+    radius = data.floats(frames.radius(), gl.SCALAR, target=gl.ARRAY_BUFFER)
+    mesh_primitives = []
+    for mode, indices in primitives:
+        attributes = gl.Attributes(POSITION=base)
+        if mode == gl.POINTS:
+            attributes._RADIUS = radius
+        mesh_primitives.append(
+            gl.Primitive(
+                attributes=attributes,
+                indices=None if indices is None else data.indices(indices),
+                mode=mode,
+                targets=targets,
+            )
+        )
+    mesh = gl.Mesh(
+        name=frames.name,
+        primitives=mesh_primitives,
+        weights=[1.0] + [0.0] * (count - 1),
+        extras={"targetNames": [f"frame_{k:04d}" for k in range(count)]},
+    )
+    times = data.floats(frames.output_times(), gl.SCALAR, bounds=True)
+    diagonal = np.arange(count, dtype=np.uint64) * (count + 1)  # keyframe k shows target k
+    weights = data.accessor(
+        componentType=gl.FLOAT,
+        count=count * count,
+        type=gl.SCALAR,
+        sparse=gl.Sparse(
+            count=count,
+            indices=gl.AccessorSparseIndices(
+                bufferView=data.view(diagonal.astype("<u4")), componentType=gl.UNSIGNED_INT
+            ),
+            values=gl.AccessorSparseValues(bufferView=data.view(np.ones(count, dtype="<f4"))),
+        ),
+    )
+    animation = gl.Animation(
+        name="simulation",
+        samplers=[gl.AnimationSampler(input=times, output=weights, interpolation=gl.ANIM_STEP)],
+        channels=[
+            gl.AnimationChannel(
+                sampler=0, target=gl.AnimationChannelTarget(node=0, path=gl.WEIGHTS)
+            )
+        ],
+    )
+    return [gl.Node(mesh=0, name=frames.name)], [mesh], animation
 
 
 def write_gltf(frames: ExportFrames, path: Path, *, binary: bool) -> list[Path]:
@@ -134,116 +329,13 @@ def write_gltf(frames: ExportFrames, path: Path, *, binary: bool) -> list[Path]:
         The files written: ``[path]``, or ``[path, path.with_suffix(".bin")]``.
 
     Raises:
-        ModelError: If the buffer would exceed :data:`MAX_GLTF_BYTES`.
+        ModelError: If a mesh export would exceed :data:`MAX_GLTF_BYTES` or
+            :data:`MAX_MORPH_FRAMES`.
     """
     import pygltflib as gl
 
-    primitives = _primitive_indices(frames)
-    index_count = sum(0 if indices is None else indices.size for _, indices in primitives)
-    _check_size(frames, index_count)
-    points, count = frames.point_count, frames.count
-    frame_bytes = points * _VEC3_BYTES
-
-    # One allocation for the whole buffer; every part is written straight into its place.
-    buffer = np.zeros(gltf_size(points, count, index_count), dtype=np.uint8)
-    views: list[gl.BufferView] = []
-    accessors: list[gl.Accessor] = []
-    offset = 0
-
-    def view(length: int, **options: int) -> tuple[int, np.ndarray]:
-        nonlocal offset
-        views.append(gl.BufferView(buffer=0, byteOffset=offset, byteLength=length, **options))
-        part = buffer[offset : offset + length]
-        offset += length  # every part is a whole number of 4-byte values: stays aligned
-        return len(views) - 1, part
-
-    position_view, raw = view((count + 1) * frame_bytes, byteStride=12, target=gl.ARRAY_BUFFER)
-    positions = raw.view("<f4").reshape(count + 1, points, 3)
-    first = frames.points_at(0)
-    positions[0] = first
-    for k in range(count):
-        # Displacements are rounded once, from float64: base + target k is frame k to within
-        # float32 rounding of the position and of the displacement.
-        positions[k + 1] = frames.points_at(k) - first
-    for k in range(count + 1):
-        low, high = _bounds(positions[k])
-        accessors.append(
-            gl.Accessor(
-                bufferView=position_view,
-                byteOffset=k * frame_bytes,
-                componentType=gl.FLOAT,
-                count=points,
-                type=gl.VEC3,
-                min=low,
-                max=high,
-            )
-        )
-
-    index_accessor: list[int | None] = []
-    for _, indices in primitives:
-        if indices is None:
-            index_accessor.append(None)
-            continue
-        index_view, raw = view(indices.size * _SCALAR_BYTES, target=gl.ELEMENT_ARRAY_BUFFER)
-        raw.view("<u4")[:] = indices
-        accessors.append(
-            gl.Accessor(
-                bufferView=index_view,
-                componentType=gl.UNSIGNED_INT,
-                count=int(indices.size),
-                type=gl.SCALAR,
-            )
-        )
-        index_accessor.append(len(accessors) - 1)
-
-    time_view, raw = view(count * _SCALAR_BYTES)
-    times = raw.view("<f4")
-    times[:] = frames.output_times()
-    accessors.append(
-        gl.Accessor(
-            bufferView=time_view,
-            componentType=gl.FLOAT,
-            count=count,
-            type=gl.SCALAR,
-            min=[float(times[0])],
-            max=[float(times[-1])],
-        )
-    )
-    weight_view, raw = view(count * count * _SCALAR_BYTES)
-    weights = raw.view("<f4").reshape(count, count)
-    weights[np.arange(count), np.arange(count)] = 1.0  # keyframe k shows target k only
-    accessors.append(
-        gl.Accessor(
-            bufferView=weight_view, componentType=gl.FLOAT, count=count * count, type=gl.SCALAR
-        )
-    )
-    time_accessor, weight_accessor = len(accessors) - 2, len(accessors) - 1
-
-    targets = [gl.Attributes(POSITION=k + 1) for k in range(count)]
-    mesh = gl.Mesh(
-        name=frames.name,
-        primitives=[
-            gl.Primitive(
-                attributes=gl.Attributes(POSITION=0), indices=index, mode=mode, targets=targets
-            )
-            for (mode, _), index in zip(primitives, index_accessor, strict=True)
-        ],
-        weights=[1.0] + [0.0] * (count - 1),
-        extras={"targetNames": [f"frame_{k:04d}" for k in range(count)]},
-    )
-    animation = gl.Animation(
-        name="simulation",
-        samplers=[
-            gl.AnimationSampler(
-                input=time_accessor, output=weight_accessor, interpolation=gl.ANIM_STEP
-            )
-        ],
-        channels=[
-            gl.AnimationChannel(
-                sampler=0, target=gl.AnimationChannelTarget(node=0, path=gl.WEIGHTS)
-            )
-        ],
-    )
+    data = _Buffer()
+    nodes, meshes, animation = (_bodies if _as_bodies(frames) else _mesh)(frames, data)
     document = gl.GLTF2(
         asset=gl.Asset(
             generator=f"visviva {__version__}",
@@ -252,28 +344,29 @@ def write_gltf(frames: ExportFrames, path: Path, *, binary: bool) -> list[Path]:
                 "fps": frames.fps,
                 "speed": frames.speed,
                 "start_time_s": float(frames.time[0]),
+                "frames": frames.count,
                 "units": "m",
             },
         ),
         scene=0,
         scenes=[gl.Scene(nodes=[0])],
-        nodes=[gl.Node(mesh=0, name=frames.name)],
-        meshes=[mesh],
-        accessors=accessors,
-        bufferViews=views,
+        nodes=nodes,
+        meshes=meshes,
+        accessors=data.accessors,
+        bufferViews=data.views,
         animations=[animation],
     )
-
+    blob = data.blob()
     if binary:
-        document.buffers = [gl.Buffer(byteLength=buffer.size)]
-        document.set_binary_blob(buffer.data)
+        document.buffers = [gl.Buffer(byteLength=len(blob))]
+        document.set_binary_blob(blob)
         with all_or_nothing([path]) as (temporary,), temporary.open("wb") as file:
             for chunk in document.save_to_bytes():
                 file.write(chunk)
         return [path]
     sidecar = path.with_suffix(".bin")
-    document.buffers = [gl.Buffer(byteLength=buffer.size, uri=quote(sidecar.name))]
+    document.buffers = [gl.Buffer(byteLength=len(blob), uri=quote(sidecar.name))]
     with all_or_nothing([path, sidecar]) as (json_file, bin_file):
         json_file.write_text(document.gltf_to_json(), encoding="utf-8")
-        buffer.tofile(bin_file)
+        bin_file.write_bytes(blob)
     return [path, sidecar]

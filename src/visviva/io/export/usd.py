@@ -15,8 +15,9 @@ Written with Pixar's ``usd-core`` (``pxr``), following the UsdGeom schemas (open
   two-vertex curve per edge, time-sampled ``points`` (the two ends of every edge, in edge
   order) and ``extent``, and a constant width of half the thinnest diameter among points
   with a radius;
-* ``/World/mesh`` (``UsdGeom.Mesh``): the triangles as ``faceVertexCounts`` (all 3) and
-  ``faceVertexIndices``, ``orientation = rightHanded`` (counter-clockwise seen from outside,
+* ``/World/mesh`` (``UsdGeom.Mesh``): the points the triangles use (in the recording's order)
+  and the triangles as ``faceVertexCounts`` (all 3) and ``faceVertexIndices`` into them,
+  ``orientation = rightHanded`` (counter-clockwise seen from outside,
   the recording's convention), ``subdivisionScheme = none`` (a simulation mesh is the surface
   itself, not a cage to be smoothed), ``doubleSided`` (cloth has no inside), time-sampled
   ``points`` and ``extent``.
@@ -113,11 +114,15 @@ def _add_mesh(stage: Any, frames: ExportFrames, faces: np.ndarray) -> Callable[[
     prim = UsdGeom.Mesh.Define(stage, "/World/mesh")
     counts = np.full(faces.shape[0], 3, dtype=np.int32)
     prim.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(counts))
-    prim.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(faces.ravel().astype(np.int32)))
+    # Only the points the faces use, renumbered in order: a point on no face would become a
+    # stray vertex of the mesh (those are /World/points already).
+    used, renumbered = np.unique(faces, return_inverse=True)
+    indices = renumbered.reshape(faces.shape).ravel().astype(np.int32)
+    prim.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(indices))
     prim.CreateOrientationAttr(UsdGeom.Tokens.rightHanded)
     prim.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
     prim.CreateDoubleSidedAttr(True)
-    return _animate(prim, frames, None, 0.0)
+    return _animate(prim, frames, None if used.size == frames.point_count else used, 0.0)
 
 
 def write_usd(frames: ExportFrames, path: Path, *, encoding: str) -> list[Path]:
