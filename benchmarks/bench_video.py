@@ -69,7 +69,8 @@ def main() -> None:
 
     camera = Camera.framing(drawn_bounds(geometry), aspect=size[0] / size[1])
     painter, _ = timed(
-        "set-up: kernels (cached), sky and ground", lambda: FramePainter(geometry, size, camera)
+        "set-up: kernels (cached), sky and ground",
+        lambda: FramePainter(geometry, size, camera, recording.time),
     )
     painter.paint(0, 0.0)
     _, seconds = timed(

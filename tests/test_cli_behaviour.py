@@ -143,3 +143,54 @@ def test_a_figure_needs_an_image_suffix_and_may_go_into_a_new_folder(monkeypatch
     status, _, err = run_main(monkeypatch, capsys, "stability", "rk4", "-o", target)
     assert status == 0, err
     assert target.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_export_to_obj_prints_one_line(monkeypatch, capsys, tmp_path):
+    path = _recording(tmp_path, points=np.zeros((5, 2, 3)))
+    status, out, err = run_main(monkeypatch, capsys, "export", path, "--to", "obj", "--fps", "4")
+    assert status == 0, err
+    assert out.splitlines() == [f"wrote 5 OBJ files into {tmp_path / 'obj'}/ (frame_0000.obj …)"]
+
+
+def test_export_plays_at_the_speed_its_run_was_made_with(monkeypatch, capsys, tmp_path):
+    """A year of orbit recorded by a run that plays a week per second: `export --to gif` uses
+    that speed, as `run -f gif` did, instead of refusing a year of video at speed 1."""
+    year, week = 365.25 * 86_400.0, 7 * 86_400.0
+    t = np.linspace(0.0, year, 53)
+    points = np.zeros((53, 1, 3))
+    points[:, 0, 0] = np.cos(2 * np.pi * t / year)
+    recording = vv.Recording(
+        t, {"points": points}, attrs={"playback_speed": week, "playback_trail": 8 * week}
+    )
+    path = recording.save(tmp_path / "recording.h5")
+    status, out, err = run_main(monkeypatch, capsys, "export", path, "--to", "gif", "--fps", "2")
+    assert status == 0, err
+    assert "animation.gif" in out
+    line = refused(
+        monkeypatch,
+        capsys,
+        "export",
+        path,
+        "--to",
+        "gif",
+        "--speed",
+        "1",
+        "-o",
+        tmp_path / "slow.gif",
+    )
+    assert "output frames" in line and "speed" in line
+    from visviva.io.outputs import playback
+
+    assert playback(recording, None, None) == (week, 8 * week)
+    assert playback(recording, 1.0, 0.0) == (1.0, 0.0)
+
+
+def test_demos_record_how_they_play(tmp_path):
+    from visviva.demos import demos, run_demo
+
+    run_demo("kepler", tmp_path, duration=6.0)
+    kepler = demos()["kepler"]
+    for run in vv.io.read_recordings(tmp_path / "recording.h5").values():
+        assert run.attrs["playback_speed"] == kepler.speed
+        assert run.attrs["playback_trail"] == kepler.trail > 0.0  # Kepler's ellipse is drawn
+        assert run.static["color"].shape == (2, 3)

@@ -7,7 +7,6 @@ text and ``struct``) and compared with the recording at the frames the output ra
 
 from __future__ import annotations
 
-import base64
 import json
 import re
 import sys
@@ -22,6 +21,7 @@ import visviva as vv
 from test_export import FLOAT32_RTOL, gltf_frames, read_obj, read_pc2, usd_points
 from visviva.cli.main import app, main
 from visviva.io.timeline import frames_at_rate
+from visviva.viz.viewer._payload import decoded_positions
 
 FPS = 20.0
 FORMATS = ("mp4", "gif", "html", "usd", "glb", "obj", "pc2")
@@ -103,10 +103,11 @@ def test_viewer_embeds_the_resampled_frames_and_loads_nothing_from_the_network(r
     payload = json.loads(data.group(1))
     positions, checked, tolerance = shown_positions(recording)
     assert payload["frames"] == positions.shape[0] and payload["fps"] == FPS
-    stored = np.frombuffer(base64.b64decode(payload["layers"]["points"]["positions"]), "<f4")
-    stored = stored.reshape(positions.shape)
+    stored = decoded_positions(payload["layers"]["points"], payload["frames"])
+    # Quantized to a 16-bit grid over the points' box: within half a grid step (viewer docs).
+    half_step = 0.5 * np.ptp(positions.reshape(-1, 3), axis=0) / 65535
     for k in checked:
-        np.testing.assert_allclose(stored[k], positions[k], rtol=0, atol=tolerance)
+        assert np.all(np.abs(stored[k] - positions[k]) <= half_step * (1 + 1e-9) + tolerance)
 
 
 def test_exports_hold_the_recorded_positions_at_three_frames(run):
@@ -159,10 +160,12 @@ def test_export_command_writes_the_run_names_next_to_the_recording(
         assert status == 0, output
     names = {"scene.usdc", "scene.glb", "obj", "points.pc2", "animation.gif"}
     assert {p.name for p in tmp_path.iterdir()} == names | {"recording.h5"}
-    # Without --fps the exports keep every recorded frame (an even 100 frames/s here).
+    # Without --fps the exports play at a whole number of frames per second: the recording's
+    # 100 frames/s capped at 60 (docs/export.md).
     _, pc2 = read_pc2(tmp_path / "points.pc2")
     tolerance = FLOAT32_RTOL * float(np.abs(recording["points"]).max())
-    np.testing.assert_allclose(pc2, recording["points"], rtol=0, atol=tolerance)
+    expected = recording["points"][frames_at_rate(recording.time, 60.0)]
+    np.testing.assert_allclose(pc2, expected, rtol=0, atol=tolerance)
     status, output = run_main(monkeypatch, capsys, "export", source, "--to", "pc2")
     assert status == 2 and "--force" in output
     status, output = run_main(monkeypatch, capsys, "export", source, "--to", "usdz")

@@ -287,3 +287,77 @@ def test_a_still_and_an_empty_scene_render(tmp_path, suffix):
     empty = vv.Recording(np.arange(3) / 30.0, {"points": np.zeros((3, 0, 3))})
     frames = read_frames(render_video(empty, tmp_path / f"empty.{suffix}", size=(64, 48)))
     assert len(frames) == 3 and sphere_mask(frames[0]).sum() == 0
+
+
+# Legible pictures: colours and display sizes per point, trails, time in the unit that reads.
+
+
+def _orbit(frames: int = 121, *, span: float = 365.25 * 86_400.0) -> vv.Recording:
+    """A 'sun' at rest and a 'planet' circling it once in the x–z plane over ``span`` [s]."""
+    t = np.linspace(0.0, span, frames)
+    angle = 2.0 * np.pi * t / span
+    points = np.zeros((frames, 2, 3))
+    points[:, 1, 0], points[:, 1, 2] = np.cos(angle), -np.sin(angle)
+    return vv.Recording(
+        t,
+        {"points": points},
+        static={
+            "color": np.array([[1.0, 0.78, 0.18], [0.16, 0.42, 0.86]]),
+            "display_radius": np.array([0.15, 0.06]),
+        },
+    )
+
+
+def _painter(recording, trail=0.0, size=(320, 180)):
+    from visviva.viz.frame import FramePainter, drawn_bounds
+    from visviva.viz.video import Camera
+
+    geometry = recording.geometry()
+    camera = Camera.framing(drawn_bounds(geometry), aspect=size[0] / size[1])
+    return FramePainter(geometry, size, camera, recording.time, trail)
+
+
+def test_points_are_drawn_in_their_colours_at_their_display_radii():
+    image = _painter(_orbit()).paint(0, 0.0).astype(int)
+    red, green, blue = image[..., 0], image[..., 1], image[..., 2]
+    yellow = (red > 150) & (green > 100) & (blue < 90)  # the sun, shaded
+    planet = (blue - red > 60) & (blue > 110)
+    assert yellow.sum() > 2 * planet.sum() > 0  # display radii 0.15 and 0.06: the sun is larger
+    cols = np.nonzero(yellow)[1]
+    assert abs(cols.mean() - np.nonzero(planet)[1].mean()) > 20  # apart, not one on the other
+
+
+def test_the_label_says_when_sizes_are_not_to_scale_and_picks_a_readable_unit():
+    orbit = _orbit()
+    assert _painter(orbit).label(182.625 * 86_400.0) == "t = 182.6 days, sizes not to scale"
+    recording = vv.Recording(
+        np.linspace(0.0, 2.0, 3), {"points": np.zeros((3, 1, 3))}, static={"radius": [0.1]}
+    )
+    assert _painter(recording).label(1.5) == "t = 1.500 s"
+    from visviva.viz.timescale import format_time
+
+    assert format_time(90.0, 600.0) == "t = 1.50 min"
+    assert format_time(7200.0, 86_400.0) == "t = 2.00 h"
+    assert format_time(3.0 * 365.25 * 86_400.0, 10 * 365.25 * 86_400.0) == "t = 3.00 years"
+
+
+def test_trails_draw_the_path_behind_each_point():
+    """After three quarters of the orbit with a trail of one orbit, pixels along the planet's
+    past path differ from the picture without trail; none differ without a trail."""
+    orbit = _orbit()
+    span = float(orbit.time[-1])
+    plain = _painter(orbit).paint(90, float(orbit.time[90])).astype(int)
+    trailed = _painter(orbit, trail=span).paint(90, float(orbit.time[90])).astype(int)
+    changed = np.abs(trailed - plain).sum(axis=2) > 30
+    assert changed.sum() > 100  # a line along three quarters of a circle
+    cols = np.nonzero(changed)[1]
+    assert cols.max() - cols.min() > 100  # it spans the picture, not one spot
+    again = _painter(orbit).paint(90, float(orbit.time[90])).astype(int)
+    assert np.array_equal(again, plain)
+
+
+def test_trails_are_refused_for_many_points(tmp_path):
+    recording = vv.Recording(np.arange(3.0), {"points": np.zeros((3, 1001, 3))})
+    with pytest.raises(vv.ModelError, match="at most 1000 points"):
+        vv.viz.video.render_video(recording, tmp_path / "a.gif", fps=1.0, trail=1.0)
+    assert list(tmp_path.iterdir()) == []

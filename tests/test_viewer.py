@@ -399,22 +399,17 @@ def test_bad_input_is_refused_before_anything_is_written(tmp_path, change, messa
 
 
 def _embedded_positions(page: Path) -> tuple[np.ndarray, np.ndarray]:
-    """Decode the page's frame times and positions in Python, as viewer.js does (see
-    viewer/_payload.py)."""
+    """The page's frame times and positions, decoded in Python as viewer.js does."""
     import base64
     import json
     import re
-    import zlib
+
+    from visviva.viz.viewer._payload import decoded_positions
 
     text = page.read_text(encoding="utf-8")
     data = json.loads(re.search(r'id="visviva-data"[^>]*>(.*?)</script>', text, re.S).group(1))
-    layer = data["layers"]["points"]
-    planes = np.frombuffer(zlib.decompress(base64.b64decode(layer["positions"])), np.uint8)
-    n = planes.size // 2
-    differences = planes[:n].astype(np.uint16) | (planes[n:].astype(np.uint16) << 8)
-    levels = np.cumsum(differences.reshape(data["frames"], -1), axis=0, dtype=np.uint16)
     times = np.frombuffer(base64.b64decode(data["times"]), "<f8")
-    return times, layer["origin"] + levels.reshape(data["frames"], -1, 3) * np.array(layer["step"])
+    return times, decoded_positions(data["layers"]["points"], data["frames"])
 
 
 def test_galaxy_viewer_is_quantized_to_under_12_megabytes(tmp_path):
@@ -432,3 +427,31 @@ def test_galaxy_viewer_is_quantized_to_under_12_megabytes(tmp_path):
     # The documented precision: half a step of a ~20 m box is about 0.15 mm.
     flat = recording["points"].reshape(-1, 3)
     assert np.max(flat.max(axis=0) - flat.min(axis=0)) / 65535 / 2 < 2.5e-4
+
+
+def test_colours_display_radii_trails_and_time_unit_reach_the_page(browser, tmp_path):
+    """A year of a planet about a sun, coloured and drawn at display radii with a trail: the
+    page says the time in days and that sizes are not to scale, and draws the sun yellow."""
+    year = 365.25 * 86_400.0
+    t = np.linspace(0.0, year, 61)
+    points = np.zeros((61, 2, 3))
+    points[:, 1, 0], points[:, 1, 2] = np.cos(2 * np.pi * t / year), -np.sin(2 * np.pi * t / year)
+    recording = vv.Recording(
+        t,
+        {"points": points},
+        static={
+            "color": np.array([[1.0, 0.78, 0.18], [0.16, 0.42, 0.86]]),
+            "display_radius": np.array([0.15, 0.06]),
+        },
+    )
+    page = write_viewer(recording, tmp_path / "orbit.html", fps=10.0, speed=year / 6, trail=year)
+    opened = Opened(browser, page)
+    try:
+        assert opened.errors == []
+        image = opened.image(40)
+        text = opened.js("document.getElementById('time').textContent")
+        assert text.startswith("t = 243.5 days, sizes not to scale")
+        red, green, blue = (image[..., i].astype(int) for i in range(3))
+        assert ((red > 170) & (green > 120) & (blue < 110)).sum() > 50  # the sun, yellow
+    finally:
+        opened.page.close()

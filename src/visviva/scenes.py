@@ -169,7 +169,9 @@ def run_scene(
         for name in extra if failure is None else ():
             try:
                 with job.writing(name) as path:
-                    write_output(recording, path, model.output_fps, model.output_speed)
+                    write_output(
+                        recording, path, model.output_fps, model.output_speed, model.output_trail
+                    )
             except ModelError as error:
                 # The simulation is done: keep it, and say which output could not be made.
                 unwritten.append(f"{name} was not written: {error}")
@@ -214,6 +216,8 @@ def _simulate_streaming(
         "visviva_version": __version__,
         "method": settings.method,
         "dt": settings.dt,
+        "playback_speed": model.output_speed,
+        "playback_trail": model.output_trail,
     }
     failure: SimulationError | Interrupted | None = None
     with RecordingWriter(path, units=model.units(), attrs=attrs, static=model.static()) as writer:

@@ -26,9 +26,19 @@ FpsOption = Annotated[
     float | None, typer.Option("--fps", help="Frames per second of the output [1/s].")
 ]
 SpeedOption = Annotated[
-    float,
+    float | None,
     typer.Option(
-        "--speed", help="Simulated seconds per second of playback (86400: a day per second)."
+        "--speed",
+        help="Simulated seconds per second of playback (86400: a day per second); default: "
+        "the speed the run was made with (its scene's or demo's), else 1.",
+    ),
+]
+TrailOption = Annotated[
+    float | None,
+    typer.Option(
+        "--trail",
+        help="Simulated seconds [s] of each point's path drawn behind it (video, viewer); "
+        "default: the run's, else 0.",
     ),
 ]
 
@@ -164,18 +174,22 @@ def view_command(
         typer.Option("--output", "-o", help="HTML file (default: viewer.html next to it)."),
     ] = None,
     fps: FpsOption = None,
-    speed: SpeedOption = 1.0,
+    speed: SpeedOption = None,
+    trail: TrailOption = None,
     run: RunOption = None,
     force: ForceOption = False,
 ) -> None:
     """Write the single-file web viewer of a recording (open it in any browser)."""
     from ..io.files import check_new_file
+    from ..io.outputs import playback
     from ..io.recording import Recording
     from ..viz.viewer import write_viewer
 
     target = output or recording.with_name("viewer.html")
     check_new_file(target, force=force)
-    written = write_viewer(Recording.load(recording, run), target, fps=fps, speed=speed)
+    source = Recording.load(recording, run)
+    speed, trail = playback(source, speed, trail)
+    written = write_viewer(source, target, fps=fps, speed=speed, trail=trail)
     typer.echo(f"wrote {written}; open it in a browser (file://{written.resolve()})")
 
 
@@ -187,7 +201,8 @@ def export_command(
         Path | None, typer.Option("--output", "-o", help="Output file (default: next to it).")
     ] = None,
     fps: FpsOption = None,
-    speed: SpeedOption = 1.0,
+    speed: SpeedOption = None,
+    trail: TrailOption = None,
     size: Annotated[
         str | None,
         typer.Option("--size", help="Video size WIDTHxHEIGHT in pixels (mp4, gif), e.g. 1280x720."),
@@ -199,7 +214,7 @@ def export_command(
     from .._validation import did_you_mean
     from ..errors import ModelError
     from ..io.files import check_new_file
-    from ..io.outputs import OUTPUT_FILES
+    from ..io.outputs import OUTPUT_FILES, playback
     from ..io.recording import Recording
 
     formats = ("usd", "glb", "obj", "pc2", "mp4", "gif")
@@ -219,16 +234,23 @@ def export_command(
     else:
         check_new_file(target, force=force)
     source = Recording.load(recording, run)
+    speed, trail = playback(source, speed, trail)
     if video:
         from ..viz.video import render_video
 
-        written = [render_video(source, target, fps=fps or 30.0, size=pixels, speed=speed)]
+        written = [
+            render_video(source, target, fps=fps or 30.0, size=pixels, speed=speed, trail=trail)
+        ]
     else:
         from ..io.export import export_recording
 
         written = export_recording(source, target, to=to, fps=fps, speed=speed)
-    for path in written:
-        typer.echo(f"wrote {path}")
+    if to == "obj":
+        folder = written[0].parent
+        typer.echo(f"wrote {len(written)} OBJ files into {folder}/ ({written[0].name} …)")
+    else:
+        for path in written:
+            typer.echo(f"wrote {path}")
 
 
 def _video_size(text: str) -> tuple[int, int]:

@@ -36,6 +36,8 @@ class Demo:
         picture: The demo's first recording carries drawable geometry (``points``), so it can
             be written as a video, the web viewer or an export (``visviva demo NAME -f mp4``).
         speed: Simulated seconds per second of those outputs' playback.
+        trail: Simulated seconds of each point's path drawn behind it in the video and the
+            viewer (0: none).
     """
 
     name: str
@@ -44,6 +46,7 @@ class Demo:
     run: Callable[[JobOutput, float], dict[str, Any]]
     picture: bool = False
     speed: float = 1.0
+    trail: float = 0.0
 
 
 _DEMOS: dict[str, Demo] = {}
@@ -138,6 +141,8 @@ def run_demo(
                 output.recordings[_interrupted_run_name(output, error)] = error.recording
         if interrupted is None and stops.requested:
             interrupted = Interrupted(stops.requested, seconds)
+        for recording in output.recordings.values():  # later exports play them the same way
+            recording.attrs |= {"playback_speed": demo.speed, "playback_trail": demo.trail}
         summary = _summary(demo, output, seconds, interrupted) | extra
         if extras and interrupted is None:
             run, primary = next(iter(output.recordings.items()))
@@ -145,7 +150,7 @@ def run_demo(
             for file_name in extras:
                 try:
                     with output.writing(file_name) as path:
-                        write_output(primary, path, fps, demo.speed)
+                        write_output(primary, path, fps, demo.speed, demo.trail)
                 except KeyboardInterrupt:
                     interrupted = Interrupted(stops.requested or "SIGINT", seconds)
                     summary["interrupted"] = interrupted.signal

@@ -7,17 +7,28 @@ import numpy as np
 from ..io.recording import Recording
 
 
-def drawn_bodies(recording: Recording) -> Recording:
+def drawn_bodies(
+    recording: Recording,
+    *,
+    color: np.ndarray | None = None,
+    display_radius: np.ndarray | None = None,
+) -> Recording:
     """``recording`` of an n-body problem (fields ``q`` and ``v``, the bodies' coordinates
     flattened) with each quantity once: ``points`` [m] and ``velocities`` [m/s], ``(frames, N,
-    3)``, plus the recorded energy."""
+    3)``, plus the recorded energy; optionally each body's sRGB ``color`` ``(N, 3)`` and
+    ``display_radius`` [m] ``(N,)`` (see :mod:`visviva.io.recording`)."""
     x, v = body_states(recording)
     fields = {"points": x, "velocities": v}
-    units = {"points": "m", "velocities": "m/s"}
+    units = {"points": "m", "velocities": "m/s", "display_radius": "m"}
     if "energy" in recording:
         fields["energy"] = recording["energy"]
         units["energy"] = recording.units.get("energy", "J")
-    return Recording(recording.time, fields, units=units, attrs=recording.attrs)
+    static = {
+        name: np.asarray(value, dtype=np.float64)
+        for name, value in (("color", color), ("display_radius", display_radius))
+        if value is not None
+    }
+    return Recording(recording.time, fields, units=units, attrs=recording.attrs, static=static)
 
 
 def body_states(recording: Recording) -> tuple[np.ndarray, np.ndarray]:

@@ -22,6 +22,11 @@ from . import Demo, register_demo
 Q0 = np.array([2.0, 1.0])  # released from rest [rad]
 DELTA = 1e-9  # initial difference in theta2 [rad]
 DT = 1e-3  # [s]
+#: Colours of the two pendulums' pivot and bobs: one blue, the other orange, pivots grey.
+PIVOT_AND_BOBS = (
+    [[0.45, 0.45, 0.45], [0.18, 0.44, 0.70], [0.18, 0.44, 0.70]],
+    [[0.45, 0.45, 0.45], [0.90, 0.45, 0.10], [0.90, 0.45, 0.10]],
+)
 
 
 def _together(system: Any, first: Recording, second: Recording) -> Recording:
@@ -31,9 +36,8 @@ def _together(system: Any, first: Recording, second: Recording) -> Recording:
     points[..., 1] += 2.2
     edges = np.concatenate([a.static["edges"], b.static["edges"] + 3])
     fields = dict(first.fields) | {"points": points}
-    return Recording(
-        first.time, fields, units={"points": "m"}, attrs=first.attrs, static={"edges": edges}
-    )
+    static = {"edges": edges, "color": np.array(PIVOT_AND_BOBS[0] + PIVOT_AND_BOBS[1])}
+    return Recording(first.time, fields, units={"points": "m"}, attrs=first.attrs, static=static)
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:

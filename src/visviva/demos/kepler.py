@@ -24,6 +24,10 @@ ECCENTRICITY = 0.5
 MASSES = (1.0, 0.1)  # [kg], with G = 1 (N-body units)
 STEPS_PER_ORBIT = 1000
 METHODS = ("velocity_verlet", "rk4", "explicit_euler")
+#: The heavier body orange, the lighter blue.
+COLORS = np.array([[0.90, 0.45, 0.10], [0.18, 0.44, 0.70]])
+#: Kepler's third law with G = 1: T = 2π √(a³ / (m1 + m2)) for a = 1 [s].
+PERIOD = 2 * np.pi / np.sqrt(sum(MASSES))
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
@@ -47,7 +51,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     figures = {}
     for name in METHODS:
         solution = solve(problem, name, dt=dt, t_end=duration, record_every=10)
-        output.recordings[name] = drawn_bodies(solution.recording)
+        output.recordings[name] = drawn_bodies(solution.recording, color=COLORS)
         x, v = body_states(solution.recording)
         relative_energy = solution.energy / orbit.energy - 1.0
         spin = angular_momentum(masses, x, v)[:, 1]
@@ -89,5 +93,6 @@ register_demo(
         60.0,
         run,
         picture=True,
+        trail=PERIOD,  # the whole ellipse behind each body
     )
 )

@@ -23,6 +23,11 @@ DAY = 86_400.0  # [s]
 YEAR = 365.25 * DAY  # Julian year [s]
 DT = 3600.0  # one hour [s]
 AU = 149_597_870_700.0  # [m]
+#: How the bodies are drawn: the Sun yellow, the Earth blue, the Moon grey, and far larger than
+#: they are (the Earth's true radius is 4e-5 AU, a hundredth of a pixel here). The Moon's orbit
+#: (0.0026 AU) is smaller than the Earth's drawn sphere: the Moon shows as a grey cap on it.
+COLORS = np.array([[1.0, 0.78, 0.18], [0.16, 0.42, 0.86], [0.78, 0.78, 0.76]])
+DISPLAY_RADIUS = np.array([0.08, 0.025, 0.0125]) * AU
 
 
 def _period(t: np.ndarray, relative: np.ndarray) -> float:
@@ -50,7 +55,9 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     solution = solve(
         bodies.problem(name="Sun-Earth-Moon"), "velocity_verlet", dt=DT, t_end=duration
     )
-    output.recordings["velocity_verlet"] = drawn_bodies(solution.recording)
+    output.recordings["velocity_verlet"] = drawn_bodies(
+        solution.recording, color=COLORS, display_radius=DISPLAY_RADIUS
+    )
     x, v = body_states(solution.recording)
     earth = x[:, 1] - x[:, 0]
     moon = x[:, 2] - x[:, 1]
@@ -96,5 +103,6 @@ register_demo(
         run,
         picture=True,
         speed=7 * DAY,  # a week per second: the year in 52 s
+        trail=60 * DAY,  # two months of orbit behind each body
     )
 )

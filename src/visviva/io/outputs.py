@@ -13,7 +13,7 @@ from .._validation import did_you_mean
 from ..errors import ModelError
 from .recording import Recording
 
-__all__ = ["OUTPUT_FILES", "output_names", "write_output"]
+__all__ = ["OUTPUT_FILES", "output_names", "playback", "write_output"]
 
 #: Output format → its file (or, for OBJ, folder) name in a run's output directory; `visviva
 #: export` uses the same names next to the recording.
@@ -40,20 +40,37 @@ def output_names(formats: Iterable[str]) -> list[str]:
     return [OUTPUT_FILES[name] for name in chosen]
 
 
-def write_output(recording: Recording, path: Path, fps: float, speed: float = 1.0) -> None:
+def write_output(
+    recording: Recording, path: Path, fps: float, speed: float = 1.0, trail: float = 0.0
+) -> None:
     """Write one output (video, viewer or export, chosen by the suffix of ``path``) at ``fps``
-    frames per second, playing ``speed`` simulated seconds per second."""
+    frames per second, playing ``speed`` simulated seconds per second; the video and the viewer
+    draw ``trail`` simulated seconds of each point's path behind it."""
     suffix = path.suffix.lower()
     if suffix in (".mp4", ".gif"):
         from ..viz.video import render_video
 
-        render_video(recording, path, fps=fps, speed=speed)
+        render_video(recording, path, fps=fps, speed=speed, trail=trail)
     elif suffix == ".html":
         from ..viz.viewer import write_viewer
 
-        write_viewer(recording, path, fps=fps, speed=speed)
+        write_viewer(recording, path, fps=fps, speed=speed, trail=trail)
     else:
         from .export import export_recording
 
         to = {".usdc": "usd", ".glb": "glb", ".pc2": "pc2", "": "obj"}[suffix]
         export_recording(recording, path, to=to, fps=fps, speed=speed)
+
+
+def playback(recording: Recording, speed: float | None, trail: float | None) -> tuple[float, float]:
+    """The playback ``speed`` [simulated s per s] and ``trail`` [s] of an output made later from
+    ``recording``: the ones given, else those its run was made with (``visviva run`` and
+    ``visviva demo`` store them as the attributes ``playback_speed`` and ``playback_trail``),
+    else 1 and 0. So ``visviva export REC --to mp4`` plays a year of orbits at the week per
+    second ``visviva run -f mp4`` chose, not a year of video."""
+    attrs = recording.attrs
+    if speed is None:
+        speed = float(attrs.get("playback_speed", 1.0))
+    if trail is None:
+        trail = float(attrs.get("playback_trail", 0.0))
+    return speed, trail

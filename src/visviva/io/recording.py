@@ -24,6 +24,10 @@ convention, read back by :meth:`Recording.geometry`:
     static/edges            int64 (E, 2): pairs of point indices drawn as lines (optional)
     static/faces            int64 (F, 3): triangles of point indices, counter-clockwise seen
                             from outside (optional)
+    static/color            float64 (P, 3): sRGB colour of each point, in [0, 1] (optional)
+    static/display_radius   float64 (P,) [m]: the radius to draw instead of the physical one,
+                            where true sizes would be invisible (planets at the scale of their
+                            orbits); outputs then say "sizes not to scale" (optional)
 
 Files are written to a temporary name next to the target and renamed when complete, so a
 crash never leaves a truncated file under the real name.
@@ -75,12 +79,23 @@ class Geometry:
         radius: Radii [m], shape ``(P,)``, or ``None`` (draw as small dots).
         edges: Point-index pairs drawn as lines, shape ``(E, 2)``, or ``None``.
         faces: Point-index triangles, shape ``(F, 3)``, or ``None``.
+        color: sRGB colour of each point in [0, 1], shape ``(P, 3)``, or ``None`` (the
+            outputs' default colour).
+        display_radius: Radii [m] drawn instead of ``radius`` where true sizes would be
+            invisible, shape ``(P,)``, or ``None`` (drawn to scale).
     """
 
     points: np.ndarray
     radius: np.ndarray | None = None
     edges: np.ndarray | None = None
     faces: np.ndarray | None = None
+    color: np.ndarray | None = None
+    display_radius: np.ndarray | None = None
+
+    @property
+    def to_scale(self) -> bool:
+        """False if the points are drawn larger (or smaller) than they are."""
+        return self.display_radius is None
 
     @property
     def frames(self) -> int:
@@ -111,8 +126,11 @@ class Geometry:
         return radius
 
     def drawn_radius(self) -> np.ndarray:
-        """Radius [m] of each point as drawn, shape ``(P,)``: the recorded one, else
-        :meth:`default_radius` (the same in the video, the viewer and every export)."""
+        """Radius [m] of each point as drawn, shape ``(P,)``: the display radius, else the
+        recorded one, else :meth:`default_radius` (the same in the video, the viewer and every
+        export)."""
+        if self.display_radius is not None:
+            return np.asarray(self.display_radius, dtype=np.float64)
         if self.radius is not None:
             return np.asarray(self.radius, dtype=np.float64)
         return np.full(self.points.shape[1], self.default_radius())
@@ -196,9 +214,19 @@ class Recording:
         if points.ndim != 3 or points.shape[2] != 3:
             raise ModelError(f"`points` must have shape (frames, P, 3) (got {points.shape})")
         count = points.shape[1]
-        radius = self.static.get("radius")
-        if radius is not None and radius.shape != (count,):
-            raise ModelError(f"`radius` must have shape ({count},) (got {radius.shape})")
+        per_point = {}
+        for name, shape in (
+            ("radius", (count,)),
+            ("display_radius", (count,)),
+            ("color", (count, 3)),
+        ):
+            value = self.static.get(name)
+            if value is not None and value.shape != shape:
+                raise ModelError(f"`{name}` must have shape {shape} (got {value.shape})")
+            per_point[name] = value
+        color = per_point["color"]
+        if color is not None and not (np.all(color >= 0.0) and np.all(color <= 1.0)):
+            raise ModelError("`color` must hold sRGB values between 0 and 1")
         topology = {}
         for name, width in (("edges", 2), ("faces", 3)):
             value = self.static.get(name)
@@ -208,7 +236,7 @@ class Recording:
                 if value.size and (value.min() < 0 or value.max() >= count):
                     raise ModelError(f"`{name}` refers to points outside 0..{count - 1}")
             topology[name] = value
-        return Geometry(points, radius, **topology)
+        return Geometry(points, **per_point, **topology)
 
     def save(self, path: str | os.PathLike[str], *, run: str = "run") -> Path:
         """Write this recording as the only run of an HDF5 file (see the module docstring)."""

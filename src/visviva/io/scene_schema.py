@@ -116,6 +116,11 @@ class Output(_Strict):
         description="simulated seconds per second of playback (1: real time; 86400: a day "
         "per second)",
     )
+    trail: NonNegative = Field(
+        0.0,
+        description="simulated seconds of each point's path drawn behind it in the video and "
+        "the viewer [s] (0: none; at most 1000 points)",
+    )
 
 
 class Particles(_Strict):

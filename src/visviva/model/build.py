@@ -67,6 +67,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         output_formats=tuple(scene.output.formats),
         output_fps=scene.output.fps,
         output_speed=scene.output.speed,
+        output_trail=scene.output.trail,
         source=source,
     )
     problems = _check_start(model, scene)

@@ -105,6 +105,7 @@ class Model:
         output_formats: Extra outputs the scene asks ``visviva run`` for.
         output_fps: Frame rate of videos, viewer and exports [1/s].
         output_speed: Simulated seconds per second of their playback.
+        output_trail: Simulated seconds of each point's path drawn behind it [s].
         source: The scene file's text, stored in recordings for reproducibility.
     """
 
@@ -120,6 +121,7 @@ class Model:
     output_formats: tuple[str, ...] = ()
     output_fps: float = 30.0
     output_speed: float = 1.0
+    output_trail: float = 0.0
     source: str | None = field(default=None, repr=False)
 
     @property

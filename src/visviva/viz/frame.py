@@ -26,6 +26,7 @@ import numpy as np
 
 from ..io.recording import Geometry
 from . import ground, raster
+from .timescale import format_time
 
 if TYPE_CHECKING:
     from .video import Camera
@@ -54,6 +55,8 @@ SHADOW_DARKNESS = 0.45
 SHADOW_SIZE, SHADOW_FADE = 1.1, 2.0
 #: Light blocked by a triangle.
 FACE_SHADOW_WEIGHT = 1.0
+#: Most recorded positions along one trail (longer trails are drawn through a subsample).
+TRAIL_SAMPLES = 400
 #: Occlusion map: at most this many cells along its longer side, and at least a third of a
 #: typical shadow's radius per cell (coarser cells blur the shadows into soft blobs and keep
 #: the cost per sphere to a few cells).
@@ -77,6 +80,7 @@ def drawn_bounds(geometry: Geometry) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass
 class _Frame:
+    index: int  # recorded frame
     positions: np.ndarray  # (P, 3) world [m]
     view: np.ndarray  # (P, 3) camera coordinates: right, up, forward [m]
     screen: np.ndarray  # (P, 3) pixel x, y (NaN behind the camera) and view depth [m]
@@ -180,9 +184,9 @@ class _Layer(Protocol):
 
 
 class _Spheres:
-    def __init__(self, radius: np.ndarray) -> None:
+    def __init__(self, radius: np.ndarray, colour: np.ndarray) -> None:
         self.radius = radius
-        self.colour = np.tile(np.array(SPHERE_COLOUR, dtype=np.float32), (radius.size, 1))
+        self.colour = colour
         self.material = np.array(MATERIAL)
 
     def cast_shadows(self, stage: _Stage, frame: _Frame, shadows: _ShadowMap) -> None:
@@ -230,16 +234,50 @@ class _Edges:
 
     def draw(self, stage: _Stage, frame: _Frame, color: np.ndarray, depth: np.ndarray) -> None:
         start, end = frame.view[self.edges[:, 0]], frame.view[self.edges[:, 1]]
-        keep = (start[:, 2] > stage.near) | (end[:, 2] > stage.near)
-        start, end = start[keep], end[keep]
-        # Clip to the near plane: move the end behind it to where the segment crosses it.
-        for behind, other in ((start, end), (end, start)):
-            cut = behind[:, 2] <= stage.near
-            if cut.any():
-                s = (stage.near * 1.0001 - behind[cut, 2]) / (other[cut, 2] - behind[cut, 2])
-                behind[cut] += s[:, None] * (other[cut] - behind[cut])
-        segments = np.concatenate([stage.to_screen(start), stage.to_screen(end)], axis=1)
+        segments = _screen_segments(stage, start, end)
         raster.draw_lines(color, depth, segments, self.half_width, self.colour, LINE_DEPTH_BIAS)
+
+
+def _screen_segments(stage: _Stage, start: np.ndarray, end: np.ndarray) -> np.ndarray:
+    """Segments between view-space points ``(E, 3)``, clipped to the near plane, as screen
+    ``x0, y0, z0, x1, y1, z1`` rows for :func:`raster.draw_lines`."""
+    keep = (start[:, 2] > stage.near) | (end[:, 2] > stage.near)
+    start, end = start[keep].copy(), end[keep].copy()
+    # Clip to the near plane: move the end behind it to where the segment crosses it.
+    for behind, other in ((start, end), (end, start)):
+        cut = behind[:, 2] <= stage.near
+        if cut.any():
+            s = (stage.near * 1.0001 - behind[cut, 2]) / (other[cut, 2] - behind[cut, 2])
+            behind[cut] += s[:, None] * (other[cut] - behind[cut])
+    return np.concatenate([stage.to_screen(start), stage.to_screen(end)], axis=1)
+
+
+class _Trails:
+    """Each point's path over the last ``trail`` simulated seconds, a line of its colour."""
+
+    def __init__(
+        self, points: np.ndarray, times: np.ndarray, trail: float, colour: np.ndarray, height: int
+    ) -> None:
+        self.points, self.times, self.trail = points, times, trail
+        self.colour = 0.6 * colour + 0.4  # paler than the point
+        self.half_width = 0.5 * max(1.0, height / 540.0)
+
+    def cast_shadows(self, stage: _Stage, frame: _Frame, shadows: _ShadowMap) -> None:
+        return None
+
+    def draw(self, stage: _Stage, frame: _Frame, color: np.ndarray, depth: np.ndarray) -> None:
+        k = frame.index
+        first = int(np.searchsorted(self.times, self.times[k] - self.trail, side="left"))
+        picks = np.unique(np.linspace(first, k, min(TRAIL_SAMPLES, k - first + 1)).round())
+        if picks.size < 2:
+            return
+        path = self.points[picks.astype(np.int64)]  # (n, P, 3)
+        view = stage.to_view(path.reshape(-1, 3)).reshape(path.shape)
+        for p in range(path.shape[1]):
+            segments = _screen_segments(stage, view[:-1, p], view[1:, p])
+            raster.draw_lines(
+                color, depth, segments, self.half_width, self.colour[p], LINE_DEPTH_BIAS
+            )
 
 
 class _Faces:
@@ -293,10 +331,22 @@ class FramePainter:
         camera: The view, fixed for every frame.
     """
 
-    def __init__(self, geometry: Geometry, size: tuple[int, int], camera: Camera) -> None:
+    def __init__(
+        self,
+        geometry: Geometry,
+        size: tuple[int, int],
+        camera: Camera,
+        times: np.ndarray,
+        trail: float = 0.0,
+    ) -> None:
         self.geometry = geometry
         self.width, self.height = size
         radius = geometry.drawn_radius()
+        colour = (
+            np.tile(np.array(SPHERE_COLOUR, dtype=np.float32), (radius.size, 1))
+            if geometry.color is None
+            else np.asarray(geometry.color, dtype=np.float32)
+        )
         low, high = drawn_bounds(geometry)
         scene = max(float(np.linalg.norm(high - low)), 1e-9)
         stage = _Stage(camera, self.width, self.height, min(0.0, float(low[1])), scene)
@@ -306,7 +356,10 @@ class FramePainter:
             self.layers.append(_Faces(geometry.faces))
         if geometry.edges is not None and len(geometry.edges):
             self.layers.append(_Edges(geometry.edges, self.height))
-        self.layers.append(_Spheres(radius))
+        if trail > 0.0:
+            self.layers.append(_Trails(geometry.points, times, trail, colour, self.height))
+        self.layers.append(_Spheres(radius, colour))
+        self.span = float(times[-1] - times[0]) if times.size else 0.0
         shape = (self.height, self.width)
         self.background = np.empty((*shape, 3), dtype=np.float32)
         self.background_depth = np.empty(shape, dtype=np.float32)
@@ -330,11 +383,17 @@ class FramePainter:
         self.depth = np.empty_like(self.background_depth)
         self._label = _Label(self.height)
 
+    def label(self, time: float) -> str:
+        """The text in the corner: the time in the unit that reads best for the recording's
+        span, and a warning when points are drawn at display radii."""
+        text = format_time(time, self.span)
+        return text if self.geometry.to_scale else f"{text}, sizes not to scale"
+
     def paint(self, index: int, time: float) -> np.ndarray:
         """Image of recorded frame ``index`` labelled with ``time`` [s]: uint8, ``(H, W, 3)``."""
         positions = np.asarray(self.geometry.points[index], dtype=np.float64)
         view = self.stage.to_view(positions)
-        frame = _Frame(positions, view, self.stage.to_screen(view))
+        frame = _Frame(index, positions, view, self.stage.to_screen(view))
         shadows = self.shadows
         shadows.occlusion.fill(0.0)
         for layer in self.layers:
@@ -354,7 +413,7 @@ class FramePainter:
         )
         for layer in self.layers:
             layer.draw(self.stage, frame, self.color, self.depth)
-        self._label.stamp(self.color, f"t = {time:.3f} s")
+        self._label.stamp(self.color, self.label(time))
         image = np.empty((self.height, self.width, 3), dtype=np.uint8)
         raster.to_bytes(self.color, image)
         return image

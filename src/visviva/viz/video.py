@@ -17,11 +17,13 @@ core, while the next frame is drawn.
 
 What a frame shows (:class:`FramePainter` in :mod:`visviva.viz.frame`): a sky gradient, a
 checkered ground plane at ``y = min(0, lowest point)``, points as shaded spheres of their
-recorded radius (or the viewer's default radius), edges as lines, faces as Gouraud-shaded
-triangles, shadows from a light above, and the time of the recorded frame shown,
-``t = 1.234 s``. Output frame ``k`` shows the recorded frame nearest ``t0 + k/fps``
-(:func:`visviva.io.timeline.frames_at_rate`), so the video plays in real time whatever the
-recording's frame spacing.
+recorded radius and colour (or the viewer's default radius and blue; a recording's display
+radii, for bodies too small to see, are drawn instead and the label says "sizes not to
+scale"), optional trails behind the points, edges as lines, faces as Gouraud-shaded triangles,
+shadows from a light above, and the time of the recorded frame shown in the unit that reads
+best, ``t = 1.234 s`` or ``t = 182.6 days``. Output frame ``k`` shows the recorded frame
+nearest ``t0 + k/fps`` (:func:`visviva.io.timeline.frames_at_rate`), so the video plays in
+real time whatever the recording's frame spacing.
 
 References: ITU-T H.264 (libx264 via ffmpeg); GIF89a specification (delays in hundredths of a
 second, hence the frame delays below alternate so that their sum keeps time).
@@ -46,7 +48,10 @@ from ..io.recording import Recording
 from ..io.timeline import frames_at_rate
 from .frame import FramePainter, drawn_bounds
 
-__all__ = ["FORMATS", "MAX_GIF_FPS", "MAX_SIZE", "Camera", "render_video"]
+__all__ = ["FORMATS", "MAX_GIF_FPS", "MAX_SIZE", "MAX_TRAIL_POINTS", "Camera", "render_video"]
+
+#: Most points that get trails: each is a line of up to 400 segments per frame.
+MAX_TRAIL_POINTS = 1000
 
 #: Default vertical field of view [degrees] (the web viewer's).
 FIELD_OF_VIEW = 45.0
@@ -186,6 +191,7 @@ def render_video(
     camera: Camera | None = None,
     progress: bool | None = None,
     speed: float = 1.0,
+    trail: float = 0.0,
 ) -> Path:
     """Render a recording's geometry to an mp4 or GIF file.
 
@@ -201,7 +207,10 @@ def render_video(
         progress: Show a progress bar on stderr for long renders; ``None`` (default): only
             when stderr is a terminal.
         speed: Simulated seconds per second of video (1: real time; 86400: a day per
-            second). The time label shows simulated time.
+            second). The time label shows simulated time, in the unit that reads best for the
+            recording's span (s, min, h, days, years).
+        trail: Draw each point's path over the last ``trail`` simulated seconds [s] behind
+            it (0: none); for at most :data:`MAX_TRAIL_POINTS` points.
 
     Returns:
         The path written.
@@ -234,12 +243,18 @@ def render_video(
             f"down (got {fps:g}); use fps={MAX_GIF_FPS:g} or write an .mp4"
         )
     width, height = _checked_size(size, even=suffix == ".mp4")
+    trail = real_number("trail", trail, nonnegative=True, unit=" s")
     if camera is not None and not isinstance(camera, Camera):
         raise ModelError(f"`camera` must be a visviva Camera or None (got {describe(camera)})")
     if not isinstance(recording, Recording):
         raise ModelError(f"`recording` must be a visviva Recording (got {describe(recording)})")
     geometry = recording.geometry()
     _check_finite(geometry.points, geometry.radius)
+    if trail > 0.0 and geometry.points.shape[1] > MAX_TRAIL_POINTS:
+        raise ModelError(
+            f"`trail` draws a path behind each point, for at most {MAX_TRAIL_POINTS} points "
+            f"(this recording has {geometry.points.shape[1]}); leave it at 0"
+        )
     if not target.parent.is_dir():
         raise ModelError(
             f"`path` {os.fspath(path)!r}: directory {os.fspath(target.parent)!r} does not "
@@ -249,7 +264,7 @@ def render_video(
 
     if camera is None:
         camera = Camera.framing(drawn_bounds(geometry), aspect=width / height)
-    painter = FramePainter(geometry, (width, height), camera)
+    painter = FramePainter(geometry, (width, height), camera, recording.time, trail)
     times = recording.time[shown]
     from ..simulation.progress import Progress
 

@@ -30,6 +30,7 @@ from ...errors import ModelError
 from ...io.files import atomic_path
 from ...io.recording import Recording
 from ...io.timeline import frames_at_rate
+from ..video import MAX_TRAIL_POINTS
 from ._payload import encode_payload, to_json
 
 __all__ = ["FALLBACK_FPS", "MAX_DEFAULT_FPS", "MAX_POSITION_BYTES", "default_fps", "write_viewer"]
@@ -177,6 +178,7 @@ def write_viewer(
     fps: float | None = None,
     title: str | None = None,
     speed: float = 1.0,
+    trail: float = 0.0,
 ) -> Path:
     """Write ``recording``'s animation as one self-contained HTML file.
 
@@ -193,7 +195,9 @@ def write_viewer(
             ``t0 + k/fps``. Default: :func:`default_fps`.
         title: Page title; default ``"visviva — <scene or problem name>"``.
         speed: Simulated seconds per second of playback (1: real time); the page shows
-            simulated time.
+            simulated time, in the unit that reads best (s, min, h, days, years).
+        trail: Draw each point's path over the last ``trail`` simulated seconds [s] behind it
+            (0: none); for at most :data:`~visviva.viz.video.MAX_TRAIL_POINTS` points.
 
     Returns:
         The path written.
@@ -216,10 +220,22 @@ def write_viewer(
     target = _check_target(path)
     _check_finite(geometry.points)
     rate = _check_fps(recording, fps, speed)
+    trail = real_number("trail", trail, nonnegative=True, unit=" s")
+    if trail > 0.0 and geometry.points.shape[1] > MAX_TRAIL_POINTS:
+        raise ModelError(
+            f"`trail` draws a path behind each point, for at most {MAX_TRAIL_POINTS} points "
+            f"(this recording has {geometry.points.shape[1]}); leave it at 0"
+        )
     shown = frames_at_rate(recording.time, rate, speed=speed)
     page_title = _default_title(recording) if title is None else title
     payload = encode_payload(
-        geometry, recording.time, shown, fps=rate, title=page_title, attrs=recording.attrs
+        geometry,
+        recording.time,
+        shown,
+        fps=rate,
+        title=page_title,
+        attrs=recording.attrs,
+        trail_frames=round(trail * rate / speed),
     )
     parts = {
         "title": html.escape(page_title, quote=False),

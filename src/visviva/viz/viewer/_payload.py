@@ -30,8 +30,16 @@ from typing import Any
 import numpy as np
 
 from ...io.recording import Geometry
+from ..timescale import time_unit
 
-__all__ = ["PAYLOAD_FORMAT", "PAYLOAD_VERSION", "encode_payload", "to_json"]
+__all__ = [
+    "PAYLOAD_FORMAT",
+    "PAYLOAD_VERSION",
+    "decoded_positions",
+    "encode_payload",
+    "quantized_positions",
+    "to_json",
+]
 
 PAYLOAD_FORMAT = "visviva.viewer"
 PAYLOAD_VERSION = 2
@@ -48,20 +56,30 @@ def _base64(array: np.ndarray, dtype: str) -> str:
     return base64.b64encode(np.ascontiguousarray(array, dtype=dtype).tobytes()).decode("ascii")
 
 
-def _points_layer(geometry: Geometry, shown: np.ndarray) -> dict[str, Any]:
+def _points_layer(geometry: Geometry, shown: np.ndarray, trail_frames: int) -> dict[str, Any]:
     count = geometry.points.shape[1]
-    if geometry.radius is None:
-        radius = np.full(count, geometry.default_radius())
-    else:
-        radius = geometry.radius
     origin, step, data = quantized_positions(geometry.points[shown])
-    return {
+    layer = {
         "count": count,
         "origin": [float(v) for v in origin],
         "step": [float(v) for v in step],
         "positions": data,
-        "radius": _base64(radius, "<f4"),
+        "radius": _base64(geometry.drawn_radius(), "<f4"),
+        "trail": trail_frames,
     }
+    if geometry.color is not None:
+        layer["colors"] = _base64(np.round(255 * geometry.color), "u1")
+    return layer
+
+
+def decoded_positions(layer: dict[str, Any], frames: int) -> np.ndarray:
+    """The positions [m] a page shows, ``(frames, P, 3)``, decoded from its points layer as
+    ``viewer.js`` does (to check a page, or to read one back)."""
+    planes = np.frombuffer(zlib.decompress(base64.b64decode(layer["positions"])), np.uint8)
+    half = planes.size // 2
+    differences = planes[:half].astype(np.uint16) | (planes[half:].astype(np.uint16) << 8)
+    levels = np.cumsum(differences.reshape(frames, -1), axis=0, dtype=np.uint16)
+    return np.asarray(layer["origin"]) + levels.reshape(frames, -1, 3) * np.asarray(layer["step"])
 
 
 def quantized_positions(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, str]:
@@ -103,6 +121,8 @@ def _legend(attrs: dict[str, Any], geometry: Geometry, fps: float) -> list[list[
             parts.append(f"{value.shape[0]} {name}")
     rows.append(["shows", ", ".join(parts)])
     rows.append(["playback", f"{fps:.6g} frames/s"])
+    if not geometry.to_scale:
+        rows.append(["sizes", "not to scale (display radii)"])
     return rows
 
 
@@ -114,6 +134,7 @@ def encode_payload(
     fps: float,
     title: str,
     attrs: dict[str, Any],
+    trail_frames: int = 0,
 ) -> dict[str, Any]:
     """The viewer's data object for ``geometry`` resampled to the recorded frames ``shown``.
 
@@ -124,12 +145,14 @@ def encode_payload(
         fps: Output frames per second [1/s].
         title: Page title.
         attrs: Recording attributes (only the legend's few are read).
+        trail_frames: Output frames of each point's path drawn behind it (0: none).
 
     Returns:
         A JSON-serialisable dict (see the module docstring).
     """
     low, high = geometry.bounds()
-    layers: dict[str, Any] = {"points": _points_layer(geometry, shown)}
+    layers: dict[str, Any] = {"points": _points_layer(geometry, shown, trail_frames)}
+    unit, seconds, decimals = time_unit(float(time[-1] - time[0]))
     if geometry.edges is not None and geometry.edges.shape[0]:
         layers["edges"] = _index_layer(geometry.edges)
     if geometry.faces is not None and geometry.faces.shape[0]:
@@ -141,6 +164,8 @@ def encode_payload(
         "fps": fps,
         "frames": int(shown.size),
         "times": _base64(time[shown], "<f8"),
+        "time_unit": [unit, seconds, decimals],
+        "to_scale": geometry.to_scale,
         "bounds": [[float(v) for v in low], [float(v) for v in high]],
         "legend": _legend(attrs, geometry, fps),
         "layers": layers,

@@ -111,6 +111,49 @@
     current.needsUpdate = true;
   }
 
+  /* Colour i of 8-bit sRGB triples (setHex reads sRGB, as the recording's colours are). */
+  function srgb(rgb, i) {
+    return new THREE.Color().setHex((rgb[3 * i] << 16) | (rgb[3 * i + 1] << 8) | rgb[3 * i + 2]);
+  }
+
+  /* Each point's path over the last layer.trail frames: one polyline per point (segments
+   * j, j+1), paler than the point, refilled from the decoded positions when the frame changes. */
+  function trailLines(layer) {
+    const length = layer.trail + 1;
+    const rgb = layer.colors ? decode(layer.colors, Uint8Array) : null;
+    const chain = new Uint32Array(2 * (length - 1));
+    for (let j = 0; j < length - 1; j++) { chain[2 * j] = j; chain[2 * j + 1] = j + 1; }
+    const lines = [];
+    for (let i = 0; i < pointCount; i++) {
+      const geometry = new THREE.BufferGeometry();
+      const path = new THREE.BufferAttribute(new Float32Array(3 * length), 3);
+      path.setUsage(THREE.DynamicDrawUsage);
+      geometry.setAttribute("position", path);
+      geometry.setIndex(new THREE.BufferAttribute(chain, 1));
+      const colour = rgb ? srgb(rgb, i) : new THREE.Color(POINT_COLOUR);
+      colour.lerp(new THREE.Color(BACKGROUND), 0.4);
+      const line = new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: colour }));
+      line.frustumCulled = false;
+      scene.add(line);
+      lines.push(geometry);
+    }
+    return function (k) {
+      const first = Math.max(0, k - layer.trail);
+      for (let i = 0; i < pointCount; i++) {
+        const path = lines[i].getAttribute("position");
+        const out = path.array;
+        for (let f = first, j = 0; f <= k; f++, j += 3) {
+          const from = f * stride + 3 * i;
+          out[j] = allPositions[from];
+          out[j + 1] = allPositions[from + 1];
+          out[j + 2] = allPositions[from + 2];
+        }
+        path.needsUpdate = true;
+        lines[i].setDrawRange(0, 2 * (k - first));
+      }
+    };
+  }
+
   function indexedGeometry(layer, width) {
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute("position", current);
@@ -127,8 +170,14 @@
       let around = SPHERE_SEGMENTS.find((n) => pointCount * n * n <= SPHERE_TRIANGLE_BUDGET);
       if (around === undefined) around = SPHERE_SEGMENTS[SPHERE_SEGMENTS.length - 1];
       const sphere = new THREE.SphereGeometry(1, around, around / 2 + 1);
-      const material = new THREE.MeshLambertMaterial({ color: POINT_COLOUR });
+      const material = new THREE.MeshLambertMaterial({
+        color: layer.colors ? 0xffffff : POINT_COLOUR }); // white: instance colours multiply
       const mesh = new THREE.InstancedMesh(sphere, material, pointCount);
+      if (layer.colors) { // per-point sRGB colours of the recording
+        const rgb = decode(layer.colors, Uint8Array);
+        for (let i = 0; i < pointCount; i++) mesh.setColorAt(i, srgb(rgb, i));
+      }
+      const trail = layer.trail > 0 ? trailLines(layer) : null;
       mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
       mesh.frustumCulled = false; // the points move; a bounding sphere from frame 0 would lie
       const matrices = mesh.instanceMatrix.array; // column-major 4x4 per point
@@ -146,6 +195,7 @@
           matrices[16 * i + 14] = xyz[3 * i + 2];
         }
         mesh.instanceMatrix.needsUpdate = true;
+        if (trail) trail(frame);
       };
     },
     /* Lines between pairs of points (ropes, springs). */
@@ -277,7 +327,9 @@
     loadFrame(k);
     for (const update of updates) update();
     slider.value = String(k);
-    timeText.textContent = "t = " + times[k].toFixed(3) + " s  (" + (k + 1) + "/" + frames + ")";
+    const [unit, seconds, decimals] = data.time_unit;
+    timeText.textContent = "t = " + (times[k] / seconds).toFixed(decimals) + " " + unit +
+      (data.to_scale ? "" : ", sizes not to scale") + "  (" + (k + 1) + "/" + frames + ")";
     needsDraw = true;
   }
 
