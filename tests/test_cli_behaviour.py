@@ -194,3 +194,31 @@ def test_demos_record_how_they_play(tmp_path):
         assert run.attrs["playback_speed"] == kepler.speed
         assert run.attrs["playback_trail"] == kepler.trail > 0.0  # Kepler's ellipse is drawn
         assert run.static["color"].shape == (2, 3)
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (["export", "--to", "mp4", "--speed", "1e308"], "less than 0.001 s"),
+        (["export", "--to", "glb", "--speed", "1e-300"], "output frames"),
+        (["view", "--speed", "1e308"], "less than 0.001 s"),
+        (["view", "--speed", "1e-300"], ""),  # the viewer lowers its rate to fit, with a warning
+        (["export", "--to", "gif", "--fps", "0.001"], "at least 0.0015"),
+        (["export", "--to", "mp4", "--trail", "nan"], "`trail` must be finite"),
+    ],
+)
+def test_playback_numbers_at_the_edge_of_a_float(monkeypatch, capsys, tmp_path, args, fragment):
+    path = _recording(tmp_path, points=np.zeros((5, 2, 3)))
+    command, *options = args
+    monkeypatch.setattr(sys, "argv", ["visviva", command, str(path), *options])
+    try:
+        main()
+        status = 0
+    except SystemExit as exit_:
+        status = exit_.code
+    _, err = capsys.readouterr()
+    assert "Traceback" not in err
+    if fragment:
+        assert status == 2 and fragment in err, err
+    else:
+        assert status == 0, err

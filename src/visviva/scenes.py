@@ -349,7 +349,7 @@ def output_problems(model: Model, formats: Iterable[str], seconds: float) -> lis
     """What stops the scene's outputs (its own and ``formats``) from being written for a run
     of ``seconds`` [s]: no picture, too many frames, a GIF rate players cannot keep."""
     from .io.timeline import MAX_OUTPUT_FRAMES
-    from .viz.video import MAX_GIF_FPS
+    from .viz.video import MAX_GIF_FPS, MIN_GIF_FPS
 
     chosen = list(dict.fromkeys([*model.output_formats, *formats]))
     if not chosen:
@@ -386,10 +386,6 @@ def output_problems(model: Model, formats: Iterable[str], seconds: float) -> lis
             )
         )
     return problems
-
-
-#: The slowest GIF: its frame delay is a 16-bit count of hundredths of a second [frames/s].
-MIN_GIF_FPS = 100.0 / 65535
 
 
 def _frame(model: Model, parts: tuple[Any, ...]) -> dict[str, Any]:

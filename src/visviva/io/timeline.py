@@ -16,13 +16,26 @@ import numpy as np
 from .._validation import real_number
 from ..errors import ModelError
 
-__all__ = ["MAX_OUTPUT_FRAMES", "frames_at_rate"]
+__all__ = ["MAX_OUTPUT_FRAMES", "MIN_PLAYBACK", "check_playback", "frames_at_rate"]
 
 #: Output frames closer than this fraction of a frame to the end still count as inside the run.
 _END_SLACK = 1e-9
 #: Most frames one output may have: a million frames is ~9 hours at 30 frames/s; more is almost
 #: surely a rate in the wrong unit or a long run without a ``speed``.
 MAX_OUTPUT_FRAMES = 1_000_000
+#: Shortest playback of a whole recording [s]: faster is a ``speed`` in the wrong unit.
+MIN_PLAYBACK = 1e-3
+
+
+def check_playback(span: float, speed: float) -> None:
+    """Refuse a ``speed`` [simulated s per s] that plays ``span`` [s] of simulation in less than
+    :data:`MIN_PLAYBACK` (``speed = 1e308`` would show a run in 1e-307 s: not a video)."""
+    if span > 0.0 and span / speed < MIN_PLAYBACK:
+        raise ModelError(
+            f"`speed` = {speed:g} plays the {span:g} s recorded in {span / speed:.3g} s of "
+            f"playback, less than {MIN_PLAYBACK:g} s; use a speed of at most "
+            f"{span / MIN_PLAYBACK:.3g} (simulated seconds per second)"
+        )
 
 
 def frames_at_rate(time: np.ndarray, fps: float, *, speed: float = 1.0) -> np.ndarray:
@@ -50,11 +63,12 @@ def frames_at_rate(time: np.ndarray, fps: float, *, speed: float = 1.0) -> np.nd
     if time.ndim != 1 or time.size == 0:
         raise ModelError(f"a recording needs at least one frame to resample (got {time.shape})")
     t0, span = time[0], time[-1] - time[0]
+    check_playback(float(span), speed)
     rate = fps / speed  # output frames per simulated second
     if span * rate >= MAX_OUTPUT_FRAMES:
         raise ModelError(
             f"{span:g} s of simulation at {fps:g} frames/s and speed {speed:g} is "
-            f"{math.floor(span * rate) + 1} output frames, more than {MAX_OUTPUT_FRAMES}; "
+            f"{span * rate:.3g} output frames, more than {MAX_OUTPUT_FRAMES}; "
             f"play it faster (speed = simulated seconds per second, e.g. {span / 60:.3g} for "
             "a one-minute clip) or lower fps"
         )

@@ -48,7 +48,15 @@ from ..io.recording import Recording
 from ..io.timeline import frames_at_rate
 from .frame import FramePainter, drawn_bounds
 
-__all__ = ["FORMATS", "MAX_GIF_FPS", "MAX_SIZE", "MAX_TRAIL_POINTS", "Camera", "render_video"]
+__all__ = [
+    "FORMATS",
+    "MAX_GIF_FPS",
+    "MAX_SIZE",
+    "MAX_TRAIL_POINTS",
+    "MIN_GIF_FPS",
+    "Camera",
+    "render_video",
+]
 
 #: Most points that get trails: each is a line of up to 400 segments per frame.
 MAX_TRAIL_POINTS = 1000
@@ -65,6 +73,8 @@ FORMATS = (".mp4", ".gif")
 #: GIF delays are whole hundredths of a second and players treat delays below 2 as 10:
 #: faster GIFs play slower, not faster, so they are refused.
 MAX_GIF_FPS = 50.0
+#: The slowest GIF: its frame delay is a 16-bit count of hundredths of a second [frames/s].
+MIN_GIF_FPS = 100.0 / 65535
 #: Largest width or height [px] (8K UHD width): beyond it a frame buffer alone is > 400 MB.
 MAX_SIZE = 7680
 #: H.264 constant rate factor: 18 is visually lossless for these flat-shaded pictures.
@@ -241,6 +251,11 @@ def render_video(
         raise ModelError(
             f"`fps` of a GIF must be at most {MAX_GIF_FPS:g} frames/s: players slow faster GIFs "
             f"down (got {fps:g}); use fps={MAX_GIF_FPS:g} or write an .mp4"
+        )
+    if suffix == ".gif" and fps < MIN_GIF_FPS:
+        raise ModelError(
+            f"`fps` of a GIF must be at least {MIN_GIF_FPS:.4f} frames/s: a GIF frame lasts at "
+            f"most 655.35 s (got {fps:g}); use a higher fps or write an .mp4"
         )
     width, height = _checked_size(size, even=suffix == ".mp4")
     trail = real_number("trail", trail, nonnegative=True, unit=" s")

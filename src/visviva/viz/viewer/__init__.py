@@ -29,7 +29,7 @@ from ..._validation import describe, real_number
 from ...errors import ModelError
 from ...io.files import atomic_path
 from ...io.recording import Recording
-from ...io.timeline import frames_at_rate
+from ...io.timeline import check_playback, frames_at_rate
 from ..video import MAX_TRAIL_POINTS
 from ._payload import encode_payload, to_json
 
@@ -87,9 +87,10 @@ def default_fps(recording: Recording, speed: float = 1.0) -> float:
     """
     geometry = recording.geometry()
     speed = real_number("speed", speed, positive=True, unit=" simulated s per s")
-    time = recording.time / speed  # playback time [s]
-    if time.size == 0:
+    if recording.time.size == 0:
         raise ModelError("the recording has no frames: there is nothing to play")
+    check_playback(float(recording.time[-1] - recording.time[0]), speed)
+    time = recording.time / speed  # playback time [s]
     rate = _recorded_rate(time)
     if rate is None:
         fps = FALLBACK_FPS
