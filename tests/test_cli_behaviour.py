@@ -8,25 +8,13 @@ from __future__ import annotations
 
 import json
 import re
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import visviva as vv
-from visviva.cli.main import main
-
-
-def run_main(monkeypatch, capsys, *args) -> tuple[int, str, str]:
-    monkeypatch.setattr(sys, "argv", ["visviva", *map(str, args)])
-    try:
-        main()
-        status = 0
-    except SystemExit as exit_:
-        status = 0 if exit_.code is None else exit_.code
-    captured = capsys.readouterr()
-    return status, captured.out, captured.err
+from test_cli import run_main
 
 
 def refused(monkeypatch, capsys, *args) -> str:
@@ -210,13 +198,7 @@ def test_demos_record_how_they_play(tmp_path):
 def test_playback_numbers_at_the_edge_of_a_float(monkeypatch, capsys, tmp_path, args, fragment):
     path = _recording(tmp_path, points=np.zeros((5, 2, 3)))
     command, *options = args
-    monkeypatch.setattr(sys, "argv", ["visviva", command, str(path), *options])
-    try:
-        main()
-        status = 0
-    except SystemExit as exit_:
-        status = exit_.code
-    _, err = capsys.readouterr()
+    status, _, err = run_main(monkeypatch, capsys, command, path, *options)
     assert "Traceback" not in err
     if fragment:
         assert status == 2 and fragment in err, err
