@@ -67,7 +67,7 @@ def main() -> None:
         out = Path(tmp) / "run"
         print("(a) recording")
         timed("visviva run (simulate + stream to HDF5)", lambda: vv.run_scene(model, out))
-        recording = vv.Recording.load(out / "recording.h5")
+        recording = vv.io.load_recording(out / "recording.h5")
         assert recording.frames == frames, recording.frames
 
         def floor() -> None:

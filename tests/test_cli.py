@@ -275,7 +275,7 @@ def test_demo_recording_holds_one_run_per_method(oscillator_run):
     path = oscillator_run / "recording.h5"
     runs = vv.io.read_recordings(path)
     assert list(runs) == vv.integrators.names()
-    rk4 = vv.Recording.load(path, run="rk4")
+    rk4 = vv.io.load_recording(path, run="rk4")
     assert rk4.attrs["method"] == "rk4"
     assert rk4.time[0] == 0.0
     assert rk4.time[-1] == pytest.approx(1.0, abs=1e-12)

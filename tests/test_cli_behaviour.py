@@ -58,7 +58,7 @@ def test_help_shows_units_and_no_type_tags_on_flags(monkeypatch, capsys):
 def _recording(tmp_path: Path, **fields) -> Path:
     time = np.linspace(0.0, 1.0, 5)
     recording = vv.Recording(time, fields)
-    return recording.save(tmp_path / "recording.h5")
+    return vv.io.save_recording(recording, tmp_path / "recording.h5")
 
 
 def test_plot_refuses_a_recording_without_energy_or_momenta(monkeypatch, capsys, tmp_path):
@@ -77,7 +77,7 @@ def test_plot_draws_what_the_recording_has(monkeypatch, capsys, tmp_path):
         {"points": np.zeros((5, 2, 3)), "velocities": np.ones((5, 2, 3))},
         static={"mass": np.ones(2)},
     )
-    path = recording.save(tmp_path / "recording.h5")
+    path = vv.io.save_recording(recording, tmp_path / "recording.h5")
     status, out, err = run_main(monkeypatch, capsys, "plot", path)
     assert status == 0 and "momentum.png" in out, err
     assert (tmp_path / "momentum.png").read_bytes()[:4] == b"\x89PNG"
@@ -150,7 +150,7 @@ def test_export_plays_at_the_speed_its_run_was_made_with(monkeypatch, capsys, tm
     recording = vv.Recording(
         t, {"points": points}, attrs={"playback_speed": week, "playback_trail": 8 * week}
     )
-    path = recording.save(tmp_path / "recording.h5")
+    path = vv.io.save_recording(recording, tmp_path / "recording.h5")
     status, out, err = run_main(monkeypatch, capsys, "export", path, "--to", "gif", "--fps", "2")
     assert status == 0, err
     assert "animation.gif" in out

@@ -65,7 +65,7 @@ def test_kepler_scene_follows_the_ellipse(tmp_path):
     model = build_model(parse_scene(scene("kepler", "eccentricity = 0.3, mass2 = 0.5", 6.0)))
     out = tmp_path / "run"
     vv.run_scene(model, out)
-    recording = vv.Recording.load(out / "recording.h5")
+    recording = vv.io.load_recording(out / "recording.h5")
     orbit = vv.mechanics.kepler_orbit(1.0, 0.3, masses=(1.0, 0.5), G=1.0)
     points = recording["points"]  # the bodies' positions, recorded once
     # Verlet, h = 0.01 s over about one orbit: position error ~h² · (n² a) · t ≈ 1e-3 m.
@@ -94,7 +94,7 @@ def test_large_galaxy_scene_runs_on_the_tree_and_follows_direct_summation(tmp_pa
     model = build_model(parse_scene(scene("galaxy", parameters, duration=0.1)))
     out = tmp_path / "run"
     vv.run_scene(model, out)
-    recording = vv.Recording.load(out / "recording.h5")
+    recording = vv.io.load_recording(out / "recording.h5")
     tree = recording["points"][-1]
     assert tree.shape == (4202, 3) and recording.time[-1] == pytest.approx(0.1)
     bodies = vv.mechanics.colliding_disks(
@@ -126,7 +126,7 @@ def test_cluster_scene_stays_in_virial_equilibrium(tmp_path):
     model = build_model(parse_scene(scene("cluster", parameters, duration=3.0)))
     out = tmp_path / "run"
     vv.run_scene(model, out)
-    recording = vv.Recording.load(out / "recording.h5")
+    recording = vv.io.load_recording(out / "recording.h5")
     energy = recording["energy"]
     assert np.abs(energy - energy[0]).max() <= 1e-4 * abs(energy[0])
     x = recording["points"][-1]
@@ -142,7 +142,7 @@ def test_gravitating_bodies_are_recorded_once(tmp_path):
     and the points are the positions themselves, with no offset for the picture."""
     model = build_model(parse_scene(scene("cluster", "bodies = 64, softening = 0.05", 0.1)))
     vv.run_scene(model, tmp_path / "scene")
-    recording = vv.Recording.load(tmp_path / "scene" / "recording.h5")
+    recording = vv.io.load_recording(tmp_path / "scene" / "recording.h5")
     assert set(recording.fields) == {"points", "velocities", "energy"}
     assert recording.units["points"] == "m" and recording.units["velocities"] == "m/s"
     start = vv.mechanics.plummer_sphere(64, total_mass=1.0, scale_radius=1.0, G=1.0, seed=0)

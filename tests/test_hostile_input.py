@@ -196,7 +196,7 @@ def _malformed(tmp_path: Path, damage: str) -> Path:
 def test_a_malformed_recording_is_refused_by_every_reader(tmp_path, damage, monkeypatch, capsys):
     path = _malformed(tmp_path, damage)
     with pytest.raises(vv.ModelError, match="damaged visviva recording"):
-        vv.Recording.load(path)
+        vv.io.load_recording(path)
     for command in (["export", path, "--to", "usd"], ["view", path], ["plot", path]):
         monkeypatch.setattr(sys, "argv", ["visviva", *map(str, command)])
         with pytest.raises(SystemExit) as exit_:

@@ -9,7 +9,6 @@ import scipy.sparse as sp
 import visviva as vv
 from visviva.analysis.reference_problems import reference_problem, reference_problems
 from visviva.ode.system import _finite_difference
-from visviva.simulation.loop import initial_state
 
 IMPLICIT = [m for m in vv.integrators.names() if vv.integrators.get(m).implicit]
 
@@ -47,7 +46,7 @@ def test_reference_jacobians_match_finite_differences(name):
     """Every analytic Jacobian shipped with a reference problem equals differences of its f."""
     problem = reference_problem(name).problem
     system = problem.system()
-    state = initial_state(problem)
+    state = problem.initial_state()
     rng = np.random.default_rng(5)
     for _ in range(3):
         parts = tuple(p + rng.normal(scale=0.3, size=p.shape) for p in state.parts)

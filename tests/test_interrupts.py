@@ -76,7 +76,7 @@ def test_a_signal_stops_the_run_and_keeps_the_recording(tmp_path, sig, status):
     # Everything moved into place; no staging directory, no video of a run that never ended.
     assert sorted(p.name for p in out.iterdir()) == ["recording.h5", "summary.json"]
     summary = json.loads((out / "summary.json").read_text())
-    recording = vv.Recording.load(out / "recording.h5")
+    recording = vv.io.load_recording(out / "recording.h5")
     assert summary["interrupted"] == name and summary["complete"] is False
     assert 0.0 < summary["t_reached_s"] < 1000.0
     assert recording.attrs["complete"] is False and recording.attrs["interrupted"] == name
@@ -183,7 +183,7 @@ def test_a_killed_process_leaves_a_readable_recording_in_its_staging(tmp_path):
     process.kill()
     process.wait(timeout=30)
     (staged,) = out.glob(f"{STAGING_PREFIX}*/recording.h5")
-    recording = vv.Recording.load(staged)
+    recording = vv.io.load_recording(staged)
     assert recording.frames > 0 and recording.attrs["success"] is False
     # The next run into the same directory cleans it up.
     result = subprocess.run(

@@ -18,7 +18,6 @@ import pytest
 import visviva as vv
 from visviva.analysis.advisor import largest_stable_step, matrix_free_eigenvalues
 from visviva.integrators import get, newton
-from visviva.simulation.loop import initial_state
 
 EXAMPLES = Path(__file__).parents[1] / "examples" / "scenes"
 
@@ -43,7 +42,7 @@ def spring_chain(n: int, *, stiffness: float = 100.0, damping: float = 0.0):
 def test_advisor_matches_the_closed_form_on_a_long_spring_chain():
     n, k = 1000, 100.0  # 2000 first-order unknowns: above the dense limit
     problem = spring_chain(n, stiffness=k)
-    state = initial_state(problem)
+    state = problem.initial_state()
     omega_max = 2.0 * np.sqrt(k) * np.sin(n * np.pi / (2 * (n + 1)))
     # Velocity Verlet is stable for h ω ≤ 2 on the imaginary axis.
     dt = largest_stable_step(problem.system(), get("velocity_verlet"), state)
@@ -56,7 +55,7 @@ def test_advisor_matches_the_dense_spectrum_with_damping():
     """Velocity-dependent forces take the full first-order operator: the estimate agrees with
     the dense computation of the same finite-difference Jacobian to the Arnoldi tolerance."""
     problem = spring_chain(760, damping=0.5)  # 1520 unknowns: just above the dense limit
-    system, state = problem.system(), initial_state(problem)
+    system, state = problem.system(), problem.initial_state()
     lam = matrix_free_eigenvalues(system, state)
     dense = np.linalg.eigvals(vv.analysis.state_jacobian(system, state))
     assert np.abs(lam).max() == pytest.approx(np.abs(dense).max(), rel=1e-3)
@@ -77,14 +76,14 @@ def test_advisor_matches_the_dense_spectrum_of_a_first_order_problem():
 
     problem = vv.ode.FirstOrderProblem(f, np.sin(np.linspace(0, np.pi, n)))
     lam_max = 4.0 * np.sin(n * np.pi / (2 * (n + 1))) ** 2
-    dt = largest_stable_step(problem.system(), get("explicit_euler"), initial_state(problem))
+    dt = largest_stable_step(problem.system(), get("explicit_euler"), problem.initial_state())
     assert dt == pytest.approx(2.0 / lam_max, rel=1e-3)
 
 
 def test_advisor_on_a_star_cluster_agrees_with_the_dense_jacobian():
     bodies = vv.mechanics.plummer_sphere(300, total_mass=1.0, scale_radius=1.0, G=1.0, seed=2)
     problem = bodies.problem(softening=0.05)
-    system, state = problem.system(), initial_state(problem)
+    system, state = problem.system(), problem.initial_state()
     dense = vv.analysis.max_stable_dt(
         "velocity_verlet", jacobian=vv.analysis.state_jacobian(system, state)
     )
@@ -99,7 +98,7 @@ def test_free_particles_have_no_step_limit_and_cost_one_product():
     builder.add_particle_cloud(count=count)
     problem = builder.build().problem()
     system = problem.system()
-    limit = largest_stable_step(system, get("rk4"), initial_state(problem))
+    limit = largest_stable_step(system, get("rk4"), problem.initial_state())
     assert limit == np.inf
     assert system.counters.f_evaluations <= 3  # the force, then one product that vanished
 

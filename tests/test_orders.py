@@ -94,11 +94,10 @@ def test_adaptive_dopri5_meets_its_tolerance():
 def test_dopri5_dense_output_is_fourth_order_between_steps():
     """The continuous extension has local error O(h^5) at interior points (order 4 + 1)."""
     from visviva.integrators import DormandPrince5
-    from visviva.simulation.loop import initial_state
 
     reference = reference_problem("first-order")
     system = reference.problem.system()
-    start = initial_state(reference.problem)
+    start = reference.problem.initial_state()
     steps = np.array([0.4, 0.2, 0.1, 0.05])
     errors = []
     for h in steps:

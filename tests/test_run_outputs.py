@@ -61,7 +61,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, vv.Recording]:
         arguments += ["-f", format]
     result = CliRunner().invoke(app, arguments)
     assert result.exit_code == 0, result.output
-    return out, vv.Recording.load(out / "recording.h5")
+    return out, vv.io.load_recording(out / "recording.h5")
 
 
 def shown_positions(recording: vv.Recording) -> tuple[np.ndarray, list[int], float]:

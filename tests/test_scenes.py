@@ -109,7 +109,7 @@ def test_free_fall_matches_the_parabola(tmp_path):
     """Velocity Verlet is exact for constant acceleration: x(t) = x0 + v0 t + ½ g t²."""
     builder = build_in_python()
     vv.run_scene(builder.build(), tmp_path)
-    recording = vv.Recording.load(tmp_path / "recording.h5")
+    recording = vv.io.load_recording(tmp_path / "recording.h5")
     t = recording.time[:, None, None]
     x0 = np.array([[0.0, 2.0, 0.0], [1.0, 0.1, 0.3]])
     v0 = np.array([[0.0, 0.0, 0.0], [0.5, 4.0, 0.0]])
@@ -130,7 +130,7 @@ def test_pendulum_system_keeps_its_rod_length(tmp_path):
     builder.set_integration(method="rk4", dt=0.01, duration=2.0)
     builder.add_system("pendulum", length=0.7, theta0=0.4)
     vv.run_scene(builder.build(), tmp_path)
-    geometry = vv.Recording.load(tmp_path / "recording.h5").geometry()
+    geometry = vv.io.load_recording(tmp_path / "recording.h5").geometry()
     rod = np.linalg.norm(geometry.points[:, 1] - geometry.points[:, 0], axis=-1)
     np.testing.assert_allclose(rod, 0.7, rtol=1e-12)
     np.testing.assert_array_equal(geometry.edges, [[0, 1]])
@@ -172,7 +172,7 @@ os._exit(9)  # die without closing the file
 """
     result = subprocess.run([sys.executable, "-c", script], check=False)
     assert result.returncode == 9
-    recording = vv.Recording.load(path)
+    recording = vv.io.load_recording(path)
     assert recording.frames >= 20  # the frames up to the last flush (20) at least
     np.testing.assert_array_equal(recording["points"][:20, 0, 0], np.arange(20.0))
     assert recording.attrs["success"] is False
@@ -183,7 +183,7 @@ def test_writer_final_attributes_replace_the_provisional_ones(tmp_path):
     with RecordingWriter(tmp_path / "r.h5", attrs={"method": "rk4"}) as writer:
         writer.append(0.0, {"q": np.zeros(2)})
         writer.finish({"success": True, "message": "completed"}, {"energy": np.ones(1)})
-    recording = vv.Recording.load(tmp_path / "r.h5")
+    recording = vv.io.load_recording(tmp_path / "r.h5")
     assert recording.attrs["success"] is True and recording.attrs["method"] == "rk4"
     np.testing.assert_array_equal(recording["energy"], [1.0])
 

@@ -206,9 +206,8 @@ def test_state_jacobian_of_a_second_order_problem_with_mass():
         v0=[0.0, 0.0],
         jacobian=lambda t, q, v: (stiffness, damping),
     )
-    from visviva.simulation.loop import initial_state
 
-    jacobian = vv.analysis.state_jacobian(problem.system(), initial_state(problem))
+    jacobian = vv.analysis.state_jacobian(problem.system(), problem.initial_state())
     expected = np.block(
         [[np.zeros((2, 2)), np.eye(2)], [stiffness / masses[:, None], damping / masses[:, None]]]
     )

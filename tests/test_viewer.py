@@ -419,7 +419,7 @@ def test_galaxy_viewer_is_quantized_to_under_12_megabytes(tmp_path):
     run_demo("galaxy", tmp_path, formats=["html"])
     page = tmp_path / "viewer.html"
     assert page.stat().st_size <= 12_000_000
-    recording = vv.Recording.load(tmp_path / "recording.h5")
+    recording = vv.io.load_recording(tmp_path / "recording.h5")
     times, decoded = _embedded_positions(page)
     shown = np.searchsorted(recording.time, times)
     np.testing.assert_array_equal(recording.time[shown], times)

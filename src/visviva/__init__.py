@@ -31,10 +31,10 @@ from .errors import (
 
 if TYPE_CHECKING:
     from . import analysis, demos, forces, integrators, io, mechanics, model, ode, simulation, viz
-    from .io import Recording
     from .model import Model, SceneBuilder
     from .scenes import load_model, run_scene
     from .simulation import Solution, simulate, solve
+    from .simulation.recording import Recording
 
 __all__ = [
     "Model",
@@ -81,7 +81,7 @@ _FUNCTIONS = {
     "SceneBuilder": "model",
     "load_model": "scenes",
     "run_scene": "scenes",
-    "Recording": "io",
+    "Recording": "simulation",
     "Solution": "simulation",
     "simulate": "simulation",
     "solve": "simulation",

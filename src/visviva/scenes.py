@@ -87,13 +87,12 @@ def dry_run(model: Model, *, duration: float | None = None, formats: Iterable[st
 
     from .analysis.advisor import largest_stable_step
     from .integrators import get
-    from .simulation.loop import initial_state
 
     seconds = _duration(model, duration)
     settings = model.integration
     steps = math.ceil(seconds / settings.dt - 1e-9)
     problem = model.problem()
-    limit = largest_stable_step(problem.system(), get(settings.method), initial_state(problem))
+    limit = largest_stable_step(problem.system(), get(settings.method), problem.initial_state())
     return DryRun(
         particles=model.particle_count,
         system=None if model.system is None else model.system.system,
@@ -231,7 +230,9 @@ def _simulate_streaming(
                     substeps=settings.substeps,
                     record_every=settings.record_every,
                     progress=progress,
-                    on_frame=lambda t, parts: writer.append(t, _frame(model, parts)),
+                    on_frame=lambda state, energy: writer.append(
+                        state.t, _frame(model, state.parts)
+                    ),
                 )
         except (SimulationError, Interrupted) as error:
             failure = error
@@ -301,11 +302,10 @@ def _summary(
 
 def _energy_warning(model: Model, problem: Any, drift: float, tolerance: float) -> str:
     from .integrators import get
-    from .simulation.loop import initial_state
     from .simulation.watch import energy_drift_advice, suggested_dt
 
     method = get(model.integration.method)
-    suggestion = suggested_dt(problem.system(), method, initial_state(problem))
+    suggestion = suggested_dt(problem.system(), method, problem.initial_state())
     return (
         f"the energy of this conservative scene changed by {100 * drift:+.3g} % (tolerance "
         f"{100 * tolerance:.3g} %, [integration] energy_tolerance). "
@@ -396,7 +396,7 @@ def _frame(model: Model, parts: tuple[Any, ...]) -> dict[str, Any]:
 
 def _as_scene_recording(model: Model, recording: Any) -> Any:
     """The loop's recording (``q``, ``v`` or ``y``) as the scene's fields and static arrays."""
-    from .io.recording import Recording
+    from .simulation.recording import Recording
 
     names = ("y",) if "y" in recording else ("q", "v")
     fields = model.frame_fields(tuple(recording[name] for name in names))

@@ -22,8 +22,8 @@ from .invariants import energy_drift, max_energy_error
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from ..io.recording import Recording
     from ..ode.problems import Problem
+    from ..simulation.recording import Recording
 
 __all__ = ["Comparison", "MethodResult", "compare_methods"]
 

@@ -65,12 +65,10 @@ def _reference_parts(reference: Any, problem: Problem, t_end: float) -> tuple[np
     parts = (
         tuple(np.asarray(v) for v in value) if isinstance(value, tuple) else (np.asarray(value),)
     )
-    expected = 1 if problem.kind == "first_order" else 2
-    if len(parts) != expected:
-        raise ModelError(
-            f"`reference` must give {'y' if expected == 1 else '(q, v)'} at t_end for a "
-            f"{problem.kind.replace('_', '-')} problem"
-        )
+    names = problem.initial_state().names()
+    if len(parts) != len(names):
+        shown = names[0] if len(names) == 1 else f"({', '.join(names)})"
+        raise ModelError(f"`reference` must give {shown} at t_end for this problem")
     return parts
 
 
@@ -123,9 +121,9 @@ def convergence_order(
                 f"`dt` must hold at least three positive finite step sizes (got {describe(dt)})"
             )
     floor_scale = 1.0
+    names = problem.initial_state().names()
     if reference is None:
         accurate = solve(problem, "dopri5", t_end=t_end, rtol=1e-13, atol=1e-13).raise_for_status()
-        names = ("y",) if problem.kind == "first_order" else ("q", "v")
         exact = tuple(accurate.recording[name][-1] for name in names)
         floor_scale = 1000.0  # the reference itself is only good to ~1e-11
     else:
@@ -139,7 +137,6 @@ def convergence_order(
         if not solution.success:
             errors[i] = np.inf
             continue
-        names = ("y",) if problem.kind == "first_order" else ("q", "v")
         final = tuple(solution.recording[name][-1] for name in names)
         errors[i] = max(float(np.max(np.abs(f - e))) for f, e in zip(final, exact, strict=True))
     used = _asymptotic_range(steps, errors, ROUND_OFF_FLOOR * floor_scale * scale)

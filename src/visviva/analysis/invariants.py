@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import ModelError
 
 if TYPE_CHECKING:
-    from ..io.recording import Recording
+    from ..simulation.recording import Recording
 
 __all__ = [
     "angular_momentum",

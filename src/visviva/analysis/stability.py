@@ -261,7 +261,7 @@ def state_jacobian(system: System, state: State) -> Any:
     """
     import scipy.sparse as sp
 
-    if system.kind == "first_order":
+    if not system.second_order:
         return system.jacobian(state.t, state.parts[0])  # type: ignore[union-attr]
     q, v = state.parts
     stiffness, damping = system.force_jacobian(state.t, q, v)  # type: ignore[union-attr]

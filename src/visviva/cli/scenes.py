@@ -127,14 +127,14 @@ def plot_command(
 ) -> None:
     """Plot a recording: energy or momenta over time (default: energy if it was recorded)."""
     from ..errors import ModelError
-    from ..io.recording import Recording, read_recordings
+    from ..io.recording import load_recording, read_recordings
     from ..viz.plots import plot_energy, plot_momentum
 
     if energy and momentum:
         raise ModelError("choose one of --energy and --momentum per plot")
     runs = read_recordings(recording)
     if run is not None:
-        runs = {run: Recording.load(recording, run)}
+        runs = {run: load_recording(recording, run)}
     with_energy = {name: r for name, r in runs.items() if "energy" in r and r.frames > 0}
     kind = "momentum" if momentum or (not energy and not with_energy) else "energy"
     if kind == "energy" and not with_energy:
@@ -182,12 +182,12 @@ def view_command(
     """Write the single-file web viewer of a recording (open it in any browser)."""
     from ..io.files import check_new_file
     from ..io.outputs import playback
-    from ..io.recording import Recording
+    from ..io.recording import load_recording
     from ..viz.viewer import write_viewer
 
     target = output or recording.with_name("viewer.html")
     check_new_file(target, force=force)
-    source = Recording.load(recording, run)
+    source = load_recording(recording, run)
     speed, trail = playback(source, speed, trail)
     written = write_viewer(source, target, fps=fps, speed=speed, trail=trail)
     typer.echo(f"wrote {written}; open it in a browser (file://{written.resolve()})")
@@ -215,7 +215,7 @@ def export_command(
     from ..errors import ModelError
     from ..io.files import check_new_file
     from ..io.outputs import OUTPUT_FILES, playback
-    from ..io.recording import Recording
+    from ..io.recording import load_recording
 
     formats = ("usd", "glb", "obj", "pc2", "mp4", "gif")
     if to not in formats:
@@ -233,7 +233,7 @@ def export_command(
             raise ModelError(f"{target} already holds OBJ files; pass --force to replace them")
     else:
         check_new_file(target, force=force)
-    source = Recording.load(recording, run)
+    source = load_recording(recording, run)
     speed, trail = playback(source, speed, trail)
     if video:
         from ..viz.video import render_video

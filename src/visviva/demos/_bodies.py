@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..io.recording import Recording
+from ..simulation.recording import Recording
 
 
 def drawn_bodies(

@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 
 from ..io.job import JobOutput
-from ..io.recording import Recording
 from ..mechanics import classic
+from ..simulation.recording import Recording
 from ..simulation.solve import solve
 from . import Demo, register_demo
 

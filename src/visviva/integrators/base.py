@@ -87,7 +87,7 @@ class Integrator(ABC):
 
     def check(self, system: System) -> None:
         """Raise :class:`~visviva.errors.ModelError` if this method cannot integrate ``system``."""
-        if self.second_order_only and system.kind != "second_order":
+        if self.second_order_only and not system.second_order:
             raise ModelError(
                 f"method {self.name!r} needs the split (q, v) state of a second-order problem; "
                 "build it with vv.ode.SecondOrderProblem, or pick a method that integrates "

@@ -28,7 +28,6 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from ..ode.state import FirstOrderState, SecondOrderState
 from .base import Integrator
 from .newton import NewtonOptions, solve_stage
 from .runge_kutta import ButcherTableau, initial_rate
@@ -78,10 +77,8 @@ class ImplicitOneStage(Integrator):
         self, state: State, dt: float, stage: tuple[np.ndarray, ...], rate: np.ndarray
     ) -> State:
         """The new state from the solved stage; the end-point rate is cached for the next step."""
-        t1 = state.t + dt
-        if isinstance(state, FirstOrderState):
-            return FirstOrderState(t1, stage[0], rate)
-        return SecondOrderState(t1, stage[0], stage[1], rate)
+        derivative = (stage[1], rate) if len(stage) == 2 else (rate,)
+        return state.from_parts(state.t + dt, stage, derivative)
 
 
 class BackwardEuler(ImplicitOneStage):

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..ode.state import FirstOrderState, SecondOrderState
+from ..ode.state import Layout, State
 from ..ode.system import WorkCounters
 
 if TYPE_CHECKING:
@@ -32,7 +32,7 @@ __all__ = ["measured_stability_function"]
 class _TestEquation:
     """``y' = λ y`` for a batch of complex ``λ`` (one per system, ``n = 1``)."""
 
-    kind = "first_order"
+    second_order = False
     has_energy = False
 
     def __init__(self, lam: np.ndarray) -> None:
@@ -52,7 +52,7 @@ class _TestEquation:
 class _TestOscillator:
     """``q'' = α q + β v`` for a batch of complex ``(α, β)`` (one per system, ``n = 1``)."""
 
-    kind = "second_order"
+    second_order = True
     has_energy = False
     mass = None
     velocity_dependent = True
@@ -84,7 +84,7 @@ def measured_stability_function(method: Integrator, z: Any) -> np.ndarray:
     if not method.second_order_only:
         system = _TestEquation(flat)
         y0 = np.ones((flat.size, 1), dtype=np.complex128)
-        state = method.step(system, FirstOrderState(0.0, y0), 1.0)  # type: ignore[arg-type]
+        state = method.step(system, State(0.0, (y0,), Layout.first_order()), 1.0)  # type: ignore[arg-type]
         return np.asarray(state.parts[0][:, 0]).reshape(z.shape)
 
     alpha = -(np.abs(flat) ** 2)
@@ -95,7 +95,7 @@ def measured_stability_function(method: Integrator, z: Any) -> np.ndarray:
     # Two columns of the amplification matrix: start from (q, v) = (1, 0) and from (0, 1).
     q0 = np.concatenate([ones, zeros])[:, None]
     v0 = np.concatenate([zeros, ones])[:, None]
-    state2 = method.step(system2, SecondOrderState(0.0, q0, v0), 1.0)  # type: ignore[arg-type]
+    state2 = method.step(system2, State(0.0, (q0, v0), Layout.positions_and_velocities()), 1.0)  # type: ignore[arg-type]
     q1, v1 = (np.asarray(part)[:, 0] for part in state2.parts)
     m = flat.size
     amplification = np.empty((m, 2, 2), dtype=np.complex128)

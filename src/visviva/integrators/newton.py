@@ -98,7 +98,7 @@ def solve_stage(
         The stage ``(Y,)`` or ``(Q, V)``, and the derivative there, ``f(t*, Y)`` or
         ``q''(t*, Q, V)``, recovered from the stage equation without another evaluation.
     """
-    if system.kind == "first_order":
+    if not system.second_order:
         return _solve_first_order(system, t_star, base[0], theta_h, options)  # type: ignore[arg-type]
     return _solve_second_order(system, t_star, base, theta_h, options)  # type: ignore[arg-type]
 

@@ -147,12 +147,8 @@ class Stages:
 
 def initial_rate(system: System, state: State) -> tuple[np.ndarray, ...]:
     """``f`` at the state itself, reusing what the previous step left in the state."""
-    if system.kind == "first_order":
-        rate = state.rate  # type: ignore[union-attr]
-        return (rate,) if rate is not None else system.derivative(state.t, state.parts)
-    cached = state.acceleration  # type: ignore[union-attr]
-    if cached is not None:
-        return (state.v, cached)  # type: ignore[union-attr]
+    if state.derivative is not None:
+        return state.derivative
     return system.derivative(state.t, state.parts)
 
 

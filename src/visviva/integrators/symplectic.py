@@ -22,7 +22,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from ..ode.state import SecondOrderState
 from .base import CompiledStep, Integrator
 from .compiled import _memoized, acceleration_adapter, problem_key
 
@@ -34,7 +33,7 @@ if TYPE_CHECKING:
 __all__ = ["Leapfrog", "SymplecticEuler", "SymplecticEulerPositionFirst", "VelocityVerlet"]
 
 
-def start_acceleration(system: SecondOrderSystem, state: SecondOrderState):
+def start_acceleration(system: SecondOrderSystem, state: State):
     """``q''`` at the state, reusing what the previous step left in the state."""
     if state.acceleration is not None:
         return state.acceleration
@@ -55,7 +54,7 @@ class _Split(Integrator):
         if accel is None:
             return None
         n = problem.size
-        velocity_dependent = problem.velocity_dependent  # type: ignore[union-attr]
+        velocity_dependent = problem.velocity_dependent
         return _memoized((self.name, *key), lambda: make(accel, n, velocity_dependent))
 
 
@@ -74,10 +73,9 @@ class SymplecticEuler(_Split):
     summary = "symplectic Euler, kick then drift: v += h a(q); q += h v"
 
     def step(self, system: System, state: State, dt: float) -> State:
-        assert isinstance(state, SecondOrderState)
-        a = start_acceleration(system, state)  # type: ignore[arg-type]
+        a = start_acceleration(system, state)
         v1 = state.v + dt * a
-        return SecondOrderState(state.t + dt, state.q + dt * v1, v1)
+        return state.from_parts(state.t + dt, (state.q + dt * v1, v1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         return self._compile(problem, _symplectic_euler_kernel)
@@ -97,14 +95,13 @@ class SymplecticEulerPositionFirst(_Split):
     summary = "symplectic Euler, drift then kick: q += h v; v += h a(q')"
 
     def step(self, system: System, state: State, dt: float) -> State:
-        assert isinstance(state, SecondOrderState)
         t1 = state.t + dt
         q1 = state.q + dt * state.v
-        a = system.acceleration(t1, q1, state.v)  # type: ignore[union-attr]
+        a = system.acceleration(t1, q1, state.v)
         v1 = state.v + dt * a
         # For position-only forces `a` is exactly the acceleration of the new state.
-        cached = None if system.velocity_dependent else a  # type: ignore[union-attr]
-        return SecondOrderState(t1, q1, v1, cached)
+        cached = None if system.velocity_dependent else a
+        return state.from_parts(t1, (q1, v1), None if cached is None else (v1, cached))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         return self._compile(problem, _symplectic_euler_position_first_kernel)
@@ -126,16 +123,16 @@ class VelocityVerlet(_Split):
     summary = "velocity Verlet: half kick, drift, half kick"
 
     def step(self, system: System, state: State, dt: float) -> State:
-        assert isinstance(state, SecondOrderState)
-        a0 = start_acceleration(system, state)  # type: ignore[arg-type]
+        a0 = start_acceleration(system, state)
         t1 = state.t + dt
         v_half = state.v + (0.5 * dt) * a0
         q1 = state.q + dt * v_half
-        if system.velocity_dependent:  # type: ignore[union-attr]
-            a1 = system.acceleration(t1, q1, state.v + dt * a0)  # type: ignore[union-attr]
-            return SecondOrderState(t1, q1, v_half + (0.5 * dt) * a1)
-        a1 = system.acceleration(t1, q1, v_half)  # type: ignore[union-attr]
-        return SecondOrderState(t1, q1, v_half + (0.5 * dt) * a1, a1)
+        if system.velocity_dependent:
+            a1 = system.acceleration(t1, q1, state.v + dt * a0)
+            return state.from_parts(t1, (q1, v_half + (0.5 * dt) * a1))
+        a1 = system.acceleration(t1, q1, v_half)
+        v1 = v_half + (0.5 * dt) * a1
+        return state.from_parts(t1, (q1, v1), (v1, a1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         return self._compile(problem, _velocity_verlet_kernel)
@@ -156,16 +153,15 @@ class Leapfrog(_Split):
     summary = "leapfrog / position Verlet: half drift, kick, half drift"
 
     def step(self, system: System, state: State, dt: float) -> State:
-        assert isinstance(state, SecondOrderState)
         t_half = state.t + 0.5 * dt
         q_half = state.q + (0.5 * dt) * state.v
         v_mid = state.v
-        if system.velocity_dependent:  # type: ignore[union-attr]
-            a0 = start_acceleration(system, state)  # type: ignore[arg-type]
+        if system.velocity_dependent:
+            a0 = start_acceleration(system, state)
             v_mid = state.v + (0.5 * dt) * a0
-        a = system.acceleration(t_half, q_half, v_mid)  # type: ignore[union-attr]
+        a = system.acceleration(t_half, q_half, v_mid)
         v1 = state.v + dt * a
-        return SecondOrderState(state.t + dt, q_half + (0.5 * dt) * v1, v1)
+        return state.from_parts(state.t + dt, (q_half + (0.5 * dt) * v1, v1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         return self._compile(problem, _leapfrog_kernel)

@@ -16,7 +16,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from ..ode.state import SecondOrderState
 from .base import CompiledStep, Integrator
 from .compiled import _memoized, acceleration_adapter, problem_key
 from .symplectic import start_acceleration
@@ -41,10 +40,9 @@ class Taylor(Integrator):
     summary = "Taylor update with frozen acceleration: q + v h + a h^2/2, v + a h"
 
     def step(self, system: System, state: State, dt: float) -> State:
-        assert isinstance(state, SecondOrderState)
-        a = start_acceleration(system, state)  # type: ignore[arg-type]
+        a = start_acceleration(system, state)
         q1 = state.q + dt * state.v + (0.5 * dt * dt) * a
-        return SecondOrderState(state.t + dt, q1, state.v + dt * a)
+        return state.from_parts(state.t + dt, (q1, state.v + dt * a))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         key = problem_key(problem)

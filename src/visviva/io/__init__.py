@@ -1,19 +1,19 @@
-"""Files in and out: recordings (HDF5)."""
+"""Files in and out: recordings (HDF5), scene files, exports."""
 
 from .recording import (
     FORMAT,
     FORMAT_VERSION,
-    Geometry,
-    Recording,
+    load_recording,
     read_recordings,
+    save_recording,
     write_recordings,
 )
 
 __all__ = [
     "FORMAT",
     "FORMAT_VERSION",
-    "Geometry",
-    "Recording",
+    "load_recording",
     "read_recordings",
+    "save_recording",
     "write_recordings",
 ]

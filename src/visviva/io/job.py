@@ -29,7 +29,7 @@ from .recording import write_recordings
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from .recording import Recording
+    from ..simulation.recording import Recording
 
 __all__ = [
     "JobOutput",

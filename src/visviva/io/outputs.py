@@ -11,7 +11,7 @@ from pathlib import Path
 
 from .._validation import did_you_mean
 from ..errors import ModelError
-from .recording import Recording
+from ..simulation.recording import Recording
 
 __all__ = ["OUTPUT_FILES", "output_names", "playback", "write_output"]
 

@@ -1,11 +1,10 @@
-"""Recordings: the frames a run keeps, and their HDF5 file format.
+"""The recording file format (HDF5): runs written and read back.
 
-A :class:`Recording` holds the times of the recorded frames and one array per state field
-(``y``, or ``q`` and ``v``, plus derived series such as ``energy``), each with its unit, and the
-attributes that make the run reproducible (method, step, substeps, library version, work).
+A :class:`~visviva.simulation.recording.Recording` (the frames of a run in memory) is written
+with :func:`save_recording` (one run) or :func:`write_recordings` (several runs in one file, a
+comparison of methods) and read with :func:`load_recording` / :func:`read_recordings`.
 
-File layout (format ``visviva.recording``, version 1), one HDF5 group per run so that a
-comparison of several methods fits in one file::
+File layout (format ``visviva.recording``, version 1), one HDF5 group per run::
 
     /                       attrs: format, format_version, visviva_version, created_utc,
                                    runs (JSON list of run names, in order)
@@ -16,21 +15,9 @@ comparison of several methods fits in one file::
     /<run>/fields/<name>    (frames, ...) float64 or complex128, attr units, chunked per frame
     /<run>/static/<name>    arrays without a frame axis (topology, radii), attr units
 
-Drawable geometry (what the video, the web viewer and the exporters show) follows one
-convention, read back by :meth:`Recording.geometry`:
-
-    fields/points           float64 (frames, P, 3) [m]: point positions, world frame, Y up
-    static/radius           float64 (P,) [m]: point radii (optional)
-    static/edges            int64 (E, 2): pairs of point indices drawn as lines (optional)
-    static/faces            int64 (F, 3): triangles of point indices, counter-clockwise seen
-                            from outside (optional)
-    static/color            float64 (P, 3): sRGB colour of each point, in [0, 1] (optional)
-    static/display_radius   float64 (P,) [m]: the radius to draw instead of the physical one,
-                            where true sizes would be invisible (planets at the scale of their
-                            orbits); outputs then say "sizes not to scale" (optional)
-
-Files are written to a temporary name next to the target and renamed when complete, so a
-crash never leaves a truncated file under the real name.
+The drawable-geometry names (``points``, ``radius``, ``edges``, ...) are those of
+:mod:`visviva.simulation.recording`. Files are written to a temporary name next to the target
+and renamed when complete, so a crash never leaves a truncated file under the real name.
 """
 
 from __future__ import annotations
@@ -38,7 +25,6 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -48,218 +34,40 @@ import numpy as np
 from .._validation import describe
 from .._version import __version__
 from ..errors import ModelError
+from ..simulation.recording import Recording
 from .files import atomic_path
 
 __all__ = [
     "FORMAT",
     "FORMAT_VERSION",
-    "Geometry",
-    "Recording",
+    "load_recording",
     "read_recordings",
+    "save_recording",
     "write_recordings",
 ]
-
-#: Default point radius, as a fraction of the scene's bounding-box diagonal.
-_RADIUS_FRACTION = 0.01
-#: With edges or faces, at most this fraction of the median edge length.
-_RADIUS_FRACTION_OF_EDGE = 0.1
-#: Radius [m] for a scene with no extent (one point that never moves).
-_RADIUS_OF_A_POINT_SCENE = 0.05
 
 FORMAT = "visviva.recording"
 FORMAT_VERSION = 1
 
 
-@dataclass(frozen=True)
-class Geometry:
-    """What a recording shows: moving points, optionally with radii, edges and triangles.
-
-    Attributes:
-        points: Positions [m], shape ``(frames, P, 3)``, world frame, Y up.
-        radius: Radii [m], shape ``(P,)``, or ``None`` (draw as small dots).
-        edges: Point-index pairs drawn as lines, shape ``(E, 2)``, or ``None``.
-        faces: Point-index triangles, shape ``(F, 3)``, or ``None``.
-        color: sRGB colour of each point in [0, 1], shape ``(P, 3)``, or ``None`` (the
-            outputs' default colour).
-        display_radius: Radii [m] drawn instead of ``radius`` where true sizes would be
-            invisible, shape ``(P,)``, or ``None`` (drawn to scale).
-    """
-
-    points: np.ndarray
-    radius: np.ndarray | None = None
-    edges: np.ndarray | None = None
-    faces: np.ndarray | None = None
-    color: np.ndarray | None = None
-    display_radius: np.ndarray | None = None
-
-    @property
-    def to_scale(self) -> bool:
-        """False if the points are drawn larger (or smaller) than they are."""
-        return self.display_radius is None
-
-    @property
-    def frames(self) -> int:
-        """Number of frames."""
-        return self.points.shape[0]
-
-    def default_radius(self) -> float:
-        """Radius [m] drawn for points when the recording gives none.
-
-        1 % of the diagonal of :meth:`bounds`; with edges or faces, where points are only the
-        vertices of the shape, at most a tenth of the median edge length in the first frame (so
-        neighbouring dots never touch); 0.05 m for a scene with no extent.
-        """
-        low, high = self.bounds()
-        diagonal = float(np.linalg.norm(high - low))
-        if not diagonal > 0.0:
-            return _RADIUS_OF_A_POINT_SCENE
-        radius = _RADIUS_FRACTION * diagonal
-        pairs = [] if self.edges is None else [self.edges]
-        if self.faces is not None:
-            pairs.extend(self.faces[:, [i, (i + 1) % 3]] for i in range(3))
-        if pairs and self.frames:
-            ends = self.points[0][np.concatenate(pairs)]
-            lengths = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
-            lengths = lengths[lengths > 0.0]
-            if lengths.size:
-                radius = min(radius, _RADIUS_FRACTION_OF_EDGE * float(np.median(lengths)))
-        return radius
-
-    def drawn_radius(self) -> np.ndarray:
-        """Radius [m] of each point as drawn, shape ``(P,)``: the display radius, else the
-        recorded one, else :meth:`default_radius` (the same in the video, the viewer and every
-        export)."""
-        if self.display_radius is not None:
-            return np.asarray(self.display_radius, dtype=np.float64)
-        if self.radius is not None:
-            return np.asarray(self.radius, dtype=np.float64)
-        return np.full(self.points.shape[1], self.default_radius())
-
-    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Lower and upper corners [m] of the box holding every point of every frame (radii
-        included)."""
-        pad = 0.0 if self.radius is None or self.radius.size == 0 else float(self.radius.max())
-        flat = self.points.reshape(-1, 3)
-        if flat.size == 0:
-            return np.zeros(3), np.zeros(3)
-        return flat.min(axis=0) - pad, flat.max(axis=0) + pad
+def save_recording(recording: Recording, path: str | os.PathLike[str], *, run: str = "run") -> Path:
+    """Write ``recording`` as the only run of an HDF5 file (see the module docstring)."""
+    return write_recordings(path, {run: recording})
 
 
-class Recording:
-    """Frames of one run: times, named state arrays with units, and attributes.
-
-    Args:
-        time: Frame times [s], shape ``(frames,)``.
-        fields: Arrays with a leading frame axis, e.g. ``{"q": (frames, n), "v": ...}``.
-        units: Unit of each field or static array (``""`` for dimensionless or unknown).
-        attrs: Run attributes: strings, numbers, booleans, or JSON-serialisable values.
-        static: Arrays that do not change over the run (radii, edges, faces).
-
-    Example:
-        >>> import numpy as np
-        >>> rec = Recording(np.array([0.0, 0.5]), {"q": np.zeros((2, 3))}, units={"q": "m"})
-        >>> rec.frames, rec["q"].shape, rec.units["q"]
-        (2, (2, 3), 'm')
-    """
-
-    def __init__(
-        self,
-        time: np.ndarray,
-        fields: Mapping[str, np.ndarray],
-        *,
-        units: Mapping[str, str] | None = None,
-        attrs: Mapping[str, Any] | None = None,
-        static: Mapping[str, np.ndarray] | None = None,
-    ) -> None:
-        self.time = np.asarray(time, dtype=np.float64)
-        self.fields = {name: np.asarray(value) for name, value in fields.items()}
-        for name, value in self.fields.items():
-            if value.shape[:1] != self.time.shape:
-                raise ModelError(
-                    f"field {name!r} has {value.shape[:1]} frames but time has {self.time.shape}"
-                )
-        self.static = {name: np.asarray(value) for name, value in (static or {}).items()}
-        self.units = {name: "" for name in (*self.fields, *self.static)} | dict(units or {})
-        self.attrs: dict[str, Any] = dict(attrs or {})
-
-    @property
-    def frames(self) -> int:
-        """Number of recorded frames."""
-        return self.time.shape[0]
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        try:
-            return self.fields[name]
-        except KeyError:
-            raise KeyError(
-                f"recording has no field {name!r}; fields: {', '.join(self.fields)}"
-            ) from None
-
-    def __contains__(self, name: object) -> bool:
-        return name in self.fields
-
-    def geometry(self) -> Geometry:
-        """The drawable geometry (see the module docstring), checked for consistent shapes.
-
-        Raises:
-            ModelError: If the recording has no ``points`` field or its static arrays do not
-                fit the points.
-        """
-        if "points" not in self.fields:
+def load_recording(path: str | os.PathLike[str], run: str | None = None) -> Recording:
+    """Read one run from a recording file (the only one, or the one named ``run``)."""
+    runs = read_recordings(path)
+    if run is None:
+        if len(runs) != 1:
             raise ModelError(
-                "this recording has no geometry to show (no `points` field): it comes from a "
-                "run of an abstract system; record a scene with particles or bodies instead"
+                f"{os.fspath(path)} holds {len(runs)} runs ({', '.join(runs)}); choose one "
+                "with --run NAME (in Python: run=NAME)"
             )
-        points = self.fields["points"]
-        if points.ndim != 3 or points.shape[2] != 3:
-            raise ModelError(f"`points` must have shape (frames, P, 3) (got {points.shape})")
-        count = points.shape[1]
-        per_point = {}
-        for name, shape in (
-            ("radius", (count,)),
-            ("display_radius", (count,)),
-            ("color", (count, 3)),
-        ):
-            value = self.static.get(name)
-            if value is not None and value.shape != shape:
-                raise ModelError(f"`{name}` must have shape {shape} (got {value.shape})")
-            per_point[name] = value
-        color = per_point["color"]
-        if color is not None and not (np.all(color >= 0.0) and np.all(color <= 1.0)):
-            raise ModelError("`color` must hold sRGB values between 0 and 1")
-        topology = {}
-        for name, width in (("edges", 2), ("faces", 3)):
-            value = self.static.get(name)
-            if value is not None:
-                if value.ndim != 2 or value.shape[1] != width:
-                    raise ModelError(f"`{name}` must have shape (n, {width}) (got {value.shape})")
-                if value.size and (value.min() < 0 or value.max() >= count):
-                    raise ModelError(f"`{name}` refers to points outside 0..{count - 1}")
-            topology[name] = value
-        return Geometry(points, **per_point, **topology)
-
-    def save(self, path: str | os.PathLike[str], *, run: str = "run") -> Path:
-        """Write this recording as the only run of an HDF5 file (see the module docstring)."""
-        return write_recordings(path, {run: self})
-
-    @classmethod
-    def load(cls, path: str | os.PathLike[str], run: str | None = None) -> Recording:
-        """Read one run from a recording file (the only one, or the one named ``run``)."""
-        runs = read_recordings(path)
-        if run is None:
-            if len(runs) != 1:
-                raise ModelError(
-                    f"{os.fspath(path)} holds {len(runs)} runs ({', '.join(runs)}); choose one "
-                    "with --run NAME (in Python: run=NAME)"
-                )
-            return next(iter(runs.values()))
-        if run not in runs:
-            raise ModelError(f"{os.fspath(path)} has no run {run!r}; runs: {', '.join(runs)}")
-        return runs[run]
-
-    def __repr__(self) -> str:
-        shapes = ", ".join(f"{k}{tuple(v.shape)}" for k, v in self.fields.items())
-        return f"Recording({self.frames} frames: {shapes})"
+        return next(iter(runs.values()))
+    if run not in runs:
+        raise ModelError(f"{os.fspath(path)} has no run {run!r}; runs: {', '.join(runs)}")
+    return runs[run]
 
 
 def write_recordings(path: str | os.PathLike[str], runs: Mapping[str, Recording]) -> Path:

@@ -48,7 +48,7 @@ class RecordingWriter:
         ...     for k in range(3):
         ...         writer.append(0.1 * k, {"points": np.full((2, 3), float(k))})
         ...     writer.finish({"success": True})
-        >>> vv.Recording.load(path)["points"].shape
+        >>> vv.io.load_recording(path)["points"].shape
         (3, 2, 3)
     """
 

@@ -26,8 +26,8 @@ from sympy.core.function import AppliedUndef
 
 from .._validation import describe, did_you_mean, real_number, state_array
 from ..errors import ModelError
-from ..io.recording import Recording
 from ..ode.problems import FirstOrderProblem, SecondOrderProblem
+from ..simulation.recording import Recording
 from .codegen import FLAVOURS
 from .equations_code import Derived, EquationsCode
 

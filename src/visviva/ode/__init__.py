@@ -6,17 +6,17 @@ the NumPy and Numba function conventions.
 
 from .mass import Mass
 from .problems import FirstOrderProblem, Problem, SecondOrderProblem
-from .state import FirstOrderState, SecondOrderState, State
+from .state import Layout, PartView, State
 from .system import FirstOrderSystem, SecondOrderSystem, System, WorkCounters
 
 __all__ = [
     "FirstOrderProblem",
-    "FirstOrderState",
     "FirstOrderSystem",
+    "Layout",
     "Mass",
+    "PartView",
     "Problem",
     "SecondOrderProblem",
-    "SecondOrderState",
     "SecondOrderSystem",
     "State",
     "System",

@@ -23,6 +23,7 @@ from .._validation import describe, real_number, state_array
 from ..errors import ModelError
 from .functions import UserFunction
 from .mass import Mass
+from .state import Layout, State
 from .system import FirstOrderSystem, SecondOrderSystem
 
 __all__ = ["FirstOrderProblem", "Problem", "SecondOrderProblem"]
@@ -84,7 +85,11 @@ class FirstOrderProblem:
 
     def system(self) -> FirstOrderSystem:
         """A fresh run-time system (with zeroed work counters) for this problem."""
-        return FirstOrderSystem(self)
+        return FirstOrderSystem.of(self)
+
+    def initial_state(self) -> State:
+        """The state the problem starts from (a copy of ``y0`` at ``t0``)."""
+        return State(self.t0, (self.y0.copy(),), Layout.first_order())
 
     def __repr__(self) -> str:
         return f"FirstOrderProblem({self.name!r}, y0 shape {self.y0.shape}, t0={self.t0!r})"
@@ -229,7 +234,11 @@ class SecondOrderProblem:
 
     def system(self) -> SecondOrderSystem:
         """A fresh run-time system (with zeroed work counters) for this problem."""
-        return SecondOrderSystem(self)
+        return SecondOrderSystem.of(self)
+
+    def initial_state(self) -> State:
+        """The state the problem starts from (copies of ``q0`` and ``v0`` at ``t0``)."""
+        return State(self.t0, (self.q0.copy(), self.v0.copy()), Layout.positions_and_velocities())
 
     def __repr__(self) -> str:
         return f"SecondOrderProblem({self.name!r}, q0 shape {self.q0.shape}, t0={self.t0!r})"

@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import ModelError
 from .batching import batched
 from .functions import UserFunction
+from .state import Layout
 
 if TYPE_CHECKING:
     from .mass import Mass
@@ -83,23 +84,47 @@ def evaluator(function: UserFunction, batch: bool, result: str = "array") -> Cal
 class FirstOrderSystem:
     """Evaluates ``y' = f(t, y)`` for integrators.
 
+    Args:
+        f: ``f(t, y) -> dy/dt`` on a whole (batched) state.
+        jacobian: ``jacobian(t, y) -> ∂f/∂y`` (dense, batched dense or sparse), or ``None`` for
+            finite differences of ``f``.
+        energy: ``energy(t, y)``, one value per system, or ``None``.
+        layout: The names of the state's parts (default: one part ``y``).
+        counters: Work counters to add to (default: fresh ones).
+
     Attributes:
-        problem: The problem being integrated.
         counters: Work done so far in this run.
+        layout: The names of the state's parts.
     """
 
-    kind = "first_order"
+    second_order = False
 
-    def __init__(self, problem: FirstOrderProblem, counters: WorkCounters | None = None) -> None:
-        self.problem = problem
+    def __init__(
+        self,
+        f: Callable[..., Any],
+        *,
+        jacobian: Callable[..., Any] | None = None,
+        energy: Callable[..., Any] | None = None,
+        layout: Layout | None = None,
+        counters: WorkCounters | None = None,
+    ) -> None:
+        self._f = f
+        self._jacobian = jacobian
+        self._energy = energy
+        self.layout = layout or Layout.first_order()
         self.counters = counters if counters is not None else WorkCounters()
+
+    @classmethod
+    def of(
+        cls, problem: FirstOrderProblem, counters: WorkCounters | None = None
+    ) -> FirstOrderSystem:
+        """The system of a first-order problem."""
         batch = problem.y0.ndim == 2
-        self._f = evaluator(problem.f, batch)
-        self._jacobian = (
-            None if problem.jacobian is None else evaluator(problem.jacobian, batch, "matrix")
-        )
-        self._energy = (
-            None if problem.energy is None else evaluator(problem.energy, batch, "scalar")
+        return cls(
+            evaluator(problem.f, batch),
+            jacobian=_optional_evaluator(problem.jacobian, batch, "matrix"),
+            energy=_optional_evaluator(problem.energy, batch, "scalar"),
+            counters=counters,
         )
 
     @property
@@ -142,7 +167,7 @@ class FirstOrderSystem:
         return _finite_difference(lambda x: self.rhs(t, x), y, rate)
 
     def energy(self, t: float, parts: tuple[np.ndarray, ...]) -> np.ndarray | None:
-        """The problem's monitored energy per system, or ``None`` if it defines none."""
+        """The monitored energy per system, or ``None`` if the problem defines none."""
         if self._energy is None:
             return None
         return np.asarray(self._energy(t, parts[0]), dtype=np.float64)
@@ -152,33 +177,80 @@ class SecondOrderSystem:
     """Evaluates ``M q'' = F(t, q, v)`` for integrators.
 
     For a problem given by its acceleration, ``mass`` is ``None`` and ``force`` *is* the
-    acceleration (unit mass), so implicit methods see one form.
+    acceleration (unit mass), so implicit methods see one form. Scenes build one from the sum
+    of their forces (:mod:`visviva.model`), with a layout naming the parts of ``q`` and ``v``.
+
+    Args:
+        force: ``force(t, q, v) -> F`` on a whole (batched) state, shape of ``q``.
+        mass: The constant mass matrix, or ``None`` for unit mass.
+        velocity_dependent: True if the force depends on ``v``; methods that would lose an
+            order of accuracy with velocity-dependent forces use this to evaluate where they
+            must.
+        jacobian: ``jacobian(t, q, v) -> (∂F/∂q, ∂F/∂v or None)`` (dense, batched dense or
+            sparse), or ``None`` for finite differences of the force.
+        energy: ``energy(t, q, v)``, one value per system, or ``None``.
+        layout: The names of the state's parts (default: ``q`` and ``v``).
+        counters: Work counters to add to (default: fresh ones).
 
     Attributes:
-        problem: The problem being integrated.
         counters: Work done so far in this run.
-        mass: The mass matrix, or ``None`` for an acceleration-form problem.
-        velocity_dependent: True if the force takes ``v``; methods that would lose an order of
-            accuracy with velocity-dependent forces use this to evaluate where they must.
+        mass: The mass matrix, or ``None``.
+        velocity_dependent: True if the force takes ``v``.
+        layout: The names of the state's parts.
     """
 
-    kind = "second_order"
+    second_order = True
 
-    def __init__(self, problem: SecondOrderProblem, counters: WorkCounters | None = None) -> None:
-        self.problem = problem
+    def __init__(
+        self,
+        force: Callable[..., Any],
+        *,
+        mass: Mass | None = None,
+        velocity_dependent: bool = True,
+        jacobian: Callable[..., Any] | None = None,
+        energy: Callable[..., Any] | None = None,
+        layout: Layout | None = None,
+        counters: WorkCounters | None = None,
+    ) -> None:
+        self._force = force
+        self.mass = mass
+        self.velocity_dependent = velocity_dependent
+        self._jacobian = jacobian
+        self._energy = energy
+        self.layout = layout or Layout.positions_and_velocities()
         self.counters = counters if counters is not None else WorkCounters()
-        self.mass: Mass | None = problem.mass
-        self.velocity_dependent = problem.force.state_arguments == 2
+
+    @classmethod
+    def of(
+        cls, problem: SecondOrderProblem, counters: WorkCounters | None = None
+    ) -> SecondOrderSystem:
+        """The system of a second-order problem."""
         batch = problem.q0.ndim == 2
-        self._force = evaluator(problem.force, batch)
-        jacobian = problem.jacobian
-        if jacobian is None:
-            self._jacobian = None
-        else:
-            kind = "pair" if jacobian.state_arguments == 2 else "matrix"
-            self._jacobian = evaluator(jacobian, batch, kind)
-        self._energy = (
-            None if problem.energy is None else evaluator(problem.energy, batch, "scalar")
+        moving = problem.force.state_arguments == 2
+        force = evaluator(problem.force, batch)
+        jacobian = None
+        if problem.jacobian is not None:
+            kind = "pair" if problem.jacobian.state_arguments == 2 else "matrix"
+            jacobian = evaluator(problem.jacobian, batch, kind)
+        energy = _optional_evaluator(problem.energy, batch, "scalar")
+        if moving:
+            return cls(
+                force,
+                mass=problem.mass,
+                velocity_dependent=True,
+                jacobian=jacobian,
+                energy=energy,
+                counters=counters,
+            )
+        still = jacobian
+        return cls(
+            lambda t, q, v: force(t, q),
+            mass=problem.mass,
+            velocity_dependent=False,
+            # The problem checked that the Jacobian takes the same arguments as the force.
+            jacobian=None if still is None else (lambda t, q, v: (still(t, q), None)),
+            energy=energy,
+            counters=counters,
         )
 
     @property
@@ -213,9 +285,8 @@ class SecondOrderSystem:
     def force(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``F(t, q, v)`` (the acceleration for a problem without mass), shape of ``q``."""
         self.counters.f_evaluations += 1
-        if self.velocity_dependent:
-            return _same_shape("the force F(t, q, v)", np.asarray(self._force(t, q, v)), q, t)
-        return _same_shape("the force F(t, q)", np.asarray(self._force(t, q)), q, t)
+        what = "the force F(t, q, v)" if self.velocity_dependent else "the force F(t, q)"
+        return _same_shape(what, np.asarray(self._force(t, q, v)), q, t)
 
     def acceleration(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``q'' = M⁻¹ F(t, q, v)``, shape of ``q``."""
@@ -238,11 +309,8 @@ class SecondOrderSystem:
         """
         self.counters.jacobian_evaluations += 1
         if self._jacobian is not None:
-            # The problem checked that the Jacobian takes the same arguments as the force.
-            if self.velocity_dependent:
-                stiffness, damping = self._jacobian(t, q, v)
-                return stiffness, damping
-            return self._jacobian(t, q), None
+            stiffness, damping = self._jacobian(t, q, v)
+            return stiffness, damping
         if force is None:
             force = self.force(t, q, v)
         stiffness = _finite_difference(lambda x: self.force(t, x, v), q, force)
@@ -252,7 +320,7 @@ class SecondOrderSystem:
         return stiffness, damping
 
     def energy(self, t: float, parts: tuple[np.ndarray, ...]) -> np.ndarray | None:
-        """The problem's monitored energy per system, or ``None`` if it defines none."""
+        """The monitored energy per system, or ``None`` if the problem defines none."""
         if self._energy is None:
             return None
         q, v = parts
@@ -260,6 +328,12 @@ class SecondOrderSystem:
 
 
 System = FirstOrderSystem | SecondOrderSystem
+
+
+def _optional_evaluator(
+    function: UserFunction | None, batch: bool, result: str
+) -> Callable[..., Any] | None:
+    return None if function is None else evaluator(function, batch, result)
 
 
 def _same_shape(what: str, value: np.ndarray, state: np.ndarray, t: float) -> np.ndarray:

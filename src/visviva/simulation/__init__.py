@@ -2,6 +2,7 @@
 
 from .adaptive import DenseOutput
 from .loop import Schedule, simulate
+from .recording import Geometry, Recording
 from .solve import Solution, solve
 from .watch import DEFAULT_DIVERGENCE_LIMIT, DivergenceWatch
 
@@ -9,6 +10,8 @@ __all__ = [
     "DEFAULT_DIVERGENCE_LIMIT",
     "DenseOutput",
     "DivergenceWatch",
+    "Geometry",
+    "Recording",
     "Schedule",
     "Solution",
     "simulate",

@@ -19,15 +19,15 @@ import numpy as np
 from .._version import __version__
 from ..errors import SimulationError
 from ..integrators.runge_kutta import initial_rate
-from .loop import FrameRecorder, add_energy, initial_state
 from .progress import Progress
+from .recorder import FrameRecorder
 from .watch import DivergenceWatch
 
 if TYPE_CHECKING:
     from ..integrators.dopri5 import DormandPrince5, Step
-    from ..io.recording import Recording
     from ..ode.problems import Problem
     from ..ode.state import State
+    from .recording import Recording
 
 __all__ = ["DenseOutput", "integrate_adaptive"]
 
@@ -135,12 +135,12 @@ def integrate_adaptive(
     """
     system = problem.system()
     method.check(system)
-    state = initial_state(problem)
+    state = problem.initial_state()
     # Evaluate f at the start once; every attempt from here reuses it.
     state = state.with_derivative(system.derivative(state.t, state.parts))
     t0 = state.t
     starts_at_t0 = t_eval is None or t_eval[0] == t0
-    recorder = FrameRecorder(state, include=starts_at_t0)
+    recorder = FrameRecorder(system, state, include=starts_at_t0)
     eval_index = 1 if t_eval is not None and starts_at_t0 else 0
     h = (
         first_step
@@ -218,7 +218,6 @@ def integrate_adaptive(
         "message": "completed" if error is None else str(error),
     }
     recording = recorder.recording(attrs)
-    add_energy(recording, system)
     if error is not None:
         error.recording = recording
         raise error

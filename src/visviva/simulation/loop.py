@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -33,10 +32,11 @@ from .._validation import real_number, whole_number
 from .._version import __version__
 from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get
-from ..io.recording import Recording
-from ..ode.state import FirstOrderState, SecondOrderState
 from .interrupt import Interrupted, stop_requested
 from .progress import Progress
+from .recorder import FrameCallback, FrameRecorder
+from .recording import Recording
+from .stepper import Stepper
 from .watch import DivergenceWatch
 
 if TYPE_CHECKING:
@@ -45,10 +45,7 @@ if TYPE_CHECKING:
     from ..ode.state import State
     from ..ode.system import System
 
-__all__ = ["FrameCallback", "Schedule", "initial_state", "simulate"]
-
-#: ``on_frame(t, parts)``: a recorded frame's time [s] and state arrays.
-FrameCallback = Callable[[float, tuple[np.ndarray, ...]], None]
+__all__ = ["Schedule", "simulate"]
 
 #: A fixed-step run may take at most this many integrator steps (substeps included): a billion
 #: steps is minutes compiled and hours in NumPy; more is a mistake in dt, not a plan.
@@ -112,67 +109,6 @@ class Schedule:
         return h_last, start + (sub + 1) * h_last
 
 
-def initial_state(problem: Problem) -> State:
-    """The state a problem starts from."""
-    if problem.kind == "first_order":
-        return FirstOrderState(problem.t0, problem.y0.copy())  # type: ignore[union-attr]
-    return SecondOrderState(problem.t0, problem.q0.copy(), problem.v0.copy())  # type: ignore[union-attr]
-
-
-class FrameRecorder:
-    """Collects the frames of a run.
-
-    Args:
-        template: A state of the run (its kind and shapes); recorded as the first frame unless
-            ``include`` is false.
-        include: Record ``template`` as the first frame.
-        on_frame: Called with ``(t, parts)`` for every frame as it is recorded (streaming
-            writers); ``parts`` are the state arrays, to be copied if kept.
-    """
-
-    def __init__(
-        self, template: State, include: bool = True, on_frame: FrameCallback | None = None
-    ) -> None:
-        self.template = template
-        self.on_frame = on_frame
-        self.names = ("y",) if isinstance(template, FirstOrderState) else ("q", "v")
-        self.times: list[float] = []
-        self.parts: list[list[np.ndarray]] = [[] for _ in self.names]
-        if include:
-            self.append(template)
-
-    def append(self, state: State) -> None:
-        """Record ``state`` as the next frame (copied)."""
-        self.times.append(state.t)
-        for store, part in zip(self.parts, state.parts, strict=True):
-            store.append(np.array(part))
-        if self.on_frame is not None:
-            self.on_frame(state.t, state.parts)
-
-    def extend(self, times: np.ndarray, stacked: np.ndarray, n: int, batch: bool) -> None:
-        """Append frames from the compiled path: ``stacked`` is ``(frames, batch, m)``."""
-        for t, frame in zip(times, stacked, strict=True):
-            self.times.append(float(t))
-            pieces = (frame,) if len(self.names) == 1 else (frame[:, :n], frame[:, n:])
-            kept = [np.array(piece if batch else piece[0]) for piece in pieces]
-            for store, piece in zip(self.parts, kept, strict=True):
-                store.append(piece)
-            if self.on_frame is not None:
-                self.on_frame(float(t), tuple(kept))
-
-    def last(self) -> State:
-        """The most recent frame as a state."""
-        return self.template.from_parts(self.times[-1], tuple(store[-1] for store in self.parts))
-
-    def recording(self, attrs: dict[str, Any]) -> Recording:
-        """The frames so far as a :class:`Recording` with ``attrs``."""
-        fields = {
-            name: np.stack(store) if store else np.empty((0, *part.shape), part.dtype)
-            for name, store, part in zip(self.names, self.parts, self.template.parts, strict=True)
-        }
-        return Recording(np.array(self.times, dtype=np.float64), fields, attrs=attrs)
-
-
 def simulate(
     problem: Problem,
     method: str | Integrator = "rk4",
@@ -201,13 +137,13 @@ def simulate(
             (default ``1e10 × max(1, max |initial state|)``).
         compiled: ``None`` to run compiled when possible, ``False`` to force the NumPy path,
             ``True`` to require the compiled path.
-        on_frame: Called with ``(t, parts)`` as each frame is recorded, for example to stream
-            frames to a file while the run goes on.
+        on_frame: Called with ``(state, energy)`` as each frame is recorded, for example to
+            stream frames to a file while the run goes on.
 
     Returns:
-        The :class:`~visviva.io.Recording`, with fields ``y`` (first-order) or ``q`` and ``v``,
-        plus ``energy`` if the problem defines it; its ``attrs`` hold the method, step, work
-        counters and wall time.
+        The :class:`~visviva.simulation.recording.Recording`, with fields ``y``
+        (first-order) or ``q`` and ``v``, plus ``energy`` if the problem defines it; its
+        ``attrs`` hold the method, step, work counters and wall time.
 
     Raises:
         ModelError: For invalid arguments, before any step.
@@ -240,9 +176,10 @@ def simulate(
     compiled_step = _compiled_step(integrator, problem, compiled)
 
     schedule = Schedule.build(problem.t0, t_end, dt, substeps)
-    state = initial_state(problem)
-    recorder = FrameRecorder(state, on_frame=on_frame)
+    state = problem.initial_state()
+    recorder = FrameRecorder(system, state, on_frame=on_frame)
     watch = DivergenceWatch(system, integrator, dt, state, divergence_limit)
+    stepper = Stepper(system, integrator, watch)
     attrs: dict[str, Any] = {
         "method": integrator.name,
         "dt": dt,
@@ -261,7 +198,7 @@ def simulate(
     with Progress(schedule.steps, f"{integrator.name}", progress) as bar:
         try:
             if compiled_step is None:
-                _run_numpy(integrator, system, state, schedule, record_every, recorder, watch, bar)
+                _run_numpy(stepper, state, schedule, record_every, recorder, bar)
             else:
                 _run_compiled(
                     compiled_step,
@@ -284,7 +221,6 @@ def simulate(
     if isinstance(error, Interrupted):
         attrs["interrupted"] = error.signal
     recording = recorder.recording(attrs)
-    add_energy(recording, system)
     if error is not None:
         error.recording = recording
         raise error
@@ -325,28 +261,18 @@ def _compiled_step(
 
 
 def _run_numpy(
-    integrator: Integrator,
-    system: System,
+    stepper: Stepper,
     state: State,
     schedule: Schedule,
     record_every: int,
     recorder: FrameRecorder,
-    watch: DivergenceWatch,
     bar: Progress,
 ) -> None:
     substeps = schedule.substeps
     for step in range(schedule.steps):
         for sub in range(substeps):
             h, t_after = schedule.substep(step, sub)
-            previous = state
-            try:
-                state = integrator.step(system, state, h).at_time(t_after)
-            except SimulationError as failure:
-                failure.step = step * substeps + sub
-                raise
-            system.counters.accepted_steps += 1
-            if not watch.healthy(state):
-                raise watch.diverged(state, step * substeps + sub, previous)
+            state = stepper.step(state, h, t_after, step * substeps + sub)
         last = step + 1 == schedule.steps
         if (step + 1) % record_every == 0 or last or stop_requested():
             recorder.append(state)
@@ -376,7 +302,6 @@ def _run_compiled(
     from ..integrators.compiled import make_runner
 
     batch = state.parts[0].ndim == 2
-    n = problem.size
     y = _stack(state)
     systems, m = y.shape
     run = make_runner(step, systems)
@@ -412,9 +337,9 @@ def _run_compiled(
         times = origin + (first + every * np.arange(1, valid + 1)) * h
         if valid and offset + valid * every == schedule.steps * substeps:
             times[-1] = schedule.t_end
-        recorder.extend(times, buffer[:valid], n, batch)
+        recorder.extend(times, buffer[:valid], batch)
         if done < count:
-            bad = state.from_parts(origin + (first + done + 1) * h, _unstack(y, n, batch, state))
+            bad = state.from_parts(origin + (first + done + 1) * h, _unstack(y, state))
             raise watch.diverged(bad, offset + done, recorder.last())
 
     h = schedule.h
@@ -459,21 +384,8 @@ def _stop_if_requested(recorder: FrameRecorder) -> None:
         raise Interrupted(name, recorder.times[-1])
 
 
-def _unstack(y: np.ndarray, n: int, batch: bool, template: State) -> tuple[np.ndarray, ...]:
-    rows = y if batch else y[0]
-    if isinstance(template, FirstOrderState):
-        return (rows.copy(),)
-    return (rows[..., :n].copy(), rows[..., n:].copy())
-
-
-def add_energy(recording: Recording, system: System) -> None:
-    """Add the problem's energy at every frame as the field ``energy`` (if it defines one)."""
-    if not system.has_energy:
-        return
-    names = ("y",) if system.kind == "first_order" else ("q", "v")
-    values = [
-        system.energy(float(t), tuple(recording[name][i] for name in names))
-        for i, t in enumerate(recording.time)
-    ]
-    recording.fields["energy"] = np.array(values, dtype=np.float64)
-    recording.units["energy"] = ""
+def _unstack(y: np.ndarray, template: State) -> tuple[np.ndarray, ...]:
+    """The integrated arrays of ``template``'s shapes from the stacked rows ``y``."""
+    rows = y if template.parts[0].ndim == 2 else y[0]
+    sizes = np.cumsum([part.shape[-1] for part in template.parts])[:-1]
+    return tuple(piece.copy() for piece in np.split(rows, sizes, axis=-1))

@@ -21,8 +21,8 @@ from .adaptive import DenseOutput, integrate_adaptive
 from .loop import check_end_time, check_problem, simulate
 
 if TYPE_CHECKING:
-    from ..io.recording import Recording
     from ..ode.problems import Problem
+    from .recording import Recording
 
 __all__ = ["Solution", "solve"]
 

@@ -56,7 +56,6 @@ class DivergenceWatch:
         self.system = system
         self.method = method
         self.dt = dt
-        self.names = ("y",) if system.kind == "first_order" else ("q", "v")
         if limit is None:
             scale = max(float(np.max(np.abs(part))) for part in initial.parts)
             limit = DEFAULT_DIVERGENCE_LIMIT * max(1.0, scale)
@@ -88,16 +87,19 @@ class DivergenceWatch:
         )
 
     def _first_offender(self, state: State) -> tuple[str, float, int | None]:
-        for name, part in zip(self.names, state.parts, strict=True):
+        """The first bad entry: its label (part name and index), value and batch system."""
+        for array, part in enumerate(state.parts):
             with np.errstate(invalid="ignore"):
                 bad = ~(np.abs(part) <= self.limit)
             if bad.any():
                 index = tuple(int(i) for i in np.argwhere(bad)[0])
                 value = complex(part[index]) if np.iscomplexobj(part) else float(part[index])
-                label = f"{name}[{', '.join(map(str, index))}]"
+                name, inside = state.layout.locate(array, index[-1])
+                where = (*index[:-1], *inside)
+                label = f"{name}[{', '.join(map(str, where))}]"
                 if part.ndim == 2:
                     label += f" (system {index[0]})"
-                return label, value, (index[0] if part.ndim == 2 else None)  # type: ignore[return-value]
+                return label, value, (index[0] if part.ndim == 2 else None)
         raise ValueError("state is healthy")
 
 

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
-from ..io.recording import Geometry
+from ..simulation.recording import Geometry
 from . import ground, raster
 from .timescale import format_time
 

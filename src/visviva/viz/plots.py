@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from ..analysis.convergence import ConvergenceStudy
-    from ..io.recording import Recording
+    from ..simulation.recording import Recording
 
 __all__ = [
     "plot_convergence",

@@ -44,8 +44,8 @@ import numpy as np
 from .._validation import describe, real_number
 from ..errors import ModelError
 from ..io.files import atomic_path
-from ..io.recording import Recording
 from ..io.timeline import frames_at_rate
+from ..simulation.recording import Recording
 from .frame import FramePainter, drawn_bounds
 
 __all__ = [

@@ -23,7 +23,7 @@ from pathlib import Path
 
 from ..._validation import describe, did_you_mean
 from ...errors import ModelError
-from ..recording import Recording
+from ...simulation.recording import Recording
 from ._frames import FALLBACK_FPS, MAX_OUTPUT_FRAMES, default_fps, prepare
 
 __all__ = [

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..._validation import real_number
 from ...errors import ModelError
-from ..recording import Geometry, Recording
+from ...simulation.recording import Geometry, Recording
 from ..timeline import MAX_OUTPUT_FRAMES, frames_at_rate
 
 __all__ = ["FALLBACK_FPS", "MAX_OUTPUT_FRAMES", "ExportFrames", "default_fps", "prepare"]
@@ -168,7 +168,7 @@ def prepare(recording: Recording, fps: float | None, speed: float = 1.0) -> Expo
     if not isinstance(recording, Recording):
         raise ModelError(
             f"`recording` must be a visviva.Recording (got {type(recording).__name__}); "
-            "load one with visviva.Recording.load(path)"
+            "load one with visviva.io.load_recording(path)"
         )
     geometry = recording.geometry()
     points = geometry.points

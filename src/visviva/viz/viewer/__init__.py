@@ -28,8 +28,8 @@ import numpy as np
 from ..._validation import describe, real_number
 from ...errors import ModelError
 from ...io.files import atomic_path
-from ...io.recording import Recording
 from ...io.timeline import check_playback, frames_at_rate
+from ...simulation.recording import Recording
 from ..video import MAX_TRAIL_POINTS
 from ._payload import encode_payload, to_json
 
@@ -211,7 +211,7 @@ def write_viewer(
     if not isinstance(recording, Recording):
         raise ModelError(
             f"`recording` must be a visviva Recording (got {type(recording).__name__}); "
-            "load one with visviva.Recording.load(path)"
+            "load one with visviva.io.load_recording(path)"
         )
     geometry = recording.geometry()
     if recording.frames == 0:

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ...io.recording import Geometry
+from ...simulation.recording import Geometry
 from ..timescale import time_unit
 
 __all__ = [
