@@ -1,6 +1,20 @@
-"""Forces on particles: each adds its contribution to a force array and knows its energy."""
+"""Forces on particles: each adds its contribution to a force array, reports its energy and
+gives its Jacobians (see :mod:`visviva.forces.base` for the protocol)."""
 
-from .base import Force
-from .gravity import UniformGravity
+from .assembly import ForceSum
+from .base import Force, Targets
+from .fields import Attractor, Damping, Drag, QuadraticDrag, UniformGravity, Vortex
+from .gravitation import Gravitation
 
-__all__ = ["Force", "UniformGravity"]
+__all__ = [
+    "Attractor",
+    "Damping",
+    "Drag",
+    "Force",
+    "ForceSum",
+    "Gravitation",
+    "QuadraticDrag",
+    "Targets",
+    "UniformGravity",
+    "Vortex",
+]

@@ -1,19 +1,33 @@
-"""The force protocol every particle force follows.
+"""The force protocol every particle force follows, and the pieces forces share.
 
 Positions and velocities are structure-of-arrays ``(N, 3)`` float64 arrays [m], [m/s] in the
-world frame (Y up). A force *adds* its contribution to ``out`` (so the model sums all forces into
-one array without temporaries) and reports its potential energy, so that every run can monitor
-the total energy. Forces that depend on velocity (drag, dampers) have no potential; they return
-0 and declare ``conservative = False``.
+world frame (Y up), ``N`` the particle capacity of the scene. A force:
+
+* *adds* its contribution [N] to ``out`` (so the model sums every force into one array without
+  temporaries), on the particles it targets;
+* reports its potential energy [J] (0 for forces that have none: drag, wind, vortices), so
+  every run can monitor the total energy; ``conservative`` says whether the force is ``−∇U``;
+* gives its exact Jacobians ``∂F/∂x`` and ``∂F/∂v`` as 3×3 blocks on a sparsity pattern fixed
+  when the force is built (``jacobian_blocks``), which implicit methods and the stability
+  advisor assemble into one sparse matrix (:mod:`visviva.forces.assembly`). A force without an
+  analytic Jacobian (n-body gravitation, whose Jacobian is dense) says so with
+  ``jacobian_blocks() is None``; implicit methods then go matrix-free.
+
+The kernels here are serial Numba loops over the targets: a run whose every piece is compiled
+takes the fused, parallel particle step instead (:mod:`visviva.particles.fused`), and the rest
+pays Python's overhead per force per step, which threads would only add to.
+
+Every Jacobian is tested against finite differences of the same force, and every conservative
+force's ``F = −∇U`` the same way (``tests/test_forces.py``).
 """
 
 from __future__ import annotations
 
-from typing import ClassVar, Protocol
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
-__all__ = ["Force"]
+__all__ = ["Force", "Targets", "diagonal_blocks"]
 
 
 class Force(Protocol):
@@ -21,11 +35,61 @@ class Force(Protocol):
 
     #: True if the force is ``−∇U`` of the energy it reports (energy is then conserved).
     conservative: ClassVar[bool]
+    #: True if the force depends on the velocities.
+    velocity_dependent: ClassVar[bool]
 
     def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        """Add the force [N] on every particle to ``out``, shape ``(N, 3)``."""
+        """Add the force [N] on every targeted particle to ``out``, shape ``(N, 3)``."""
         ...
 
-    def potential(self, t: float, x: np.ndarray) -> np.ndarray:
-        """Potential energy [J]: one value, or one per system for a batch ``(B, N, 3)``."""
+    def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
+        """Potential energy [J] of the targeted particles (those ``alive``, if given)."""
         ...
+
+    def jacobian_blocks(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Particle indices ``(rows, cols)`` of the 3×3 blocks ``∂F_row/∂x_col`` and
+        ``∂F_row/∂v_col`` this force may fill, fixed for the force's life; ``None`` if it has
+        no analytic Jacobian."""
+        ...
+
+    def add_jacobian(
+        self, t: float, x: np.ndarray, v: np.ndarray, dfdx: np.ndarray, dfdv: np.ndarray
+    ) -> None:
+        """Add ``∂F/∂x`` [N/m] and ``∂F/∂v`` [N·s/m] into ``dfdx`` and ``dfdv``, each
+        ``(blocks, 3, 3)`` in the order of :meth:`jacobian_blocks`."""
+        ...
+
+
+class Targets:
+    """The particles a force acts on: every particle, or a sorted set of indices.
+
+    Args:
+        count: Number of particles ``N`` in the scene.
+        indices: Indices of the targeted particles, or ``None`` for all of them.
+
+    Attributes:
+        indices: Sorted unique ``int64`` indices, shape ``(n,)`` (``arange(N)`` for all).
+        everything: True if every particle is targeted.
+    """
+
+    def __init__(self, count: int, indices: Any = None) -> None:
+        if indices is None:
+            self.indices = np.arange(count, dtype=np.int64)
+        else:
+            self.indices = np.unique(np.asarray(indices, dtype=np.int64))
+        self.everything = self.indices.shape[0] == count
+        self.indices.flags.writeable = False
+
+    def __len__(self) -> int:
+        return int(self.indices.shape[0])
+
+    def mask(self, alive: np.ndarray | None) -> np.ndarray:
+        """The targeted indices of the particles that are alive."""
+        if alive is None:
+            return self.indices
+        return self.indices[alive[self.indices]]
+
+
+def diagonal_blocks(targets: Targets) -> tuple[np.ndarray, np.ndarray]:
+    """The pattern of a force on each particle from its own state: blocks ``(i, i)``."""
+    return targets.indices, targets.indices

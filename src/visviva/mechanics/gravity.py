@@ -71,45 +71,50 @@ def _pair_weight(row_mass, mass, r2):  # pragma: no cover - compiled
     return (row_mass * mass) * inverse_cube
 
 
-@njit(cache=True, parallel=True, fastmath=_SUMS, error_model="numpy")
-def _direct_accelerations(x, y, z, mass, row_mass, eps2, factor, targets, out):  # pragma: no cover
-    """Fill ``out[k] = factor Σ_j F_ij / row_mass[i]`` for ``i = targets[k]``; return the number
-    of zero-distance pairs.
+@njit(cache=True, fastmath=_SUMS, error_model="numpy")
+def body_acceleration(x, y, z, mass, row_mass, eps2, factor, i):  # pragma: no cover - compiled
+    """``factor Σ_j F_ij / row_mass[i]`` for body ``i`` and the number of zero-distance pairs.
 
     ``row_mass`` is ``mass`` except 1 for massless bodies (test particles), whose acceleration
     is then ``factor Σ_j m_j (x_j − x_i) / r³`` as it should be. The self term has a zero
     separation and contributes exactly nothing; with ``eps2 = 0`` it is one of the counted
-    zero-distance pairs.
+    zero-distance pairs. The one pair sum of the direct method: every kernel calls it.
     """
-    n = x.shape[0]
+    xi, yi, zi, mi = x[i], y[i], z[i], row_mass[i]
+    fx = 0.0
+    fy = 0.0
+    fz = 0.0
+    zeros = 0
+    for j in range(x.shape[0]):
+        dx = x[j] - xi
+        dy = y[j] - yi
+        dz = z[j] - zi
+        r2 = dx * dx + dy * dy + dz * dz + eps2
+        zeros += 1 if r2 == 0.0 else 0
+        w = _pair_weight(mi, mass[j], r2)
+        fx += w * dx
+        fy += w * dy
+        fz += w * dz
+    scale = factor / mi
+    return scale * fx, scale * fy, scale * fz, zeros
+
+
+@njit(cache=True, parallel=True, fastmath=_SUMS, error_model="numpy")
+def _direct_accelerations(x, y, z, mass, row_mass, eps2, factor, targets, out):  # pragma: no cover
+    """Fill ``out[k]`` with the acceleration of body ``targets[k]``
+    (:func:`body_acceleration`); return the number of zero-distance pairs."""
     zero_pairs = 0
     for k in prange(targets.shape[0]):
-        i = targets[k]
-        xi, yi, zi, mi = x[i], y[i], z[i], row_mass[i]
-        fx = 0.0
-        fy = 0.0
-        fz = 0.0
-        zeros = 0
-        for j in range(n):
-            dx = x[j] - xi
-            dy = y[j] - yi
-            dz = z[j] - zi
-            r2 = dx * dx + dy * dy + dz * dz + eps2
-            zeros += 1 if r2 == 0.0 else 0
-            w = _pair_weight(mi, mass[j], r2)
-            fx += w * dx
-            fy += w * dy
-            fz += w * dz
-        scale = factor / mi
-        out[k, 0] = scale * fx
-        out[k, 1] = scale * fy
-        out[k, 2] = scale * fz
+        ax, ay, az, zeros = body_acceleration(x, y, z, mass, row_mass, eps2, factor, targets[k])
+        out[k, 0] = ax
+        out[k, 1] = ay
+        out[k, 2] = az
         zero_pairs += zeros
     return zero_pairs
 
 
 @njit(cache=True, fastmath=_SUMS, error_model="numpy")
-def _row_potential(x, y, z, mass, eps2, i):  # pragma: no cover - compiled
+def row_potential(x, y, z, mass, eps2, i):  # pragma: no cover - compiled
     """``Σ_{j>i} m_i m_j / r_ij`` and the number of zero distances among those pairs."""
     total = 0.0
     zeros = 0
@@ -137,9 +142,9 @@ def _direct_potential(x, y, z, mass, eps2):  # pragma: no cover - compiled
     total = 0.0
     zero_pairs = 0
     for k in prange((n + 1) // 2):
-        part, zeros = _row_potential(x, y, z, mass, eps2, k)
+        part, zeros = row_potential(x, y, z, mass, eps2, k)
         if n - 1 - k != k:
-            other, more = _row_potential(x, y, z, mass, eps2, n - 1 - k)
+            other, more = row_potential(x, y, z, mass, eps2, n - 1 - k)
             part += other
             zeros += more
         total += part

@@ -29,11 +29,13 @@ from .gravity import (
     GRAVITATIONAL_CONSTANT,
     PointMasses,
     accelerations_into,
+    body_acceleration,
     check_masses,
     check_method,
     check_positions,
     gravity_accelerations,
     potential_energy,
+    row_potential,
 )
 
 __all__ = ["COMPILED_MAX_BODIES", "Bodies", "nbody_problem"]
@@ -158,45 +160,40 @@ def _compiled_functions(
 ) -> tuple[Callable[..., None], Callable[..., float]]:
     """``acceleration(t, q, out)`` and ``energy(t, q, v)`` for one system of few bodies.
 
-    Compiled with Numba, the masses frozen in as constants (one compilation per set of masses,
-    kept for the session). Each pair is visited once and its force applied to both bodies
-    (Newton's third law). With ``eps2 = 0`` two bodies meeting exactly give a non-finite
+    Numba closures over the direct method's own pair sums
+    (:func:`~visviva.mechanics.gravity.body_acceleration`,
+    :func:`~visviva.mechanics.gravity.row_potential`), with the masses frozen in as constants
+    (one compilation per set of masses, kept for the session), so the compiled whole-run loop
+    can call them. With ``eps2 = 0`` two bodies meeting exactly give a non-finite
     acceleration, which the simulation's divergence watch reports.
     """
     key = (tuple(float(m) for m in masses), G, eps2)
     if key not in _COMPILED:
         import numba
 
-        m = np.array(key[0])
-        gm = G * m
+        bodies = PointMasses(np.zeros((len(key[0]), 3)), np.array(key[0]), 0.0)
+        m, scaled, row_mass = np.array(key[0]), bodies.mass, bodies.row_mass
+        factor = G * bodies.mass_scale
+        potential_factor = factor * bodies.mass_scale
         n = m.shape[0]
 
         @numba.njit(error_model="numpy")
         def acceleration(t, q, out):  # pragma: no cover - compiled
-            for k in range(3 * n):
-                out[k] = 0.0
+            x, y, z = q[0::3], q[1::3], q[2::3]
             for i in range(n):
-                for j in range(i + 1, n):
-                    dx = q[3 * j] - q[3 * i]
-                    dy = q[3 * j + 1] - q[3 * i + 1]
-                    dz = q[3 * j + 2] - q[3 * i + 2]
-                    r2 = dx * dx + dy * dy + dz * dz + eps2
-                    inverse_cube = 1.0 / (r2 * np.sqrt(r2))
-                    for axis, d in ((0, dx), (1, dy), (2, dz)):
-                        out[3 * i + axis] += gm[j] * inverse_cube * d
-                        out[3 * j + axis] -= gm[i] * inverse_cube * d
+                ax, ay, az, _ = body_acceleration(x, y, z, scaled, row_mass, eps2, factor, i)
+                out[3 * i] = ax
+                out[3 * i + 1] = ay
+                out[3 * i + 2] = az
 
         @numba.njit(error_model="numpy")
         def energy(t, q, v):  # pragma: no cover - compiled
+            x, y, z = q[0::3], q[1::3], q[2::3]
             total = 0.0
             for i in range(n):
                 speed2 = v[3 * i] ** 2 + v[3 * i + 1] ** 2 + v[3 * i + 2] ** 2
-                total += 0.5 * m[i] * speed2
-                for j in range(i + 1, n):
-                    dx = q[3 * j] - q[3 * i]
-                    dy = q[3 * j + 1] - q[3 * i + 1]
-                    dz = q[3 * j + 2] - q[3 * i + 2]
-                    total -= gm[i] * m[j] / np.sqrt(dx * dx + dy * dy + dz * dz + eps2)
+                pairs, _ = row_potential(x, y, z, scaled, eps2, i)
+                total += 0.5 * m[i] * speed2 - potential_factor * pairs
             return total
 
         _COMPILED[key] = (acceleration, energy)

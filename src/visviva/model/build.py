@@ -111,14 +111,10 @@ def _check_start(model: Model, scene: Scene) -> list[SceneProblem]:
         with np.errstate(all="ignore"):  # overflow is judged by the results below
             problem = model.problem()
             system = problem.system()
-            parts = (
-                (problem.q0, problem.v0)
-                if isinstance(problem, SecondOrderProblem)
-                else (problem.y0,)
-            )
-            values_at_start = [*system.derivative(problem.t0, parts)]
+            start = problem.initial_state()
+            values_at_start = [*system.derivative(start.t, start.parts)]
             if system.has_energy:
-                values_at_start.append(np.asarray(system.energy(problem.t0, parts)))
+                values_at_start.append(np.asarray(system.energy(start)))
     except ModelError as error:
         if model.system is None:
             return [SceneProblem(where, _NOT_FINITE)]

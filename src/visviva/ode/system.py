@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import ModelError
 from .batching import batched
 from .functions import UserFunction
-from .state import Layout
+from .state import Layout, State
 
 if TYPE_CHECKING:
     from .mass import Mass
@@ -166,11 +166,12 @@ class FirstOrderSystem:
             rate = self.rhs(t, y)
         return _finite_difference(lambda x: self.rhs(t, x), y, rate)
 
-    def energy(self, t: float, parts: tuple[np.ndarray, ...]) -> np.ndarray | None:
-        """The monitored energy per system, or ``None`` if the problem defines none."""
+    def energy(self, state: State) -> np.ndarray | None:
+        """The monitored energy of ``state``, one value per system, or ``None`` if the problem
+        defines none."""
         if self._energy is None:
             return None
-        return np.asarray(self._energy(t, parts[0]), dtype=np.float64)
+        return np.asarray(self._energy(state.t, state.parts[0]), dtype=np.float64)
 
 
 class SecondOrderSystem:
@@ -319,12 +320,13 @@ class SecondOrderSystem:
         damping = _finite_difference(lambda x: self.force(t, q, x), v, force)
         return stiffness, damping
 
-    def energy(self, t: float, parts: tuple[np.ndarray, ...]) -> np.ndarray | None:
-        """The monitored energy per system, or ``None`` if the problem defines none."""
+    def energy(self, state: State) -> np.ndarray | None:
+        """The monitored energy of ``state``, one value per system, or ``None`` if the problem
+        defines none."""
         if self._energy is None:
             return None
-        q, v = parts
-        return np.asarray(self._energy(t, q, v), dtype=np.float64)
+        q, v = state.parts
+        return np.asarray(self._energy(state.t, q, v), dtype=np.float64)
 
 
 System = FirstOrderSystem | SecondOrderSystem

@@ -60,7 +60,7 @@ class FrameRecorder:
 
     def append(self, state: State) -> None:
         """Record ``state`` as the next frame (copied)."""
-        energy = self.system.energy(state.t, state.parts)
+        energy = self.system.energy(state)
         self.times.append(state.t)
         self._last = state
         if self.keep:

@@ -1,0 +1,351 @@
+"""Force fields on particles: gravity, drag and wind, quadratic drag, damping, attractors, vortices.
+
+Each class follows :class:`~visviva.forces.base.Force` and acts on a set of target particles;
+the laws and their derivation are in :mod:`visviva.forces.laws`. Every field acts on each
+particle from that particle's own state, so its Jacobians are 3×3 blocks on the diagonal.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import ClassVar
+
+import numpy as np
+from numba import njit
+
+from .._validation import real_number
+from ..errors import ModelError
+from .base import Targets, diagonal_blocks
+from .laws import (
+    attractor_force,
+    attractor_jacobian,
+    attractor_potential,
+    quadratic_drag_force,
+    quadratic_drag_jacobian,
+    vortex_air_velocity,
+    vortex_jacobian,
+)
+
+__all__ = ["Attractor", "Damping", "Drag", "QuadraticDrag", "UniformGravity", "Vortex", "vector"]
+
+_NO_BLOCKS = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
+
+
+def vector(name: str, value: Sequence[float], *, unit: str, nonzero: bool = False) -> np.ndarray:
+    """``value`` as a finite 3-vector, refused with its name if it is not one."""
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        array = np.full(0, np.nan)
+    if array.shape != (3,) or not np.isfinite(array).all():
+        raise ModelError(f"`{name}` must be three finite numbers [{unit}] (got {value!r})")
+    if nonzero and not np.any(array):
+        raise ModelError(f"`{name}` must not be the zero vector (it gives a direction)")
+    return array
+
+
+class _Field:
+    """Common part of the fields: targets, masses and the diagonal block pattern."""
+
+    conservative: ClassVar[bool] = False
+    velocity_dependent: ClassVar[bool] = True
+
+    def __init__(self, mass: np.ndarray, targets: Targets) -> None:
+        self.mass = np.asarray(mass, dtype=np.float64)
+        self.targets = targets
+
+    def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
+        """Potential energy [J]: none for a dissipative field."""
+        return 0.0
+
+    def jacobian_blocks(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """One 3×3 block per target particle, on the diagonal."""
+        return diagonal_blocks(self.targets)
+
+
+class UniformGravity(_Field):
+    """Constant gravitational acceleration: ``F = m g``, ``U = −m g·x`` (zero at the origin).
+
+    Args:
+        gravity: Acceleration ``g`` [m/s²], shape ``(3,)`` (Y up: ``(0, −9.81, 0)`` on Earth).
+        mass: Particle masses [kg], shape ``(N,)``.
+        targets: The particles it acts on (default: all).
+    """
+
+    conservative = True
+    velocity_dependent = False
+
+    def __init__(
+        self, gravity: Sequence[float], mass: np.ndarray, targets: Targets | None = None
+    ) -> None:
+        super().__init__(mass, targets or Targets(len(mass)))
+        self.gravity = vector("gravity", gravity, unit="m/s²")
+        # m_i g for every target, once: the force does not depend on the state.
+        self._weight = self.mass[self.targets.indices, None] * self.gravity[None, :]
+
+    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        """Add ``m_i g`` [N] to ``out`` ``(N, 3)``."""
+        if self.targets.everything:
+            out += self._weight
+        else:
+            out[self.targets.indices] += self._weight
+
+    def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
+        """``U = −Σ_i m_i g·x_i`` [J] over the targets (alive ones, if given)."""
+        if alive is None:
+            return -float(np.einsum("ij,ij->", x[self.targets.indices], self._weight))
+        keep = alive[self.targets.indices]
+        return -float(np.einsum("ij,ij->", x[self.targets.indices[keep]], self._weight[keep]))
+
+    def jacobian_blocks(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """No blocks: the force does not change with the state."""
+        return _NO_BLOCKS
+
+    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+        """Nothing to add: ``∂F/∂x = ∂F/∂v = 0``."""
+
+
+class Drag(_Field):
+    """Linear drag in still or moving air: ``F = −k (v − w)`` (wind when ``w ≠ 0``).
+
+    Args:
+        coefficient: ``k`` [N·s/m], at least 0.
+        mass: Particle masses [kg] (unused by the law; kept for the common interface).
+        targets: The particles it acts on (default: all).
+        air_velocity: The air's velocity ``w`` [m/s].
+    """
+
+    def __init__(
+        self,
+        coefficient: float,
+        mass: np.ndarray,
+        targets: Targets | None = None,
+        air_velocity: Sequence[float] = (0.0, 0.0, 0.0),
+    ) -> None:
+        super().__init__(mass, targets or Targets(len(mass)))
+        self.coefficient = real_number("coefficient", coefficient, nonnegative=True)
+        self.air_velocity = vector("velocity", air_velocity, unit="m/s")
+
+    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        """Add ``−k (v − w)`` [N] to ``out``."""
+        k, w = self.coefficient, self.air_velocity
+        if self.targets.everything:
+            out -= k * (v - w)
+        else:
+            index = self.targets.indices
+            out[index] -= k * (v[index] - w)
+
+    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+        """``∂F/∂v = −k I`` [N·s/m] on each block."""
+        for axis in range(3):
+            dfdv[:, axis, axis] -= self.coefficient
+
+
+class Damping(_Field):
+    """Mass-proportional damping ``F = −γ m v``: every particle slows at the rate ``γ`` [1/s].
+
+    Args:
+        rate: ``γ`` [1/s], at least 0.
+        mass: Particle masses [kg], shape ``(N,)``.
+        targets: The particles it acts on (default: all).
+    """
+
+    def __init__(self, rate: float, mass: np.ndarray, targets: Targets | None = None) -> None:
+        super().__init__(mass, targets or Targets(len(mass)))
+        self.rate = real_number("rate", rate, nonnegative=True, unit=" 1/s")
+        self._factor = (self.rate * self.mass[self.targets.indices])[:, None]
+
+    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        """Add ``−γ m v`` [N] to ``out``."""
+        if self.targets.everything:
+            out -= self._factor * v
+        else:
+            index = self.targets.indices
+            out[index] -= self._factor * v[index]
+
+    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+        """``∂F/∂v = −γ m I`` [kg/s] on each block."""
+        for axis in range(3):
+            dfdv[:, axis, axis] -= self._factor[:, 0]
+
+
+class QuadraticDrag(_Field):
+    """Quadratic drag ``F = −c |v − w| (v − w)``, the drag of a fast body in air.
+
+    Args:
+        coefficient: ``c`` [kg/m] (``½ ρ C_d A``), at least 0.
+        mass: Particle masses [kg] (unused by the law).
+        targets: The particles it acts on (default: all).
+        air_velocity: The air's velocity ``w`` [m/s].
+    """
+
+    def __init__(
+        self,
+        coefficient: float,
+        mass: np.ndarray,
+        targets: Targets | None = None,
+        air_velocity: Sequence[float] = (0.0, 0.0, 0.0),
+    ) -> None:
+        super().__init__(mass, targets or Targets(len(mass)))
+        self.coefficient = real_number("coefficient", coefficient, nonnegative=True)
+        self.air_velocity = vector("velocity", air_velocity, unit="m/s")
+
+    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        """Add the drag [N] to ``out``."""
+        _quadratic_drag(self.targets.indices, v, *self.air_velocity, self.coefficient, out)
+
+    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+        """``∂F/∂v`` [kg/s] on each block (see :func:`~.laws.quadratic_drag_jacobian`)."""
+        _quadratic_drag_blocks(self.targets.indices, v, *self.air_velocity, self.coefficient, dfdv)
+
+
+class Attractor(_Field):
+    """A point attractor (or repulsor), softened inverse square: ``F = −s m d / ρ³``.
+
+    Args:
+        point: The centre ``c`` [m].
+        strength: ``s`` [m³/s²]: ``G M`` of the attracting mass; negative repels.
+        mass: Particle masses [kg], shape ``(N,)``.
+        targets: The particles it acts on (default: all).
+        softening: ``ε`` [m] > 0: caps the force near the centre at about ``s m / ε²``.
+    """
+
+    conservative = True
+    velocity_dependent = False
+
+    def __init__(
+        self,
+        point: Sequence[float],
+        strength: float,
+        mass: np.ndarray,
+        targets: Targets | None = None,
+        softening: float = 0.1,
+    ) -> None:
+        super().__init__(mass, targets or Targets(len(mass)))
+        self.point = vector("point", point, unit="m")
+        self.strength = real_number("strength", strength, unit=" m³/s²")
+        self.softening = real_number("softening", softening, positive=True, unit=" m")
+
+    def _parameters(self) -> tuple[float, ...]:
+        return (*self.point, self.strength, self.softening**2)
+
+    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        """Add the attraction [N] to ``out``."""
+        _attractor(self.targets.indices, x, self.mass, *self._parameters(), out)
+
+    def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
+        """``U = −Σ_i s m_i / ρ_i`` [J] over the targets (alive ones, if given)."""
+        return float(_attractor_energy(self.targets.mask(alive), x, self.mass, *self._parameters()))
+
+    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+        """``∂F/∂x`` [N/m] on each block (see :func:`~.laws.attractor_jacobian`)."""
+        _attractor_blocks(self.targets.indices, x, self.mass, *self._parameters(), dfdx)
+
+
+class Vortex(_Field):
+    """Air swirling about an axis, dragging particles along: ``F = k (u(x) − v)``.
+
+    Args:
+        point: A point ``c`` [m] on the vortex's axis.
+        axis: The axis direction (any length); the air turns counter-clockwise about it.
+        circulation: ``Γ`` [m²/s]: the air's speed at distance ``r`` (outside the core) is
+            ``Γ / (2π r)``.
+        coefficient: ``k`` [N·s/m] of the drag towards the air's velocity, at least 0.
+        mass: Particle masses [kg] (unused by the law).
+        targets: The particles it acts on (default: all).
+        core_radius: ``r`` [m] > 0: inside it the air turns like a solid body.
+    """
+
+    def __init__(
+        self,
+        point: Sequence[float],
+        axis: Sequence[float],
+        circulation: float,
+        coefficient: float,
+        mass: np.ndarray,
+        targets: Targets | None = None,
+        core_radius: float = 0.5,
+    ) -> None:
+        super().__init__(mass, targets or Targets(len(mass)))
+        self.point = vector("point", point, unit="m")
+        direction = vector("axis", axis, unit="", nonzero=True)
+        self.axis = direction / np.linalg.norm(direction)
+        self.circulation = real_number("circulation", circulation, unit=" m²/s")
+        self.coefficient = real_number("coefficient", coefficient, nonnegative=True)
+        self.core_radius = real_number("core_radius", core_radius, positive=True, unit=" m")
+
+    def _parameters(self) -> tuple[float, ...]:
+        factor = self.circulation / (2.0 * math.pi)
+        return (*self.point, *self.axis, factor, self.core_radius**2, self.coefficient)
+
+    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        """Add the vortex's drag [N] to ``out``."""
+        _vortex(self.targets.indices, x, v, *self._parameters(), out)
+
+    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+        """``∂F/∂x = k ∂u/∂x`` and ``∂F/∂v = −k I`` on each block."""
+        _vortex_blocks(self.targets.indices, x, *self._parameters(), dfdx)
+        for axis in range(3):
+            dfdv[:, axis, axis] -= self.coefficient
+
+
+# Serial loops over the targets (see visviva.forces.base for why not parallel).
+
+
+@njit(cache=True, error_model="numpy")
+def _quadratic_drag(index, v, wx, wy, wz, c, out):  # pragma: no cover - compiled
+    for i in index:
+        fx, fy, fz = quadratic_drag_force(v[i, 0], v[i, 1], v[i, 2], wx, wy, wz, c)
+        out[i, 0] += fx
+        out[i, 1] += fy
+        out[i, 2] += fz
+
+
+@njit(cache=True, error_model="numpy")
+def _quadratic_drag_blocks(index, v, wx, wy, wz, c, dfdv):  # pragma: no cover - compiled
+    for b in range(index.shape[0]):
+        i = index[b]
+        quadratic_drag_jacobian(v[i, 0], v[i, 1], v[i, 2], wx, wy, wz, c, dfdv[b])
+
+
+@njit(cache=True, error_model="numpy")
+def _attractor(index, x, m, cx, cy, cz, s, eps2, out):  # pragma: no cover - compiled
+    for i in index:
+        fx, fy, fz = attractor_force(x[i, 0], x[i, 1], x[i, 2], cx, cy, cz, s, eps2, m[i])
+        out[i, 0] += fx
+        out[i, 1] += fy
+        out[i, 2] += fz
+
+
+@njit(cache=True, error_model="numpy")
+def _attractor_energy(index, x, m, cx, cy, cz, s, eps2):  # pragma: no cover - compiled
+    total = 0.0
+    for i in index:
+        total += attractor_potential(x[i, 0], x[i, 1], x[i, 2], cx, cy, cz, s, eps2, m[i])
+    return total
+
+
+@njit(cache=True, error_model="numpy")
+def _attractor_blocks(index, x, m, cx, cy, cz, s, eps2, dfdx):  # pragma: no cover - compiled
+    for b in range(index.shape[0]):
+        i = index[b]
+        attractor_jacobian(x[i, 0], x[i, 1], x[i, 2], cx, cy, cz, s, eps2, m[i], dfdx[b])
+
+
+@njit(cache=True, error_model="numpy")
+def _vortex(index, x, v, cx, cy, cz, ax, ay, az, f, core2, k, out):  # pragma: no cover
+    for i in index:
+        ux, uy, uz = vortex_air_velocity(
+            x[i, 0], x[i, 1], x[i, 2], cx, cy, cz, ax, ay, az, f, core2
+        )
+        out[i, 0] += k * (ux - v[i, 0])
+        out[i, 1] += k * (uy - v[i, 1])
+        out[i, 2] += k * (uz - v[i, 2])
+
+
+@njit(cache=True, error_model="numpy")
+def _vortex_blocks(index, x, cx, cy, cz, ax, ay, az, f, core2, k, dfdx):  # pragma: no cover
+    for b in range(index.shape[0]):
+        i = index[b]
+        vortex_jacobian(x[i, 0], x[i, 1], x[i, 2], cx, cy, cz, ax, ay, az, f, core2, k, dfdx[b])
