@@ -105,7 +105,7 @@ def test_compare_keeps_a_hostile_scene_name_inside_out(monkeypatch, capsys, tmp_
     builder.add_system("oscillator")
     scene = tmp_path / "work" / "escape.toml"
     scene.parent.mkdir()
-    scene.write_text(builder.dump())
+    scene.write_text(vv.io.dump_scene(builder.scene))
     monkeypatch.chdir(scene.parent)
     status, _, err = run_main(
         monkeypatch, capsys, "compare", scene, "rk4", "--convergence-time", "0.1"

@@ -54,7 +54,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, vv.Recording]:
     )
     folder = tmp_path_factory.mktemp("run")
     scene = folder / "scene.toml"
-    scene.write_text(builder.dump("toml"))
+    scene.write_text(vv.io.dump_scene(builder.scene, "toml"))
     out = folder / "out"
     arguments = ["run", str(scene), "-o", str(out)]
     for format in FORMATS:

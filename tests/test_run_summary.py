@@ -22,7 +22,7 @@ runner = CliRunner()
 def _pendulum(method: str, dt: float, duration: float = 10.0) -> vv.Model:
     builder = vv.SceneBuilder(name="pendulum")
     builder.set_integration(method=method, dt=dt, duration=duration)
-    builder.add_system("pendulum", length=1.0, theta0=1.0)
+    builder.add_system("pendulum", {"length": 1.0, "theta0": 1.0})
     return builder.build()
 
 
@@ -76,7 +76,7 @@ def test_the_tolerance_is_settable_in_the_scene_and_per_run(tmp_path):
 def test_a_damped_system_losing_energy_is_not_warned_about(tmp_path):
     builder = vv.SceneBuilder(name="damped")
     builder.set_integration(method="rk4", dt=0.01, duration=10.0)
-    builder.add_system("damped-oscillator", damping=0.4)
+    builder.add_system("damped-oscillator", {"damping": 0.4})
     summary = vv.run_scene(builder.build(), tmp_path).summary
     assert summary["energy_drift"] < -0.5  # e^{-c t/m} decay: the physics, not an error
     assert _energy_warnings(summary) == []
@@ -85,7 +85,7 @@ def test_a_damped_system_losing_energy_is_not_warned_about(tmp_path):
 def test_summary_counts_what_the_scene_holds(tmp_path):
     builder = vv.SceneBuilder(name="cluster")
     builder.set_integration(method="velocity_verlet", dt=0.01, duration=0.02)
-    builder.add_system("cluster", bodies=300, softening=0.05)
+    builder.add_system("cluster", {"bodies": 300, "softening": 0.05})
     summary = vv.run_scene(builder.build(), tmp_path / "c").summary
     assert summary["counts"] == {"degrees_of_freedom": 900, "points": 300}
     builder = vv.SceneBuilder(name="spray")
@@ -97,7 +97,7 @@ def test_summary_counts_what_the_scene_holds(tmp_path):
 
 def test_run_prints_a_short_summary_with_the_warning(tmp_path):
     scene = tmp_path / "euler.toml"
-    scene.write_text(_pendulum("explicit_euler", 0.5).source)
+    scene.write_text(vv.io.dump_scene(_pendulum("explicit_euler", 0.5).scene))
     result = runner.invoke(app, ["run", str(scene), "-o", str(tmp_path / "out")])
     assert result.exit_code == 0, result.output
     lines = result.stdout.splitlines()

@@ -95,7 +95,10 @@ def replaced(old: str, new: str) -> str:
         (replaced('method = "symplectic_euler"', 'method = "dopri5"'), ["fixed-step", "dopri5"]),
         ('[scene]\nname = "empty"\n', ["entities", "empty"]),
         (replaced("mass = 1.0", "mass = [1.0, 2.0]"), ["entities[0].mass", "2 entries for 1"]),
-        (VALID + '\n[[entities]]\ntype = "system"\nsystem = "pendulum"\n', ["named system"]),
+        (
+            VALID + '\n[[entities]]\ntype = "system"\nsystem = "test-equation"\n',
+            ["entities[2]", "test equation", "scene of its own"],
+        ),
     ],
     ids=[
         "negative-mass",
@@ -118,7 +121,7 @@ def replaced(old: str, new: str) -> str:
         "adaptive-method",
         "empty-scene",
         "list-length",
-        "system-mixed-with-particles",
+        "first-order-system-mixed-with-particles",
     ],
 )
 def test_bad_scene_is_refused(monkeypatch, capsys, tmp_path, text, fragments):

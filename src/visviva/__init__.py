@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     from . import analysis, demos, forces, integrators, io, mechanics, model, ode, simulation, viz
     from .model import Model, SceneBuilder
     from .scenes import load_model, run_scene
-    from .simulation import Solution, simulate, solve
+    from .simulation import Simulation, Solution, simulate, solve
     from .simulation.recording import Recording
 
 __all__ = [
@@ -45,6 +45,7 @@ __all__ = [
     "SceneError",
     "SimulationDiverged",
     "SimulationError",
+    "Simulation",
     "Solution",
     "VisvivaError",
     "__version__",
@@ -82,6 +83,7 @@ _FUNCTIONS = {
     "load_model": "scenes",
     "run_scene": "scenes",
     "Recording": "simulation",
+    "Simulation": "simulation",
     "Solution": "simulation",
     "simulate": "simulation",
     "solve": "simulation",

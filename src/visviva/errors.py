@@ -32,10 +32,14 @@ class VisvivaError(Exception):
     Attributes:
         recording: The frames recorded before a run stopped (set by the simulation loop).
         report: What a job (``run_scene``, ``run_demo``) wrote before raising, if anything.
+        state: The last good state of a run that stopped (set by the simulation loop).
+        steps_done: Whole steps of that run before it stopped.
     """
 
     recording: Any = None
     report: Any = None
+    state: Any = None
+    steps_done: int = 0
 
 
 class ModelError(VisvivaError, ValueError):

@@ -1,7 +1,8 @@
 """Running a scene: ``visviva run scene.toml -o out/`` and :func:`run_scene`.
 
-A scene file (or builder) becomes a frozen Model; its problem runs through the one simulation
-loop while every recorded frame streams into ``recording.h5`` (flushed every few frames, so a
+A scene file (or builder) becomes a frozen Model; a :class:`~visviva.simulation.Simulation` of
+it runs through the one simulation loop while every recorded frame streams into
+``recording.h5`` (nothing of the frames stays in memory) (flushed every few frames, so a
 killed process keeps what was flushed in the output's hidden staging directory). When the run
 ends, ``summary.json`` and the requested outputs (video, viewer, exports) are written, and
 everything moves into the output directory at once. A run that diverges still delivers its
@@ -14,14 +15,18 @@ import os
 import time
 import warnings
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from ._validation import real_number
 from ._version import __version__
-from .errors import ModelError, SceneError, SceneProblem, SimulationError, VisvivaError
+from .errors import ModelError, SceneError, SceneProblem, SimulationError
 from .io.job import JobReport, python_warnings
+from .io.recording import load_recording
+from .io.scene_files import dump_scene
 from .model import Model
 from .model.build import build_model
 
@@ -64,8 +69,8 @@ class DryRun:
     """What a run would do, without doing it.
 
     Attributes:
-        particles: Number of particles.
-        system: Named system, or ``None``.
+        particles: Number of particle slots (an emitter counts its capacity).
+        systems: The named systems' kinds.
         steps: Steps of ``dt`` to the end.
         frames: Frames the recording would hold.
         max_stable_dt: The stability advisor's largest stable step for the method at the
@@ -74,7 +79,7 @@ class DryRun:
     """
 
     particles: int
-    system: str | None
+    systems: tuple[str, ...]
     steps: int
     frames: int
     max_stable_dt: float
@@ -91,11 +96,10 @@ def dry_run(model: Model, *, duration: float | None = None, formats: Iterable[st
     seconds = _duration(model, duration)
     settings = model.integration
     steps = math.ceil(seconds / settings.dt - 1e-9)
-    problem = model.problem()
-    limit = largest_stable_step(problem.system(), get(settings.method), problem.initial_state())
+    limit = largest_stable_step(model.system(), get(settings.method), model.initial_state())
     return DryRun(
         particles=model.particle_count,
-        system=None if model.system is None else model.system.system,
+        systems=tuple(s.system for s in model.systems),
         steps=steps,
         frames=steps // settings.record_every + 1 + (1 if steps % settings.record_every else 0),
         max_stable_dt=limit,
@@ -157,16 +161,16 @@ def run_scene(
     ):
         warnings.simplefilter("always")
         job.check_target(planned)
-        problem = model.problem()
         started = time.perf_counter()
-        recording, stopped = _simulate_streaming(
-            model, problem, job.stage("recording.h5"), seconds, progress, stops
-        )
-        failure: VisvivaError | None = stopped
-        summary = _summary(model, problem, recording, failure, seconds, tolerance)
+        staged = job.stage("recording.h5")
+        run, failure = _simulate_streaming(model, staged, seconds, progress, stops)
+        summary = _summary(model, run, failure, seconds, tolerance)
         unwritten: list[str] = []
+        recording = None
         for name in extra if failure is None else ():
             try:
+                if recording is None:
+                    recording = load_recording(staged)
                 with job.writing(name) as path:
                     write_output(
                         recording, path, model.output_fps, model.output_speed, model.output_trail
@@ -176,7 +180,7 @@ def run_scene(
                 unwritten.append(f"{name} was not written: {error}")
                 summary["warnings"].append({"kind": "output", "message": unwritten[-1]})
             except KeyboardInterrupt:
-                failure = Interrupted(stops.requested or "SIGINT", float(recording.time[-1]))
+                failure = Interrupted(stops.requested or "SIGINT", run.t_reached)
                 summary["interrupted"] = failure.signal
                 summary["message"] = f"{failure.signal} while writing {name}; not written"
                 break
@@ -191,121 +195,157 @@ def run_scene(
     return report
 
 
+@dataclass
+class _Run:
+    """What a streamed run leaves besides its file: outcome, work and energy figures.
+
+    The energy is followed frame by frame (first, last, largest change), so nothing in
+    memory grows with the number of frames.
+    """
+
+    t_reached: float = float("nan")
+    frames: int = 0
+    points: int = 0
+    counters: dict[str, Any] = field(default_factory=dict)
+    energy_start: float | None = None
+    energy_last: float | None = None
+    energy_change: float = 0.0
+
+    def see(self, t: float, energy: Any) -> None:
+        self.t_reached = t
+        self.frames += 1
+        if energy is None:
+            return
+        value = float(energy)
+        if self.energy_start is None:
+            self.energy_start = value
+        self.energy_last = value
+        self.energy_change = max(self.energy_change, abs(value - self.energy_start))
+
+    def drift(self) -> tuple[float | None, float | None]:
+        """``(E_last − E_0)/|E_0|`` and ``max |E − E_0|/|E_0|``, or ``None`` without energy."""
+        if self.energy_start is None or self.energy_last is None or self.energy_start == 0.0:
+            return None, None
+        scale = abs(self.energy_start)
+        return (self.energy_last - self.energy_start) / scale, self.energy_change / scale
+
+
 def _simulate_streaming(
     model: Model,
-    problem: Any,
     path: Path,
     seconds: float,
     progress: bool | None,
     stops: StopOnSignal,
-) -> tuple[Any, SimulationError | Interrupted | None]:
-    """Run the scene's problem, streaming each frame into the recording at ``path``.
+) -> tuple[_Run, SimulationError | Interrupted | None]:
+    """Run the scene, streaming each recorded frame into the recording at ``path``.
 
-    Returns the scene recording (``None`` if a second signal cut the run short before the
-    loop could hand it over) and the failure or interrupt that ended the run early, if any.
+    Returns what the run leaves (:class:`_Run`) and the failure or interrupt that ended it
+    early, if any.
     """
     from .io.writer import RecordingWriter
+    from .simulation import Simulation
     from .simulation.interrupt import Interrupted
-    from .simulation.loop import simulate
 
     settings = model.integration
     attrs = {
-        "scene": model.source or "",
+        "scene": model.source or dump_scene(model.scene),
         "scene_name": model.name,
         "visviva_version": __version__,
         "method": settings.method,
         "dt": settings.dt,
+        "substeps": settings.substeps,
+        "record_every": settings.record_every,
+        "t0": 0.0,
+        "t_end": seconds,
         "playback_speed": model.output_speed,
         "playback_trail": model.output_trail,
+        "compiled": False,
     }
+    run = _Run()
     failure: SimulationError | Interrupted | None = None
+    simulation = Simulation(model)
     with RecordingWriter(path, units=model.units(), attrs=attrs, static=model.static()) as writer:
+
+        def record(state: Any, energy: Any) -> None:
+            fields = model.frame(state)
+            if energy is not None:
+                fields["energy"] = np.asarray(energy, dtype=np.float64)
+            writer.append(state.t, fields)
+            run.see(state.t, energy)
+            run.points = fields["points"].shape[0] if "points" in fields else 0
+
+        started = time.perf_counter()
+        record(simulation.raw_state, simulation.system.energy(simulation.raw_state))
         try:
             with stops.polled():
-                loop_recording = simulate(
-                    problem,
-                    settings.method,
-                    dt=settings.dt,
-                    t_end=problem.t0 + seconds,
-                    substeps=settings.substeps,
+                simulation.run(
+                    seconds,
                     record_every=settings.record_every,
+                    on_frame=record,
                     progress=progress,
-                    on_frame=lambda state, energy: writer.append(
-                        state.t, _frame(model, state.parts)
-                    ),
                 )
         except (SimulationError, Interrupted) as error:
             failure = error
-            loop_recording = error.recording
         except KeyboardInterrupt:
             # A second signal: the user wants out now; keep the frames already streamed.
             failure = Interrupted(stops.requested or "SIGINT", writer.last_time)
-            loop_recording = None
-        recording = None if loop_recording is None else _as_scene_recording(model, loop_recording)
-        final: dict[str, Any] = {"complete": failure is None}
+        counters = simulation.system.counters.as_dict()
+        run.counters = {"steps": counters["accepted_steps"]} | counters
+        final: dict[str, Any] = run.counters | {
+            "wall_time_s": time.perf_counter() - started,
+            "complete": failure is None,
+            "success": failure is None,
+            "message": "completed" if failure is None else str(failure),
+        }
         if isinstance(failure, Interrupted):
-            final |= {
-                "success": False,
-                "message": str(failure),
-                "interrupted": failure.signal,
-            }
-        if recording is not None:
-            series = {"energy": recording["energy"]} if "energy" in recording else {}
-            writer.finish(recording.attrs | {"scene": model.source or ""} | final, series)
-        else:
-            writer.finish(final)
-    return recording, failure
+            final["interrupted"] = failure.signal
+        writer.finish(final)
+    return run, failure
 
 
 def _summary(
     model: Model,
-    problem: Any,
-    recording: Any,
+    run: _Run,
     failure: Exception | None,
     seconds: float,
     tolerance: float,
 ) -> dict[str, Any]:
     """``summary.json`` of a scene run (wall time and Python warnings are added after)."""
-    from .io.job import run_summary
     from .simulation.interrupt import Interrupted
 
     settings = model.integration
-    reached = float(recording.time[-1]) if recording is not None else None
+    drift, largest = run.drift()
     summary: dict[str, Any] = {
         "scene": model.name,
-        "counts": _counts(model, problem, recording),
+        "counts": _counts(model, run),
         "method": settings.method,
         "dt": settings.dt,
         "duration_s": seconds,
-        "t_reached_s": reached,
+        "t_reached_s": run.t_reached if run.frames else None,
         "complete": failure is None,
         "success": failure is None,
         "message": "completed" if failure is None else str(failure),
-        "steps": 0,
-        "energy_drift": None,
+        "steps": int(run.counters.get("steps", 0)),
+        "energy_drift": drift,
+        "max_energy_error": largest,
         "energy_tolerance": tolerance,
         "warnings": [],
     }
     if isinstance(failure, Interrupted):
         summary["interrupted"] = failure.signal
-    if recording is None:
-        return summary
-    work = run_summary(recording)
-    summary["steps"] = int(work.get("steps", 0))
-    summary["energy_drift"] = drift = work["energy_drift"]
     if model.conservative and drift is not None and abs(drift) > tolerance:
         summary["warnings"].append(
-            {"kind": "energy_drift", "message": _energy_warning(model, problem, drift, tolerance)}
+            {"kind": "energy_drift", "message": _energy_warning(model, drift, tolerance)}
         )
     return summary
 
 
-def _energy_warning(model: Model, problem: Any, drift: float, tolerance: float) -> str:
+def _energy_warning(model: Model, drift: float, tolerance: float) -> str:
     from .integrators import get
     from .simulation.watch import energy_drift_advice, suggested_dt
 
     method = get(model.integration.method)
-    suggestion = suggested_dt(problem.system(), method, problem.initial_state())
+    suggestion = suggested_dt(model.system(), method, model.initial_state())
     return (
         f"the energy of this conservative scene changed by {100 * drift:+.3g} % (tolerance "
         f"{100 * tolerance:.3g} %, [integration] energy_tolerance). "
@@ -313,13 +353,15 @@ def _energy_warning(model: Model, problem: Any, drift: float, tolerance: float) 
     )
 
 
-def _counts(model: Model, problem: Any, recording: Any) -> dict[str, int]:
-    """What the scene holds: particles, or a system's degrees of freedom and drawn points."""
-    if model.system is None:
-        return {"particles": model.particle_count}
-    counts = {"degrees_of_freedom": int(problem.size)}
-    if recording is not None and "points" in recording:
-        counts["points"] = int(recording["points"].shape[1])
+def _counts(model: Model, run: _Run) -> dict[str, int]:
+    """What the scene holds: particle slots, systems' degrees of freedom, drawn points."""
+    counts = {}
+    if model.particle_count:
+        counts["particles"] = model.particle_count
+    if model.systems:
+        counts["degrees_of_freedom"] = model.coordinate_count
+        if run.points and run.points != model.particle_count:
+            counts["points"] = run.points
     return counts
 
 
@@ -356,7 +398,7 @@ def output_problems(model: Model, formats: Iterable[str], seconds: float) -> lis
         return []
     problems = []
     if not model.has_geometry:
-        name = model.system.system if model.system else ""
+        name = " and ".join(s.system for s in model.systems)
         problems.append(
             SceneProblem(
                 "output.formats",
@@ -386,26 +428,3 @@ def output_problems(model: Model, formats: Iterable[str], seconds: float) -> lis
             )
         )
     return problems
-
-
-def _frame(model: Model, parts: tuple[Any, ...]) -> dict[str, Any]:
-    """One recorded frame's fields (the model's frame fields for a single frame)."""
-    fields = model.frame_fields(tuple(p[None] for p in parts))
-    return {name: value[0] for name, value in fields.items()}
-
-
-def _as_scene_recording(model: Model, recording: Any) -> Any:
-    """The loop's recording (``q``, ``v`` or ``y``) as the scene's fields and static arrays."""
-    from .simulation.recording import Recording
-
-    names = ("y",) if "y" in recording else ("q", "v")
-    fields = model.frame_fields(tuple(recording[name] for name in names))
-    if "energy" in recording:
-        fields["energy"] = recording["energy"]
-    return Recording(
-        recording.time,
-        fields,
-        units=model.units(),
-        attrs=recording.attrs | {"scene_name": model.name},
-        static=model.static(),
-    )

@@ -73,7 +73,8 @@ def run_command(
     model = load_model(scene)
     if dry_run:
         estimate = plan(model, duration=duration, formats=formats or ())
-        what = f"system {estimate.system}" if estimate.system else f"{estimate.particles} particles"
+        held = [f"{estimate.particles} particles"] if estimate.particles else []
+        what = ", ".join(held + [f"system {name}" for name in estimate.systems])
         limit = estimate.max_stable_dt
         advice = (
             "no step limit from the linearization"
@@ -102,14 +103,16 @@ def validate_command(scene: SceneArgument) -> None:
     from ..scenes import load_model
 
     model = load_model(scene)
-    what = f"system {model.system.system}" if model.system else f"{model.particle_count} particles"
+    held = [f"{model.particle_count} particles"] if model.particle_count else []
+    held += [f"system {s.system}" for s in model.systems]
+    what = ", ".join(held)
     typer.echo(f"{scene}: valid ({what}, method {model.integration.method})")
 
 
 @app.command("schema")
 def schema_command() -> None:
     """Print the JSON Schema of scene files (for editor completion)."""
-    from ..io.scene_schema import Scene
+    from ..model.scene import Scene
 
     print_json(Scene.model_json_schema())
 

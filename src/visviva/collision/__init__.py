@@ -1,7 +1,9 @@
 """Collision geometry: static collider shapes and the Numba queries collision kernels call.
 
 Particles (points with a radius) collide with static colliders. This package gives their
-geometry; the collision stage builds the response on it.
+geometry and the two responses: the collision stage (impulses with restitution and friction,
+time of impact by bisection; :mod:`~visviva.collision.response`) and the penalty force
+(:mod:`~visviva.collision.penalty`).
 
 * :mod:`~visviva.collision.shapes`: :class:`Plane` (half-space or slab), :class:`Sphere`,
   :class:`Box`, :class:`TriangleMesh`, validated at construction, each with vectorized
@@ -26,13 +28,21 @@ and the normal is the outward unit normal at the closest surface point.
 from __future__ import annotations
 
 from .bvh import MeshBVH
+from .colliders import MAX_COLLIDERS, ColliderSet
+from .penalty import PenaltyContact
+from .response import ColliderResponse, ParticleCollisions
 from .shapes import Box, Plane, Sphere, TriangleMesh
 from .tables import ColliderKind, collider_table
 
 __all__ = [
+    "MAX_COLLIDERS",
     "Box",
     "ColliderKind",
+    "ColliderResponse",
+    "ColliderSet",
     "MeshBVH",
+    "ParticleCollisions",
+    "PenaltyContact",
     "Plane",
     "Sphere",
     "TriangleMesh",

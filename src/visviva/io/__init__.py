@@ -8,11 +8,15 @@ from .recording import (
     save_recording,
     write_recordings,
 )
+from .scene_files import dump_scene, load_scene, parse_scene
 
 __all__ = [
     "FORMAT",
     "FORMAT_VERSION",
+    "dump_scene",
     "load_recording",
+    "load_scene",
+    "parse_scene",
     "read_recordings",
     "save_recording",
     "write_recordings",

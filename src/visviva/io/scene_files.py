@@ -1,7 +1,7 @@
 """Reading and writing scene files (TOML or JSON), with every problem reported at once.
 
 :func:`load_scene` reads a file, refuses what is not a scene (too large, not UTF-8, a syntax
-error with its line and column), validates it against :mod:`~visviva.io.scene_schema` and
+error with its line and column), validates it against :mod:`~visviva.model.scene` and
 reports each validation problem as ``path: message (got X)`` with the line where it can be
 found and a did-you-mean for misspelt keys. :func:`dump_scene` writes a scene back; floats are
 written with ``repr`` (the shortest text that reads back to the same double), so a
@@ -18,13 +18,13 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from pydantic import BaseModel, ValidationError
+from pydantic import ValidationError
 
-from .._validation import describe, did_you_mean
+from .._validation import describe
 from ..errors import SceneError, SceneProblem
+from ..model.scene import Scene
+from ..model.scene_errors import scene_problems
 from .scene_locate import locate_json, locate_toml
-from .scene_schema import Integration, Output, ParticleCloud, Particles, Scene, SceneInfo, System
-from .scene_schema import World as WorldSettings
 
 __all__ = ["MAX_SCENE_BYTES", "dump_scene", "load_scene", "parse_scene"]
 
@@ -33,20 +33,6 @@ MAX_SCENE_BYTES = 16 * 2**20
 #: Deepest nesting of tables and arrays a scene may have: the schema needs 5 (entity
 #: parameters, positions); deeper is a mistake, and unbounded depth would exhaust the stack.
 MAX_DEPTH = 16
-
-#: Names pydantic gives the branches of a union in error locations (never scene keys).
-_UNION_BRANCH = re.compile(r"^(float|int|str|list|tuple|dict|[a-z]+(-[a-z]+)+)$|\[")
-_TABLES: dict[str, type[BaseModel]] = {
-    "scene": SceneInfo,
-    "world": WorldSettings,
-    "integration": Integration,
-    "output": Output,
-}
-_ENTITIES: dict[str, type[BaseModel]] = {
-    "particles": Particles,
-    "particle_cloud": ParticleCloud,
-    "system": System,
-}
 
 
 def load_scene(path: str | os.PathLike[str]) -> tuple[Scene, str]:
@@ -161,7 +147,8 @@ def parse_scene(text: str, format: str = "toml", source: str | None = None) -> S
         return Scene.model_validate(raw)
     except ValidationError as exc:
         locate = locate_json if format == "json" else locate_toml
-        raise SceneError(_problems(exc, raw, lambda path: locate(text, path)), source) from None
+        problems = scene_problems(exc, raw, lambda path: locate(text, path))
+        raise SceneError(problems, source) from None
 
 
 #: One line's string literals (basic or literal), replaced by a placeholder before key scanning.
@@ -207,68 +194,6 @@ def _depth(data: Any) -> int:
         if depth <= MAX_DEPTH:  # deeper is refused anyway: no need to walk it all
             pending.extend((child, depth + 1) for child in children)
     return deepest
-
-
-def _problems(exc: ValidationError, raw: dict[str, Any], line_of: Any) -> list[SceneProblem]:
-    """One problem per field: pydantic reports each branch of a union; keep the telling one."""
-    chosen: dict[tuple[Any, ...], Any] = {}
-    for error in exc.errors(include_url=False):
-        path = _field_path(error["loc"])
-        previous = chosen.get(path)
-        if previous is None or (
-            previous["type"].endswith("_type") and not error["type"].endswith("_type")
-        ):
-            chosen[path] = error
-    problems = []
-    for path, error in chosen.items():
-        message = error["msg"].replace("Input should be", "must be", 1)
-        got: str | None = describe(error["input"])
-        if error["type"] == "extra_forbidden":
-            key = str(path[-1])
-            allowed = _allowed_keys(path[:-1], raw)
-            message = f"unknown key.{did_you_mean(key, allowed)} Allowed: {', '.join(allowed)}"
-            got = None
-        elif error["type"] == "missing":
-            got = None
-        elif error["type"] == "union_tag_invalid":
-            message = f"unknown entity type; valid types: {', '.join(_ENTITIES)}"
-            got = describe(error["input"].get("type") if isinstance(error["input"], dict) else None)
-        elif error["type"] == "finite_number":
-            message = "must be a finite number (numbers beyond ±1.8e308 overflow to inf)"
-        problems.append(SceneProblem(_dotted(path), message, got, line_of(path)))
-    return problems
-
-
-def _field_path(loc: tuple[Any, ...]) -> tuple[Any, ...]:
-    """The error's location as the user wrote it: no union-branch or entity-tag segments."""
-    path: list[Any] = []
-    for position, segment in enumerate(loc):
-        if isinstance(segment, str) and _UNION_BRANCH.search(segment):
-            continue  # a union branch name such as "constrained-float", not a key
-        if position == 2 and loc[0] == "entities" and segment in _ENTITIES:
-            continue  # the discriminator's branch, not a key
-        path.append(segment)
-    return tuple(path)
-
-
-def _allowed_keys(path: tuple[Any, ...], raw: dict[str, Any]) -> list[str]:
-    model: type[BaseModel] | None = Scene
-    if len(path) == 1:
-        model = _TABLES.get(str(path[0]))
-    elif len(path) == 2 and path[0] == "entities":
-        entities = raw.get("entities")
-        entity = entities[path[1]] if isinstance(entities, list) else None
-        model = _ENTITIES.get(str(entity.get("type"))) if isinstance(entity, dict) else None
-    elif path:
-        model = None
-    return list(model.model_fields) if model is not None else []
-
-
-def _dotted(path: tuple[Any, ...]) -> str:
-    text = ""
-    for segment in path:
-        text += f"[{segment}]" if isinstance(segment, int) else f".{segment}" if text else segment
-    return text
 
 
 def dump_scene(scene: Scene, format: str = "toml") -> str:

@@ -1,8 +1,9 @@
-"""Scenes as data: the frozen Model, the builder and the named systems."""
+"""Scenes as data: the scene description, the builder, the frozen Model and the named systems."""
 
 from .build import build_model
 from .builder import SceneBuilder
 from .model import Integration, Model, ParticleGroup, SystemInstance
+from .scene import Scene
 from .systems import SYSTEMS
 
 __all__ = [
@@ -10,6 +11,7 @@ __all__ = [
     "Integration",
     "Model",
     "ParticleGroup",
+    "Scene",
     "SceneBuilder",
     "SystemInstance",
     "build_model",

@@ -1,9 +1,11 @@
-"""From a validated :class:`~visviva.io.scene_schema.Scene` to the frozen :class:`Model`.
+"""From a validated :class:`~visviva.model.scene.Scene` to the frozen :class:`Model`.
 
 The schema checks each field on its own; this module checks what spans fields and entities —
-list lengths that must agree, unique names, known systems and parameters, what may be mixed,
-the total particle count and step count — and reports every problem at once as a
-:class:`~visviva.errors.SceneError`. Only then does it allocate the particle arrays.
+list lengths that must agree, unique names, targets that name existing entities, the total
+particle count and step count — and reports every problem at once as a
+:class:`~visviva.errors.SceneError`. Only then does it allocate the entity arrays and make the
+pieces the run needs: the particle forces (world gravity first), the named systems' problems,
+the collision stage and the emission stage (:mod:`.parts`).
 """
 
 from __future__ import annotations
@@ -14,13 +16,37 @@ import numpy as np
 
 from .._validation import describe, did_you_mean
 from ..errors import ModelError, SceneError, SceneProblem
-from ..io.scene_schema import MAX_PARTICLES, ParticleCloud, Particles, Scene, System
-from ..ode.problems import SecondOrderProblem
 from ..simulation.loop import MAX_STEPS
-from .model import Integration, Model, ParticleGroup, SystemInstance, frozen_array
+from .model import Integration, Model, SystemInstance, frozen_array
+from .parts import (
+    Located,
+    collision_stage,
+    emitter_specs,
+    force_objects,
+    particle_arrays,
+    penalty_forces,
+)
+from .scene import (
+    MAX_PARTICLES,
+    Collider,
+    Emitter,
+    ForceField,
+    ParticleCloud,
+    Particles,
+    Scene,
+    System,
+)
 from .systems import SYSTEMS
 
-__all__ = ["build_model"]
+__all__ = ["build_model", "entity_names"]
+
+#: Entities that hold particles (which forces and colliders may target).
+PARTICLE_ENTITIES = (Particles, ParticleCloud, Emitter)
+
+
+def entity_names(scene: Scene) -> list[str]:
+    """Each entity's name: its own, or its type and index (``particles0``, ``emitter2``)."""
+    return [e.name or f"{e.type}{i}" for i, e in enumerate(scene.entities)]
 
 
 def build_model(scene: Scene, source: str | None = None) -> Model:
@@ -28,7 +54,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
 
     Args:
         scene: A validated scene (from a file or a builder).
-        source: The scene file's text, kept in the model for recordings.
+        source: The scene file's text, if it came from one (kept in recordings).
 
     Raises:
         SceneError: Listing every problem found.
@@ -36,106 +62,140 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     problems = _check(scene)
     if problems:
         raise SceneError(problems)
-    particles = [e for e in scene.entities if not isinstance(e, System)]
-    systems = [e for e in scene.entities if isinstance(e, System)]
-    integration = scene.integration
-    position, velocity, mass, radius, groups = _particle_arrays(particles)
-    system = None
-    if systems:
-        entity = systems[0]
-        kind = SYSTEMS[entity.system]
-        values = {k: p.default for k, p in kind.parameters.items()} | dict(entity.parameters)
-        system = SystemInstance(entity.name or entity.system, entity.system, values)
+    settings = scene.integration
+    names = entity_names(scene)
+    specs = emitter_specs(scene, names, settings.duration)
+    arrays, groups = particle_arrays(scene, names, specs)
+    count = arrays["position"].shape[0]
+    if count > MAX_PARTICLES:
+        raise SceneError(
+            [
+                SceneProblem(
+                    "entities",
+                    f"{count} particle slots in all (emitters count their capacity); the limit "
+                    f"is {MAX_PARTICLES}",
+                )
+            ]
+        )
+    h = settings.dt / settings.substeps
+    try:
+        systems = _systems(scene, names)
+        forces = force_objects(scene, groups, arrays["mass"])
+        forces += penalty_forces(scene, groups, arrays["mass"], arrays["radius"])
+        stages = []
+        collisions = collision_stage(scene, groups, count, h)
+        if collisions is not None:
+            stages.append(collisions)
+        if specs:
+            from ..particles.emission import Emission
+
+            stages.append(Emission(specs))
+    except Located as located:
+        raise SceneError([located.problem]) from None
     model = Model(
         name=scene.scene.name,
+        scene=scene,
         gravity=frozen_array(scene.world.gravity),
         integration=Integration(
-            method=integration.method,
-            dt=integration.dt,
-            duration=integration.duration,
-            substeps=integration.substeps,
-            record_every=integration.record_every
-            or Integration.default_record_every(integration.dt),
-            energy_tolerance=integration.energy_tolerance,
+            method=settings.method,
+            dt=settings.dt,
+            duration=settings.duration,
+            substeps=settings.substeps,
+            record_every=settings.record_every or Integration.default_record_every(settings.dt),
+            energy_tolerance=settings.energy_tolerance,
         ),
-        particle_position=position,
-        particle_velocity=velocity,
-        particle_mass=mass,
-        particle_radius=radius,
-        particle_groups=groups,
-        system=system,
+        particle_position=frozen_array(arrays["position"]),
+        particle_velocity=frozen_array(arrays["velocity"]),
+        particle_mass=frozen_array(arrays["mass"]),
+        particle_radius=frozen_array(arrays["radius"]),
+        particle_color=frozen_array(arrays["color"]),
+        particle_alive=frozen_array(arrays["alive"], dtype=bool),
+        particle_groups=tuple(groups),
+        systems=tuple(systems),
+        forces=tuple(forces),
+        emitters=tuple(specs),
+        stages=tuple(stages),
         output_formats=tuple(scene.output.formats),
         output_fps=scene.output.fps,
         output_speed=scene.output.speed,
         output_trail=scene.output.trail,
         source=source,
     )
-    problems = _check_start(model, scene)
+    problems = _check_start(model)
     if problems:
         raise SceneError(problems)
     return model
 
 
-def _check_start(model: Model, scene: Scene) -> list[SceneProblem]:
-    """Problems only the built model shows: a state that overflowed while being placed, or
-    values that cannot give a finite start (``omega = 1e200`` squares to inf, a mass of 1e200
-    at 10 m/s has an infinite kinetic energy).
-
-    The model's problem is built and its initial acceleration and energy are evaluated once, so
-    a scene that ``visviva validate`` accepts also starts in ``visviva run``.
-    """
-    if model.system is None:
-        for name in ("particle_position", "particle_velocity"):
-            bad = ~np.isfinite(getattr(model, name))
-            if bad.any():
-                index = int(np.argwhere(bad)[0][0])
-                entity, group = next(
-                    (k, g)
-                    for k, g in enumerate(model.particle_groups)
-                    if g.start <= index < g.start + g.count
-                )
-                return [
-                    SceneProblem(
-                        f"entities[{entity}]",
-                        f"particle {index - group.start} starts with a non-finite "
-                        f"{name.removeprefix('particle_')}: the values overflow a float",
-                    )
-                ]
-        where = "entities"
-        values: Mapping[str, float] = {}
-    else:
-        index = next(i for i, e in enumerate(scene.entities) if isinstance(e, System))
+def _systems(scene: Scene, names: list[str]) -> list[SystemInstance]:
+    systems, offset = [], 0
+    for index, entity in enumerate(scene.entities):
+        if not isinstance(entity, System):
+            continue
+        kind = SYSTEMS[entity.system]
+        values = {k: p.default for k, p in kind.parameters.items()} | dict(entity.parameters)
         where = f"entities[{index}].parameters"
-        values = model.system.parameters
-    try:
-        with np.errstate(all="ignore"):  # overflow is judged by the results below
-            problem = model.problem()
-            system = problem.system()
-            start = problem.initial_state()
-            values_at_start = [*system.derivative(start.t, start.parts)]
-            if system.has_energy:
-                values_at_start.append(np.asarray(system.energy(start)))
-    except ModelError as error:
-        if model.system is None:
-            return [SceneProblem(where, _NOT_FINITE)]
-        return [_located(str(error), where, values)]
-    except (OverflowError, ZeroDivisionError, FloatingPointError, ValueError):
-        return [
-            SceneProblem(
-                where,
-                "these values overflow a float while the system is set up (the largest float "
-                "is 1.8e308): use smaller values or other units",
-            )
-        ]
-    if not all(np.isfinite(v).all() for v in values_at_start):
-        return [SceneProblem(where, _NOT_FINITE)]
-    return []
+        try:
+            with np.errstate(all="ignore"):  # overflow is judged by the start check
+                problem = kind.build(values, np.asarray(scene.world.gravity))
+        except ModelError as error:
+            problem = _located(str(error), where, values)
+            raise Located(problem.path, problem.message) from None
+        except (OverflowError, ZeroDivisionError, FloatingPointError, ValueError):
+            raise Located(where, _OVERFLOW) from None
+        systems.append(SystemInstance(names[index], entity.system, values, index, offset, problem))
+        offset += problem.size
+    return systems
 
 
+_OVERFLOW = (
+    "these values overflow a float while the system is set up (the largest float is 1.8e308): "
+    "use smaller values or other units"
+)
 _NOT_FINITE = (
     "these values give a non-finite initial acceleration or energy (a mass, speed, length or "
     "position too large or too small to compute with, beyond ±1.8e308): use other values or units"
 )
+
+
+def _check_start(model: Model) -> list[SceneProblem]:
+    """Problems only the built model shows: a state that overflowed while being placed, or
+    values that cannot give a finite start (``omega = 1e200`` squares to inf, a mass of 1e200
+    at 10 m/s has an infinite kinetic energy).
+
+    The model's system is built and its initial acceleration and energy are evaluated once, so
+    a scene that ``visviva validate`` accepts also starts in ``visviva run``.
+    """
+    for name in ("particle_position", "particle_velocity"):
+        bad = ~np.isfinite(getattr(model, name))
+        if bad.any():
+            index = int(np.argwhere(bad)[0][0])
+            group = next(g for g in model.particle_groups if g.start <= index < g.start + g.count)
+            return [
+                SceneProblem(
+                    f"entities[{group.entity}]",
+                    f"particle {index - group.start} starts with a non-finite "
+                    f"{name.removeprefix('particle_')}: the values overflow a float",
+                )
+            ]
+    where = "entities"
+    values: Mapping[str, float] = {}
+    if model.systems:
+        where = f"entities[{model.systems[0].entity}].parameters"
+        values = model.systems[0].parameters
+    try:
+        with np.errstate(all="ignore"):  # overflow is judged by the results below
+            system = model.system()
+            start = model.initial_state()
+            results = [*system.derivative(start.t, start.parts)]
+            results.append(np.asarray(system.energy(start)))
+    except ModelError as error:
+        return [_located(str(error), where, values)]
+    except (OverflowError, ZeroDivisionError, FloatingPointError, ValueError):
+        return [SceneProblem(where, _OVERFLOW)]
+    if not all(np.isfinite(v).all() for v in results):
+        return [SceneProblem(where, _NOT_FINITE)]
+    return []
 
 
 def _located(message: str, where: str, values: Mapping[str, float]) -> SceneProblem:
@@ -155,33 +215,17 @@ def _located(message: str, where: str, values: Mapping[str, float]) -> SceneProb
 def _check(scene: Scene) -> list[SceneProblem]:
     problems: list[SceneProblem] = []
     entities = scene.entities
-    if not entities:
+    if not any(isinstance(e, (*PARTICLE_ENTITIES, System)) for e in entities):
+        what = "nothing in this scene moves" if entities else "the scene is empty"
         problems.append(
             SceneProblem(
                 "entities",
-                "the scene is empty; add at least one [[entities]] table "
-                '(type = "particles", "particle_cloud" or "system")',
+                f'{what}; add at least one [[entities]] table of type "particles", '
+                '"particle_cloud", "emitter" or "system"',
             )
         )
-    dt, duration = scene.integration.dt, scene.integration.duration
-    if dt > duration:
-        problems.append(
-            SceneProblem(
-                "integration.dt",
-                f"the step is longer than the duration ({duration!r} s); use dt <= duration",
-                repr(dt),
-            )
-        )
-    elif duration / dt * scene.integration.substeps > MAX_STEPS:
-        steps = duration / dt * scene.integration.substeps
-        problems.append(
-            SceneProblem(
-                "integration.dt",
-                f"{steps:.3g} integrator steps (substeps included) to reach the duration; the "
-                f"limit is {MAX_STEPS:.0e}",
-                repr(dt),
-            )
-        )
+    problems += _check_steps(scene)
+    names = entity_names(scene)
     seen: dict[str, int] = {}
     total = 0
     for index, entity in enumerate(entities):
@@ -203,7 +247,7 @@ def _check(scene: Scene) -> list[SceneProblem]:
             problems += _check_lengths(entity, where)
         elif isinstance(entity, ParticleCloud):
             total += entity.count
-        else:
+        elif isinstance(entity, System):
             problems += _check_system(entity, where)
     if total > MAX_PARTICLES:
         problems.append(
@@ -212,19 +256,83 @@ def _check(scene: Scene) -> list[SceneProblem]:
                 f"{total} particles in all; the limit is {MAX_PARTICLES} (about 2.4 GB of state)",
             )
         )
-    systems = [i for i, e in enumerate(entities) if isinstance(e, System)]
-    if systems and len(systems) != len(entities):
-        problems.append(
-            SceneProblem(
-                f"entities[{systems[0]}]",
-                "a named system runs on its own: put it in a scene without particles",
-            )
-        )
-    elif len(systems) > 1:
-        problems.append(
-            SceneProblem(f"entities[{systems[1]}]", "a scene holds at most one named system")
-        )
+    problems += _check_targets(scene, names)
+    problems += _check_first_order(scene)
     return problems
+
+
+def _check_steps(scene: Scene) -> list[SceneProblem]:
+    dt, duration = scene.integration.dt, scene.integration.duration
+    if dt > duration:
+        return [
+            SceneProblem(
+                "integration.dt",
+                f"the step is longer than the duration ({duration!r} s); use dt <= duration",
+                repr(dt),
+            )
+        ]
+    steps = duration / dt * scene.integration.substeps
+    if steps > MAX_STEPS:
+        return [
+            SceneProblem(
+                "integration.dt",
+                f"{steps:.3g} integrator steps (substeps included) to reach the duration; the "
+                f"limit is {MAX_STEPS:.0e}",
+                repr(dt),
+            )
+        ]
+    return []
+
+
+def _check_targets(scene: Scene, names: list[str]) -> list[SceneProblem]:
+    """Targets must name entities that hold particles; gravitation may not target emitters."""
+    holders = {
+        names[i]: e for i, e in enumerate(scene.entities) if isinstance(e, PARTICLE_ENTITIES)
+    }
+    problems = []
+    for index, entity in enumerate(scene.entities):
+        if not isinstance(entity, (ForceField, Collider)) or entity.targets is None:
+            continue
+        for k, target in enumerate(entity.targets):
+            where = f"entities[{index}].targets[{k}]"
+            if target not in holders:
+                problems.append(
+                    SceneProblem(
+                        where,
+                        f"no particle entity is called {target!r}.{did_you_mean(target, holders)}"
+                        f" Particle entities: {', '.join(holders) or 'none'}",
+                    )
+                )
+            elif (
+                isinstance(entity, ForceField)
+                and entity.kind == "gravitation"
+                and isinstance(holders[target], Emitter)
+            ):
+                problems.append(
+                    SceneProblem(
+                        where,
+                        "gravitation acts among particles that live for the whole run; an "
+                        "emitter's particles are born and die (target particles or a "
+                        "particle_cloud instead)",
+                    )
+                )
+    return problems
+
+
+def _check_first_order(scene: Scene) -> list[SceneProblem]:
+    """A first-order system (Dahlquist's test equation) has no positions to mix with others."""
+    for index, entity in enumerate(scene.entities):
+        if isinstance(entity, System) and entity.system == "test-equation":
+            moving = [e for e in scene.entities if isinstance(e, (*PARTICLE_ENTITIES, System))]
+            if len(moving) > 1:
+                return [
+                    SceneProblem(
+                        f"entities[{index}]",
+                        "the test equation is a first-order system without positions: put it "
+                        "in a scene of its own",
+                    )
+                ]
+    return []
 
 
 def _check_lengths(entity: Particles, where: str) -> list[SceneProblem]:
@@ -271,44 +379,3 @@ def _check_system(entity: System, where: str) -> list[SceneProblem]:
                 SceneProblem(path, f"must be at most {parameter.maximum:g}", repr(value))
             )
     return problems
-
-
-def _particle_arrays(
-    entities: list[Particles | ParticleCloud],
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, tuple[ParticleGroup, ...]]:
-    """Particle state and properties of every particle entity, in entity order."""
-    positions, velocities, masses, radii, groups = [], [], [], [], []
-    start = 0
-    for index, entity in enumerate(entities):
-        if isinstance(entity, Particles):
-            x = np.array(entity.positions, dtype=np.float64)
-            count = x.shape[0]
-            v = (
-                np.zeros_like(x)
-                if entity.velocities is None
-                else np.array(entity.velocities, dtype=np.float64)
-            )
-        else:
-            count = entity.count
-            rng = np.random.default_rng(entity.seed)
-            x = np.asarray(entity.center) + (rng.random((count, 3)) - 0.5) * np.asarray(entity.size)
-            v = np.asarray(entity.velocity) + entity.velocity_jitter * rng.standard_normal(
-                (count, 3)
-            )
-        positions.append(x)
-        velocities.append(v)
-        masses.append(np.broadcast_to(np.asarray(entity.mass, dtype=np.float64), (count,)))
-        radii.append(np.broadcast_to(np.asarray(entity.radius, dtype=np.float64), (count,)))
-        groups.append(ParticleGroup(entity.name or f"{entity.type}{index}", start, count))
-        start += count
-
-    def joined(arrays: list[np.ndarray], shape: tuple[int, ...]) -> np.ndarray:
-        return frozen_array(np.concatenate(arrays) if arrays else np.zeros(shape))
-
-    return (
-        joined(positions, (0, 3)),
-        joined(velocities, (0, 3)),
-        joined(masses, (0,)),
-        joined(radii, (0,)),
-        tuple(groups),
-    )

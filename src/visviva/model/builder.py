@@ -1,21 +1,27 @@
 """The Python way to write a scene: ``vv.SceneBuilder`` → ``build()`` → frozen Model.
 
-The builder holds the same validated scene a file would (:mod:`visviva.io.scene_schema`), so a
-scene built in Python and the same scene read from TOML give the same Model, and
-:meth:`SceneBuilder.dump` writes the file that reproduces it. Each ``add_*`` validates its
-entity at once and returns the entity's id (its index in the scene).
+The builder holds the same validated scene description a file would
+(:mod:`visviva.model.scene`), so a scene built in Python and the same scene read from TOML give
+the same Model, and ``vv.io.dump_scene(builder.scene)`` writes the file that reproduces it. Each
+``add_*`` validates its entity at once (typed keywords; an argument left at ``None`` takes the
+scene file's default) and returns the entity's index in the scene.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
 from pydantic import BaseModel, ValidationError
 
 from ..errors import SceneError
-from ..io.scene_files import _problems, dump_scene
-from ..io.scene_schema import (
+from .build import build_model
+from .model import Model
+from .scene import (
+    Collider,
+    Emitter,
+    ForceField,
     Integration,
     Output,
     ParticleCloud,
@@ -24,10 +30,11 @@ from ..io.scene_schema import (
     System,
     World,
 )
-from .build import build_model
-from .model import Model
+from .scene_errors import scene_problems
 
 __all__ = ["SceneBuilder"]
+
+Vector = Sequence[float]
 
 
 class SceneBuilder:
@@ -41,11 +48,15 @@ class SceneBuilder:
         >>> import visviva as vv
         >>> builder = vv.SceneBuilder(name="drop")
         >>> builder.set_integration(method="symplectic_euler", dt=0.01, duration=1.0)
-        >>> builder.add_particles(positions=[[0.0, 2.0, 0.0]], mass=0.5, name="ball")
+        >>> builder.add_particles([[0.0, 2.0, 0.0]], mass=0.5, name="ball")
         0
+        >>> builder.add_force("drag", coefficient=0.1, targets=["ball"])
+        1
+        >>> builder.add_collider("plane", point=(0, 0, 0), normal=(0, 1, 0), restitution=0.8)
+        2
         >>> model = builder.build()
-        >>> model.particle_count, float(model.particle_mass[0])
-        (1, 0.5)
+        >>> model.particle_count, float(model.particle_mass[0]), len(model.forces)
+        (1, 0.5, 2)
     """
 
     def __init__(self, *, name: str = "untitled", description: str = "") -> None:
@@ -60,49 +71,176 @@ class SceneBuilder:
 
     @property
     def scene(self) -> Scene:
-        """The validated scene so far."""
+        """The validated scene description so far."""
         return self._scene
 
-    def set_world(self, *, gravity: Sequence[float] = (0.0, -9.81, 0.0)) -> None:
-        """Set the gravitational acceleration [m/s²] (Y up)."""
+    def set_world(self, *, gravity: Vector = (0.0, -9.81, 0.0)) -> None:
+        """Set the gravitational acceleration [m/s²] (Y up) acting on every particle."""
         self._replace(world=_validated(World, "world", gravity=gravity))
 
-    def set_integration(self, **settings: Any) -> None:
-        """Set ``method``, ``dt`` [s], ``duration`` [s], ``substeps``, ``record_every``."""
-        self._replace(integration=_validated(Integration, "integration", **settings))
+    def set_integration(
+        self,
+        *,
+        method: str | None = None,
+        dt: float | None = None,
+        duration: float | None = None,
+        substeps: int | None = None,
+        record_every: int | None = None,
+        energy_tolerance: float | None = None,
+    ) -> None:
+        """Set the integrator ``method``, the step ``dt`` [s], the ``duration`` [s], the
+        ``substeps`` per step, ``record_every`` k-th step, and the ``energy_tolerance``."""
+        self._replace(integration=_validated(Integration, "integration", **_given(locals())))
 
-    def set_output(self, **settings: Any) -> None:
-        """Set the extra output ``formats`` of ``visviva run``, their ``fps`` and ``speed``
-        (simulated seconds per second of playback)."""
-        self._replace(output=_validated(Output, "output", **settings))
+    def set_output(
+        self,
+        *,
+        formats: Sequence[str] | None = None,
+        fps: float | None = None,
+        speed: float | None = None,
+        trail: float | None = None,
+    ) -> None:
+        """Set the extra output ``formats`` of ``visviva run``, their ``fps``, ``speed``
+        (simulated seconds per second of playback) and ``trail`` [s]."""
+        self._replace(output=_validated(Output, "output", **_given(locals())))
 
-    def add_particles(self, **fields: Any) -> int:
-        """Add particles at ``positions`` [m] with optional ``velocities`` [m/s], ``mass`` [kg],
-        ``radius`` [m] and ``name``; returns the entity id."""
-        return self._add(Particles, fields | {"type": "particles"})
+    def add_particles(
+        self,
+        positions: Any,
+        *,
+        velocities: Any = None,
+        mass: float | Sequence[float] | None = None,
+        radius: float | Sequence[float] | None = None,
+        color: Vector | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add particles at ``positions`` [m] ``(n, 3)`` with ``velocities`` [m/s], ``mass`` [kg]
+        and ``radius`` [m] (one value or one per particle) and an sRGB ``color``."""
+        return self._add(Particles, "particles", _given(locals()))
 
-    def add_particle_cloud(self, **fields: Any) -> int:
-        """Add ``count`` particles at random in a box (``center``, ``size`` [m], ``velocity``,
-        ``velocity_jitter`` [m/s], ``mass``, ``radius``, ``seed``); returns the entity id."""
-        return self._add(ParticleCloud, fields | {"type": "particle_cloud"})
+    def add_particle_cloud(
+        self,
+        count: int,
+        *,
+        center: Vector | None = None,
+        size: Vector | None = None,
+        velocity: Vector | None = None,
+        velocity_jitter: float | None = None,
+        mass: float | None = None,
+        radius: float | None = None,
+        color: Vector | None = None,
+        seed: int | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add ``count`` particles at random in a box (``center``, edge lengths ``size`` [m]),
+        with a mean ``velocity`` and a ``velocity_jitter`` [m/s], ``mass``, ``radius``, ``seed``."""
+        return self._add(ParticleCloud, "particle_cloud", _given(locals()))
 
-    def add_system(self, system: str, *, name: str | None = None, **parameters: float) -> int:
+    def add_system(
+        self, system: str, parameters: Mapping[str, float] | None = None, *, name: str | None = None
+    ) -> int:
         """Add a named system (``visviva schema`` lists them: ``pendulum``, ``kepler``, ...)
-        with parameter values; returns the entity id."""
-        fields = {"type": "system", "system": system, "name": name, "parameters": parameters}
-        return self._add(System, fields)
+        with parameter values (omitted ones take their defaults)."""
+        return self._add(System, "system", _given(locals()))
+
+    def add_emitter(
+        self,
+        *,
+        rate: float | None = None,
+        start: float | None = None,
+        stop: float | None = None,
+        bursts: Sequence[Mapping[str, float]] | None = None,
+        shape: str | None = None,
+        position: Vector | None = None,
+        radius: float | None = None,
+        extent: Vector | None = None,
+        normal: Vector | None = None,
+        surface: bool | None = None,
+        vertices: Any = None,
+        triangles: Any = None,
+        direction: Vector | None = None,
+        spread: float | None = None,
+        speed: float | Sequence[float] | None = None,
+        lifetime: float | Sequence[float] | None = None,
+        particle_radius: float | Sequence[float] | None = None,
+        particle_mass: float | None = None,
+        color: Vector | None = None,
+        color_ramp: Sequence[Sequence[float]] | None = None,
+        size_ramp: Sequence[Sequence[float]] | None = None,
+        capacity: int | None = None,
+        seed: int | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add an emitter (see :class:`visviva.model.scene.Emitter` for every field): particles
+        born at ``rate`` [1/s] and in ``bursts`` (``{"time": s, "count": n}``) from a ``shape``
+        (point, disc, sphere, box, mesh), flying out along ``direction`` within ``spread``
+        degrees at ``speed`` [m/s], living ``lifetime`` [s]; ranges are ``[low, high]``."""
+        return self._add(Emitter, "emitter", _given(locals()))
+
+    def add_force(
+        self,
+        kind: str,
+        *,
+        targets: Sequence[str] | None = None,
+        coefficient: float | None = None,
+        velocity: Vector | None = None,
+        rate: float | None = None,
+        point: Vector | None = None,
+        strength: float | None = None,
+        softening: float | None = None,
+        axis: Vector | None = None,
+        circulation: float | None = None,
+        core_radius: float | None = None,
+        G: float | None = None,
+        method: str | None = None,
+        theta: float | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add a force on particles (all, or the entities named in ``targets``): ``"drag"``
+        (``coefficient`` k [N·s/m]: F = −k v), ``"wind"`` (``velocity``, ``coefficient``),
+        ``"quadratic_drag"`` (``coefficient`` [kg/m]), ``"damping"`` (``rate`` [1/s]),
+        ``"attractor"`` (``point``, ``strength`` [m³/s²], ``softening``), ``"vortex"``
+        (``point``, ``axis``, ``circulation`` [m²/s], ``coefficient``, ``core_radius``) or
+        ``"gravitation"`` among them (``G``, ``softening``, ``method``, ``theta``)."""
+        return self._add(ForceField, "force", _given(locals()))
+
+    def add_collider(
+        self,
+        shape: str,
+        *,
+        point: Vector | None = None,
+        normal: Vector | None = None,
+        thickness: float | None = None,
+        center: Vector | None = None,
+        radius: float | None = None,
+        size: Vector | None = None,
+        orientation: Sequence[float] | None = None,
+        vertices: Any = None,
+        triangles: Any = None,
+        restitution: float | None = None,
+        friction: float | None = None,
+        response: str | None = None,
+        stiffness: float | None = None,
+        damping: float | None = None,
+        time_of_impact: bool | None = None,
+        resting_speed: float | None = None,
+        targets: Sequence[str] | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add a static collider: ``"plane"`` (``point``, ``normal``, optional ``thickness``),
+        ``"sphere"`` (``center``, ``radius``), ``"box"`` (``center``, ``size``,
+        ``orientation``) or ``"mesh"`` (``vertices``, ``triangles``), with ``restitution`` e,
+        ``friction`` μ, and ``response`` ``"impulse"`` or ``"penalty"`` (``stiffness``,
+        ``damping``)."""
+        return self._add(Collider, "collider", _given(locals()))
 
     def build(self) -> Model:
         """Check the scene as a whole and return the frozen :class:`Model`."""
-        return build_model(self._scene, source=self.dump())
+        return build_model(self._scene)
 
-    def dump(self, format: str = "toml") -> str:
-        """The scene as file text (``"toml"`` or ``"json"``)."""
-        return dump_scene(self._scene, format)
-
-    def _add(self, kind: type[BaseModel], fields: dict[str, Any]) -> int:
+    def _add(self, schema: type[BaseModel], tag: str, fields: dict[str, Any]) -> int:
         index = len(self._scene.entities)
-        entity = _validated(kind, f"entities[{index}]", **fields)
+        entity = _validated(schema, f"entities[{index}]", **(fields | {"type": tag}))
         self._replace(entities=[*self._scene.entities, entity])
         return index
 
@@ -110,12 +248,34 @@ class SceneBuilder:
         self._scene = self._scene.model_copy(update=parts)
 
 
-def _validated(kind: type[Any], where: str, **fields: Any) -> Any:
-    """``kind(**fields)`` validated, with problems reported at ``where`` like a file's."""
+def _given(arguments: dict[str, Any]) -> dict[str, Any]:
+    """The arguments the caller gave (not ``None``), as plain Python values (NumPy arrays and
+    scalars become lists and floats, which the strict schema accepts)."""
+    return {
+        key: _plain(value)
+        for key, value in arguments.items()
+        if key != "self" and value is not None
+    }
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
+
+
+def _validated(schema: type[Any], where: str, /, **fields: Any) -> Any:
+    """``schema(**fields)`` validated, with problems reported at ``where`` like a file's."""
     try:
-        return kind.model_validate(fields)
+        return schema.model_validate(fields)
     except ValidationError as exc:
-        problems = _problems(exc, fields, lambda path: None)
+        problems = scene_problems(exc, fields, lambda path: None)
         for i, problem in enumerate(problems):
             path = f"{where}.{problem.path}" if problem.path else where
             problems[i] = type(problem)(path, problem.message, problem.got)

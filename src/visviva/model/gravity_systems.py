@@ -1,9 +1,11 @@
 """Gravitating bodies as named scene systems: Kepler orbit, Sun–Earth–Moon, star cluster, galaxies.
 
-The state is the bodies' positions flattened (see :func:`visviva.mechanics.nbody_problem`), so
-the picture is those positions themselves: recordings store them once, as ``points`` and
-``velocities`` (orbits lie in the horizontal x–z plane; the video's ground sits below the
-lowest body). The mechanics package loads only when a scene uses one of these.
+The coordinates are the bodies' positions flattened (see :func:`visviva.mechanics.nbody_problem`),
+so the picture is those positions themselves (orbits lie in the horizontal x–z plane; the
+video's ground sits below the lowest body). Their gravitation is the one implementation of
+:mod:`visviva.mechanics.gravity` (the :class:`~visviva.forces.Gravitation` force among particles
+uses it too); world gravity does not act on them. The mechanics package loads only when a
+scene uses one of these.
 """
 
 from __future__ import annotations
@@ -85,7 +87,15 @@ def _gravity(
             name=name,
         )
 
-    return SystemType(name, summary, parameters, build, state_is_points=True)
+    return SystemType(name, summary, parameters, build, draw=_bodies_as_points, bodies=True)
+
+
+def _bodies_as_points(
+    values: Mapping[str, float], gravity: np.ndarray, parts: tuple[np.ndarray, ...]
+) -> np.ndarray:
+    """The coordinates are the bodies' positions, ``(x, y, z)`` per body: the picture itself."""
+    q = parts[0]
+    return q.reshape(q.shape[0], -1, 3)
 
 
 _G = Parameter(1.0, "m^3/(kg s^2)", "constant of gravitation (1: N-body units)", positive=True)

@@ -1,24 +1,32 @@
 """The frozen Model: everything about a scene that does not change while it runs.
 
 Built once from a validated scene (file or :class:`~visviva.model.SceneBuilder`), a Model holds
-structure-of-arrays particle data with entity-prefixed names, the world, the integration
-settings and at most one named system. Its arrays are read-only. :meth:`Model.problem` turns it
-into the ordinary second- or first-order problem that the one simulation loop runs, and
-:meth:`Model.frame_fields` turns recorded states back into geometry (``points`` [m]) for the
-video, viewer and exporters.
+the entities as structure-of-arrays data with entity-prefixed names (``particle_position``,
+``particle_mass``, ...), the named systems with their generalized coordinates, the forces on
+particles (world gravity included), the post-step stages (collisions, emission) and the
+settings. Its arrays are read-only. :meth:`Model.system` is the view an integrator steps,
+:meth:`Model.initial_state` the state a run starts from, and :meth:`Model.frame` turns a state
+into what a recording keeps (``points`` [m] for the video, the viewer and the exporters).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..forces import UniformGravity
-from ..ode.problems import Problem, SecondOrderProblem
+from ..ode.problems import Problem
 from .systems import SYSTEMS
+
+if TYPE_CHECKING:
+    from ..forces.base import Force
+    from ..ode.state import State
+    from ..ode.system import System
+    from ..particles.emitters import EmitterSpec
+    from ..simulation.stepper import Stage
+    from .scene import Scene
 
 __all__ = ["Integration", "Model", "ParticleGroup", "SystemInstance"]
 
@@ -66,26 +74,52 @@ class Integration:
 
 @dataclass(frozen=True)
 class ParticleGroup:
-    """A named range of particles that came from one scene entity.
+    """A named range of particle slots that came from one scene entity.
 
     Attributes:
         name: Entity name.
+        entity: The entity's index in the scene.
         start: First particle index.
-        count: Number of particles.
+        count: Number of particles (an emitter's capacity).
+        emitted: True for an emitter's slots, whose particles are born and die.
     """
 
     name: str
+    entity: int
     start: int
     count: int
+    emitted: bool = False
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SystemInstance:
-    """A named system with its parameter values (defaults filled in)."""
+    """A named system of the scene with its parameter values (defaults filled in).
+
+    Attributes:
+        name: Entity name.
+        system: The system's type name (``"pendulum"``, ...).
+        parameters: Parameter values.
+        entity: The entity's index in the scene.
+        offset: Index of its first coordinate among the scene's generalized coordinates.
+        problem: Its problem (initial state, equations of motion).
+    """
 
     name: str
     system: str
     parameters: Mapping[str, float]
+    entity: int
+    offset: int
+    problem: Problem = field(repr=False)
+
+    @property
+    def size(self) -> int:
+        """Number of its coordinates."""
+        return self.problem.size
+
+    def points(self, gravity: np.ndarray, parts: tuple[np.ndarray, ...]) -> np.ndarray | None:
+        """Its picture for frames of its parts (``(frames, n)`` each): ``(frames, P, 3)`` [m]."""
+        draw = SYSTEMS[self.system].draw
+        return None if draw is None else draw(self.parameters, gravity, parts)
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,30 +128,42 @@ class Model:
 
     Attributes:
         name: Scene name.
+        scene: The scene description it was built from.
         gravity: Gravitational acceleration [m/s²], shape ``(3,)``.
         integration: Time stepping settings.
         particle_position: Initial positions [m], shape ``(particle_count, 3)``.
         particle_velocity: Initial velocities [m/s], shape ``(particle_count, 3)``.
         particle_mass: Masses [kg], shape ``(particle_count,)``.
-        particle_radius: Radii [m], shape ``(particle_count,)``.
-        particle_groups: Which entity each range of particles came from.
-        system: The named system, if the scene holds one instead of particles.
+        particle_radius: Initial radii [m], shape ``(particle_count,)``.
+        particle_color: sRGB colours in [0, 1], shape ``(particle_count, 3)``.
+        particle_alive: Which slots hold a particle at the start, ``(particle_count,)``.
+        particle_groups: Which entity each range of particle slots came from.
+        systems: The named systems, whose coordinates follow the particles' in the state.
+        forces: The forces on particles, world gravity first.
+        emitters: The emitters (their slots are among the particles').
+        stages: The post-step stages, in order (collisions, then emission).
         output_formats: Extra outputs the scene asks ``visviva run`` for.
         output_fps: Frame rate of videos, viewer and exports [1/s].
         output_speed: Simulated seconds per second of their playback.
         output_trail: Simulated seconds of each point's path drawn behind it [s].
-        source: The scene file's text, stored in recordings for reproducibility.
+        source: The scene file's text, if it came from a file (kept in recordings).
     """
 
     name: str
+    scene: Scene = field(repr=False)
     gravity: np.ndarray
     integration: Integration
     particle_position: np.ndarray
     particle_velocity: np.ndarray
     particle_mass: np.ndarray
     particle_radius: np.ndarray
+    particle_color: np.ndarray
+    particle_alive: np.ndarray
     particle_groups: tuple[ParticleGroup, ...] = ()
-    system: SystemInstance | None = None
+    systems: tuple[SystemInstance, ...] = ()
+    forces: tuple[Force, ...] = field(default=(), repr=False)
+    emitters: tuple[EmitterSpec, ...] = field(default=(), repr=False)
+    stages: tuple[Stage, ...] = field(default=(), repr=False)
     output_formats: tuple[str, ...] = ()
     output_fps: float = 30.0
     output_speed: float = 1.0
@@ -126,80 +172,70 @@ class Model:
 
     @property
     def particle_count(self) -> int:
-        """Number of particles."""
+        """Number of particle slots (an emitter's count as its capacity)."""
         return self.particle_position.shape[0]
+
+    @property
+    def coordinate_count(self) -> int:
+        """Number of generalized coordinates of the named systems."""
+        return sum(s.size for s in self.systems)
 
     @property
     def conservative(self) -> bool:
         """True if the scene's energy is conserved by the exact dynamics (so a change in it
-        measures the integrator's error): particles under gravity, undamped systems."""
-        if self.system is None:
-            return True
-        return SYSTEMS[self.system.system].conservative(self.system.parameters)
+        measures the integrator's error): no dissipative force, no stage that changes the
+        state (collisions, births), no damped system."""
+        if self.stages or not all(f.conservative for f in self.forces):
+            return False
+        return all(SYSTEMS[s.system].conservative(s.parameters) for s in self.systems)
 
     @property
     def has_geometry(self) -> bool:
         """True if runs of this model record drawable ``points``."""
-        if self.system is None:
-            return True
-        kind = SYSTEMS[self.system.system]
-        return kind.state_is_points or kind.draw is not None
-
-    def problem(self) -> Problem:
-        """The problem the simulation loop runs: particles as one second-order system with
-        ``q`` = positions flattened to ``(3N,)``, or the named system's own problem."""
-        if self.system is not None:
-            return SYSTEMS[self.system.system].build(self.system.parameters, self.gravity)
-        count = self.particle_count
-        gravity = UniformGravity(self.gravity, self.particle_mass)
-        mass3 = np.repeat(self.particle_mass, 3)
-
-        def force(t: float, q: np.ndarray) -> np.ndarray:
-            out = np.zeros(q.shape[:-1] + (count, 3))
-            x = q.reshape(out.shape)
-            gravity.accumulate(t, x, x, out)
-            return out.reshape(q.shape)
-
-        def energy(t: float, q: np.ndarray, v: np.ndarray) -> Any:
-            kinetic = 0.5 * np.sum(mass3 * v**2, axis=-1)
-            return kinetic + gravity.potential(t, q.reshape(q.shape[:-1] + (count, 3)))
-
-        return SecondOrderProblem.from_force(
-            force,
-            mass3,
-            self.particle_position.reshape(-1),
-            self.particle_velocity.reshape(-1),
-            energy=energy,
-            name=self.name,
+        return self.particle_count > 0 or any(
+            SYSTEMS[s.system].draw is not None for s in self.systems
         )
 
-    def frame_fields(self, parts: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
-        """Recorded fields for frames of states: ``parts`` are ``(frames, …)`` arrays.
+    def system(self) -> System:
+        """A fresh run-time system (with zeroed work counters): the view an integrator steps."""
+        from .scene_system import scene_system
 
-        Particles, and systems whose coordinates are positions (n bodies), give ``points`` [m]
-        and ``velocities`` [m/s], ``(frames, N, 3)``; another named system gives its
-        coordinates and, if it has a picture, ``points``. Each quantity is recorded once.
-        """
-        system = self.system
-        if system is None or SYSTEMS[system.system].state_is_points:
-            q, v = parts
-            shape = (q.shape[0], q.shape[-1] // 3, 3)
-            return {"points": q.reshape(shape), "velocities": v.reshape(shape)}
-        draw = SYSTEMS[system.system].draw
-        names = ("y",) if len(parts) == 1 else ("q", "v")
-        fields = dict(zip(names, parts, strict=True))
-        if draw is not None:
-            fields["points"] = draw(system.parameters, self.gravity, parts)
-        return fields
+        return scene_system(self)
+
+    def problem(self) -> Problem:
+        """The scene's smooth dynamics as a plain problem (for ``vv.solve`` and comparisons);
+        refused for scenes with collisions or emitters (see
+        :func:`~visviva.model.scene_system.as_problem`)."""
+        from .scene_system import as_problem
+
+        return as_problem(self)
+
+    def initial_state(self) -> State:
+        """The state a run starts from (copies of the model's arrays)."""
+        from .scene_system import initial_state
+
+        return initial_state(self)
+
+    def frame(self, state: State) -> dict[str, np.ndarray]:
+        """What a recording keeps of ``state`` (one frame; see :mod:`.frames`)."""
+        from .frames import frame_fields
+
+        return frame_fields(self, state)
 
     def static(self) -> dict[str, np.ndarray]:
-        """Arrays recorded once: particle radii and masses, or a system's edges."""
-        if self.system is None:
-            return {"radius": np.array(self.particle_radius), "mass": np.array(self.particle_mass)}
-        edges = SYSTEMS[self.system.system].edges
-        return {} if edges is None else {"edges": np.array(edges, dtype=np.int64)}
+        """Arrays recorded once (see :mod:`.frames`)."""
+        from .frames import static_fields
+
+        return static_fields(self)
 
     def units(self) -> dict[str, str]:
         """Units of the recorded fields and static arrays."""
-        energy = "J" if self.system is None else SYSTEMS[self.system.system].energy_unit
-        return {"points": "m", "velocities": "m/s", "radius": "m", "mass": "kg", "energy": energy}
+        return {
+            "points": "m",
+            "velocities": "m/s",
+            "radius": "m",
+            "mass": "kg",
+            "energy": "J",
+            "generalized_position": "",
+            "generalized_velocity": "",
+        }

@@ -51,13 +51,10 @@ class SystemType:
         build: ``build(values, gravity)`` → the problem; ``gravity`` [m/s²] is the world's.
         draw: Maps recorded frames to points, or ``None`` if the system has no picture.
         edges: Point-index pairs drawn as lines, or ``None``.
-        energy_unit: Unit of the recorded energy (``"J/kg"`` for systems written per unit
-            mass).
+        bodies: The coordinates are the positions of bodies, ``(x, y, z)`` per body, and so
+            are the picture: recordings keep them once, as ``points`` and ``velocities``.
         dissipation: Name of the parameter that makes the system lose energy when it is not
             zero (a damping coefficient), or ``None`` if it always conserves energy.
-        state_is_points: The coordinates ``q`` are the positions of points, ``(x, y, z)`` per
-            point (n bodies): they are the picture, recorded once as ``points`` and
-            ``velocities``.
     """
 
     name: str
@@ -66,9 +63,8 @@ class SystemType:
     build: Callable[[Mapping[str, float], np.ndarray], Problem]
     draw: Drawing | None = None
     edges: tuple[tuple[int, int], ...] | None = None
-    energy_unit: str = "J"
     dissipation: str | None = None
-    state_is_points: bool = False
+    bodies: bool = False
 
     def conservative(self, values: Mapping[str, float]) -> bool:
         """True if the system with these parameter values conserves its energy."""

@@ -33,7 +33,7 @@ def _oscillator(p: Mapping[str, float], gravity: np.ndarray) -> Problem:
         return np.full(q.shape + q.shape[-1:], -omega2)
 
     def energy(t: float, q: np.ndarray, v: np.ndarray) -> Any:
-        return 0.5 * v[..., 0] ** 2 + 0.5 * omega2 * q[..., 0] ** 2  # per unit mass [J/kg]
+        return 0.5 * v[..., 0] ** 2 + 0.5 * omega2 * q[..., 0] ** 2  # a 1 kg mass [J]
 
     return SecondOrderProblem(
         acceleration, [p["q0"]], [p["v0"]], jacobian=jacobian, energy=energy, name="oscillator"
@@ -105,7 +105,7 @@ SYSTEMS: dict[str, SystemType] = (
         for system in (
             SystemType(
                 "oscillator",
-                "unit mass on a spring: q'' = -omega^2 q",
+                "a 1 kg mass on a spring: q'' = -omega^2 q",
                 {
                     "omega": Parameter(2.0 * np.pi, "rad/s", "angular frequency", positive=True),
                     "q0": Parameter(1.0, "m", "initial displacement"),
@@ -114,11 +114,10 @@ SYSTEMS: dict[str, SystemType] = (
                 _oscillator,
                 _draw_oscillator,
                 ((0, 1),),
-                energy_unit="J/kg",
             ),
             SystemType(
                 "circular",
-                "seed 004's circular motion: a particle pulled to the centre, q'' = -omega^2 q",
+                "seed 004's circular motion: 1 kg pulled to the centre, q'' = -omega^2 q",
                 {
                     "radius": Parameter(1.0, "m", "orbit radius", positive=True),
                     "omega": Parameter(1.0, "rad/s", "angular velocity", positive=True),
@@ -126,7 +125,6 @@ SYSTEMS: dict[str, SystemType] = (
                 _circular,
                 _draw_circular,
                 ((0, 1),),
-                energy_unit="J/kg",
             ),
             SystemType(
                 "test-equation",

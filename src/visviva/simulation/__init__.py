@@ -3,6 +3,7 @@
 from .adaptive import DenseOutput
 from .loop import Schedule, simulate
 from .recording import Geometry, Recording
+from .simulation import Simulation, SimulationState
 from .solve import Solution, solve
 from .watch import DEFAULT_DIVERGENCE_LIMIT, DivergenceWatch
 
@@ -13,6 +14,8 @@ __all__ = [
     "Geometry",
     "Recording",
     "Schedule",
+    "Simulation",
+    "SimulationState",
     "Solution",
     "simulate",
     "solve",

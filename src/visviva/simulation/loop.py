@@ -45,7 +45,7 @@ if TYPE_CHECKING:
     from ..ode.state import State
     from ..ode.system import System
 
-__all__ = ["Schedule", "simulate"]
+__all__ = ["Schedule", "advance", "simulate"]
 
 #: A fixed-step run may take at most this many integrator steps (substeps included): a billion
 #: steps is minutes compiled and hours in NumPy; more is a mistake in dt, not a plan.
@@ -59,14 +59,18 @@ CHUNK_SYSTEM_STEPS = 200_000
 class Schedule:
     """When each step happens: ``full_steps`` steps of ``dt``, then possibly one shorter step.
 
+    Time is counted on the grid ``t0 + k·h`` (``h = dt/substeps``) from ``t0``, the grid's
+    origin; a run that continues an earlier one on the same grid starts at step ``first``, so
+    its times are exactly those one longer run would have had.
+
     Attributes:
-        t0: Start time [s].
+        t0: The grid's origin [s].
         t_end: End time [s].
         dt: Step [s].
         substeps: Integrator steps per step.
-        full_steps: Number of steps of exactly ``dt``.
-        last_dt: Length of the final shortened step [s], or 0 if ``t_end − t0`` is a whole
-            number of steps.
+        first: Steps of ``dt`` already taken from ``t0`` before this run.
+        full_steps: Number of steps of exactly ``dt`` in this run.
+        last_dt: Length of the final shortened step [s], or 0 if ``t_end`` is on the grid.
     """
 
     t0: float
@@ -75,16 +79,18 @@ class Schedule:
     substeps: int
     full_steps: int
     last_dt: float
+    first: int = 0
 
     @classmethod
-    def build(cls, t0: float, t_end: float, dt: float, substeps: int) -> Schedule:
-        """Plan the steps from ``t0`` to ``t_end`` (a remainder below 1e-9 steps is rounding)."""
+    def build(cls, t0: float, t_end: float, dt: float, substeps: int, first: int = 0) -> Schedule:
+        """Plan the steps from ``t0 + first·dt`` to ``t_end`` on the grid of origin ``t0`` (a
+        remainder below 1e-9 steps is rounding)."""
         ratio = (t_end - t0) / dt
         nearest = round(ratio)
-        if nearest >= 1 and abs(ratio - nearest) <= 1e-9 * max(1.0, ratio):
-            return cls(t0, t_end, dt, substeps, int(nearest), 0.0)
-        full = math.floor(ratio)
-        return cls(t0, t_end, dt, substeps, full, (t_end - t0) - full * dt)
+        if nearest >= first + 1 and abs(ratio - nearest) <= 1e-9 * max(1.0, ratio):
+            return cls(t0, t_end, dt, substeps, int(nearest) - first, 0.0, first)
+        full = max(math.floor(ratio), first)
+        return cls(t0, t_end, dt, substeps, full - first, (t_end - t0) - full * dt, first)
 
     @property
     def steps(self) -> int:
@@ -97,15 +103,16 @@ class Schedule:
         return self.dt / self.substeps
 
     def substep(self, step: int, sub: int) -> tuple[float, float]:
-        """``(h, t_after)`` of substep ``sub`` of step ``step`` (time from integer counters)."""
+        """``(h, t_after)`` of substep ``sub`` of this run's step ``step`` (time from integer
+        counters)."""
         if step < self.full_steps:
-            k = step * self.substeps + sub + 1
-            t_after = self.t_end if k == self.steps * self.substeps else self.t0 + k * self.h
-            return self.h, t_after
+            k = (self.first + step) * self.substeps + sub + 1
+            last = step + 1 == self.steps and sub + 1 == self.substeps
+            return self.h, self.t_end if last else self.t0 + k * self.h
         h_last = self.last_dt / self.substeps
         if sub + 1 == self.substeps:
             return h_last, self.t_end
-        start = self.t0 + self.full_steps * self.substeps * self.h
+        start = self.t0 + (self.first + self.full_steps) * self.substeps * self.h
         return h_last, start + (sub + 1) * h_last
 
 
@@ -198,7 +205,7 @@ def simulate(
     with Progress(schedule.steps, f"{integrator.name}", progress) as bar:
         try:
             if compiled_step is None:
-                _run_numpy(stepper, state, schedule, record_every, recorder, bar)
+                advance(stepper, state, schedule, record_every, recorder, bar)
             else:
                 _run_compiled(
                     compiled_step,
@@ -260,25 +267,45 @@ def _compiled_step(
     return step
 
 
-def _run_numpy(
+def advance(
     stepper: Stepper,
     state: State,
     schedule: Schedule,
     record_every: int,
-    recorder: FrameRecorder,
+    recorder: FrameRecorder | None,
     bar: Progress,
-) -> None:
+) -> State:
+    """Run ``schedule`` from ``state`` through ``stepper``: the one fixed-step loop.
+
+    A frame is recorded after every ``record_every``-th step counted from the grid's origin,
+    after the last step, and when a stop was requested (then :class:`Interrupted` is raised
+    with that frame's time). Returns the final state.
+    """
     substeps = schedule.substeps
+    done = state
     for step in range(schedule.steps):
-        for sub in range(substeps):
-            h, t_after = schedule.substep(step, sub)
-            state = stepper.step(state, h, t_after, step * substeps + sub)
+        current = done
+        try:
+            for sub in range(substeps):
+                h, t_after = schedule.substep(step, sub)
+                index = (schedule.first + step) * substeps + sub
+                current = stepper.step(current, h, t_after, index)
+        except SimulationError as failure:
+            failure.state, failure.steps_done = done, step
+            raise
+        done = current
         last = step + 1 == schedule.steps
-        if (step + 1) % record_every == 0 or last or stop_requested():
-            recorder.append(state)
+        stop = stop_requested()
+        if recorder is not None and (
+            (schedule.first + step + 1) % record_every == 0 or last or stop
+        ):
+            recorder.append(done)
         bar.advance(1)
-        if not last:
-            _stop_if_requested(recorder)
+        if stop is not None and not last:
+            interrupted = Interrupted(stop, done.t)
+            interrupted.state, interrupted.steps_done = done, step + 1
+            raise interrupted
+    return done
 
 
 def _stack(state: State) -> np.ndarray:
@@ -298,7 +325,7 @@ def _run_compiled(
     watch: DivergenceWatch,
     bar: Progress,
 ) -> None:
-    """The same schedule, frames and watch as :func:`_run_numpy`, in compiled chunks."""
+    """The same schedule, frames and watch as :func:`advance`, in compiled chunks."""
     from ..integrators.compiled import make_runner
 
     batch = state.parts[0].ndim == 2
@@ -361,7 +388,9 @@ def _run_compiled(
         done += steps
         bar.advance(steps)
         if done < schedule.full_steps or schedule.last_dt > 0.0:
-            _stop_if_requested(recorder)
+            name = stop_requested()
+            if name is not None:
+                raise Interrupted(name, recorder.last().t)
     if schedule.last_dt > 0.0:
         start = schedule.t0 + schedule.full_steps * substeps * h
         advance(
@@ -375,13 +404,6 @@ def _run_compiled(
             schedule.full_steps == 0,
         )
         bar.advance(1)
-
-
-def _stop_if_requested(recorder: FrameRecorder) -> None:
-    """Raise :class:`Interrupted` at the last recorded frame if a signal asked to stop."""
-    name = stop_requested()
-    if name is not None:
-        raise Interrupted(name, recorder.times[-1])
 
 
 def _unstack(y: np.ndarray, template: State) -> tuple[np.ndarray, ...]:

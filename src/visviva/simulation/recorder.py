@@ -61,9 +61,9 @@ class FrameRecorder:
     def append(self, state: State) -> None:
         """Record ``state`` as the next frame (copied)."""
         energy = self.system.energy(state)
-        self.times.append(state.t)
         self._last = state
         if self.keep:
+            self.times.append(state.t)
             for name, part in state.named():
                 self.fields[name].append(np.array(part))
             if energy is not None:
@@ -92,5 +92,4 @@ class FrameRecorder:
         }
         if self.energy:
             fields["energy"] = np.array(self.energy, dtype=np.float64)
-        times = np.array(self.times if self.keep else self.times[:0], dtype=np.float64)
-        return Recording(times, fields, attrs=attrs)
+        return Recording(np.array(self.times, dtype=np.float64), fields, attrs=attrs)

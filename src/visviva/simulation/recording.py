@@ -18,6 +18,16 @@ convention, read back by :meth:`Recording.geometry`:
     static/display_radius   float64 (P,) [m]: the radius to draw instead of the physical one,
                             where true sizes would be invisible (planets at the scale of their
                             orbits); outputs then say "sizes not to scale" (optional)
+
+Points that are born and die (particles of emitters) are recorded with a fixed capacity ``P``
+and, per frame:
+
+    fields/alive            bool (frames, P): which points exist in each frame; the others
+                            are not drawn (optional: all exist)
+    fields/radius           float64 (frames, P) [m]: radii that change over time (instead of
+                            static/radius)
+    fields/color            float32 (frames, P, 3): colours that change over time, sRGB in
+                            [0, 1] (instead of static/color)
 """
 
 from __future__ import annotations
@@ -42,17 +52,21 @@ _RADIUS_OF_A_POINT_SCENE = 0.05
 
 @dataclass(frozen=True)
 class Geometry:
-    """What a recording shows: moving points, optionally with radii, edges and triangles.
+    """What a recording shows: moving points, optionally with radii, colours, edges, triangles,
+    and points that are born and die.
 
     Attributes:
         points: Positions [m], shape ``(frames, P, 3)``, world frame, Y up.
-        radius: Radii [m], shape ``(P,)``, or ``None`` (draw as small dots).
+        radius: Radii [m], shape ``(P,)``, or ``(frames, P)`` when they change over time, or
+            ``None`` (draw as small dots).
         edges: Point-index pairs drawn as lines, shape ``(E, 2)``, or ``None``.
         faces: Point-index triangles, shape ``(F, 3)``, or ``None``.
-        color: sRGB colour of each point in [0, 1], shape ``(P, 3)``, or ``None`` (the
-            outputs' default colour).
+        color: sRGB colour of each point in [0, 1], shape ``(P, 3)``, or ``(frames, P, 3)``
+            when it changes over time, or ``None`` (the outputs' default colour).
         display_radius: Radii [m] drawn instead of ``radius`` where true sizes would be
             invisible, shape ``(P,)``, or ``None`` (drawn to scale).
+        alive: Which points exist in each frame, shape ``(frames, P)`` bool, or ``None`` (all
+            of them, always). Outputs draw only the live points of each frame.
     """
 
     points: np.ndarray
@@ -61,6 +75,7 @@ class Geometry:
     faces: np.ndarray | None = None
     color: np.ndarray | None = None
     display_radius: np.ndarray | None = None
+    alive: np.ndarray | None = None
 
     @property
     def to_scale(self) -> bool:
@@ -96,9 +111,9 @@ class Geometry:
         return radius
 
     def drawn_radius(self) -> np.ndarray:
-        """Radius [m] of each point as drawn, shape ``(P,)``: the display radius, else the
-        recorded one, else :meth:`default_radius` (the same in the video, the viewer and every
-        export)."""
+        """Radius [m] of each point as drawn, shape ``(P,)`` (``(frames, P)`` for radii that
+        change over time): the display radius, else the recorded one, else
+        :meth:`default_radius` (the same in the video, the viewer and every export)."""
         if self.display_radius is not None:
             return np.asarray(self.display_radius, dtype=np.float64)
         if self.radius is not None:
@@ -106,10 +121,12 @@ class Geometry:
         return np.full(self.points.shape[1], self.default_radius())
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Lower and upper corners [m] of the box holding every point of every frame (radii
-        included)."""
+        """Lower and upper corners [m] of the box holding every live point of every frame
+        (radii included)."""
         pad = 0.0 if self.radius is None or self.radius.size == 0 else float(self.radius.max())
         flat = self.points.reshape(-1, 3)
+        if self.alive is not None:
+            flat = flat[self.alive.reshape(-1)]
         if flat.size == 0:
             return np.zeros(3), np.zeros(3)
         return flat.min(axis=0) - pad, flat.max(axis=0) + pad
@@ -183,20 +200,27 @@ class Recording:
         points = self.fields["points"]
         if points.ndim != 3 or points.shape[2] != 3:
             raise ModelError(f"`points` must have shape (frames, P, 3) (got {points.shape})")
-        count = points.shape[1]
+        frames, count = points.shape[:2]
         per_point = {}
-        for name, shape in (
-            ("radius", (count,)),
-            ("display_radius", (count,)),
-            ("color", (count, 3)),
+        for name, shape, varying in (
+            ("radius", (count,), (frames, count)),
+            ("display_radius", (count,), None),
+            ("color", (count, 3), (frames, count, 3)),
         ):
-            value = self.static.get(name)
-            if value is not None and value.shape != shape:
-                raise ModelError(f"`{name}` must have shape {shape} (got {value.shape})")
+            value = self.fields.get(name) if name in self.fields else self.static.get(name)
+            allowed = [shape] if varying is None or name not in self.fields else [varying]
+            if value is not None and value.shape not in allowed:
+                raise ModelError(f"`{name}` must have shape {allowed[0]} (got {value.shape})")
             per_point[name] = value
         color = per_point["color"]
         if color is not None and not (np.all(color >= 0.0) and np.all(color <= 1.0)):
             raise ModelError("`color` must hold sRGB values between 0 and 1")
+        alive = self.fields.get("alive")
+        if alive is not None and (alive.shape != (frames, count) or alive.dtype != np.bool_):
+            raise ModelError(
+                f"`alive` must be a boolean array of shape {(frames, count)} (got {alive.dtype} "
+                f"{alive.shape})"
+            )
         topology = {}
         for name, width in (("edges", 2), ("faces", 3)):
             value = self.static.get(name)
@@ -206,7 +230,7 @@ class Recording:
                 if value.size and (value.min() < 0 or value.max() >= count):
                     raise ModelError(f"`{name}` refers to points outside 0..{count - 1}")
             topology[name] = value
-        return Geometry(points, **per_point, **topology)
+        return Geometry(points, **per_point, **topology, alive=alive)
 
     def __repr__(self) -> str:
         shapes = ", ".join(f"{k}{tuple(v.shape)}" for k, v in self.fields.items())

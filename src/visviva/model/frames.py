@@ -1,0 +1,139 @@
+"""What a recording keeps of a scene's state: drawable points, and the parts worth plotting.
+
+Per frame (:func:`frame_fields`), following the recording convention of
+:mod:`visviva.simulation.recording`:
+
+    points                (P, 3) [m]   particles, then each named system's picture
+    velocities            (N, 3) [m/s] particle velocities (and gravitating bodies')
+    generalized_position  (m,)         the named systems' coordinates (and velocities), unless
+                                       every system is of gravitating bodies, whose coordinates
+                                       are already their points
+    y                     (n,)         a first-order system's state
+    alive                 (P,) bool    with emitters: which points hold a live particle
+    radius                (P,) [m]     with emitters: radii as they grow and shrink
+    color                 (P, 3)       with colour ramps: sRGB colours in [0, 1]
+
+Once (:func:`static_fields`): the radii and colours that do not change, particle masses, and
+the systems' edges (point indices, shifted past the particles).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..particles.emitters import ramp_values
+from .systems import SYSTEMS
+
+if TYPE_CHECKING:
+    from ..ode.state import State
+    from .model import Model, SystemInstance
+
+__all__ = ["frame_fields", "static_fields"]
+
+
+def _system_points(model: Model, state: State) -> list[np.ndarray]:
+    """Each drawable system's points for this state, ``(P_s, 3)``."""
+    if not model.systems:
+        return []
+    if "y" in state.names():
+        parts: tuple[np.ndarray, ...] = (state["y"][None],)
+        return [p[0] for s in model.systems if (p := s.points(model.gravity, parts)) is not None]
+    q, v = state["generalized_position"], state["generalized_velocity"]
+    pictures = []
+    for system in model.systems:
+        a, b = system.offset, system.offset + system.size
+        points = system.points(model.gravity, (q[None, a:b], v[None, a:b]))
+        if points is not None:
+            pictures.append(points[0])
+    return pictures
+
+
+def _bodies(system: SystemInstance) -> bool:
+    """True for a system of gravitating bodies: its coordinates are its picture."""
+    return SYSTEMS[system.system].bodies
+
+
+def _varying_color(model: Model) -> bool:
+    return any(e.color_ramp.shape[0] > 1 for e in model.emitters)
+
+
+def frame_fields(model: Model, state: State) -> dict[str, np.ndarray]:
+    """One frame of ``state`` as recorded fields (see the module docstring)."""
+    fields: dict[str, np.ndarray] = {}
+    pictures = _system_points(model, state)
+    count = model.particle_count
+    if count or pictures:
+        particles = [state["particle_position"]] if count else []
+        fields["points"] = np.concatenate(particles + pictures) if pictures else particles[0]
+    velocities = [state["particle_velocity"]] if count else []
+    if model.systems and "y" not in state.names():
+        v = state["generalized_velocity"]
+        velocities += [
+            v[s.offset : s.offset + s.size].reshape(-1, 3) for s in model.systems if _bodies(s)
+        ]
+        if not all(_bodies(s) for s in model.systems):
+            fields["generalized_position"] = state["generalized_position"]
+            fields["generalized_velocity"] = v
+    if velocities:
+        fields["velocities"] = np.concatenate(velocities) if len(velocities) > 1 else velocities[0]
+    if "y" in state.names():
+        fields["y"] = state["y"]
+    if model.emitters:
+        extra = sum(p.shape[0] for p in pictures)
+        fields["alive"] = np.concatenate([state["particle_alive"], np.ones(extra, dtype=bool)])
+        fields["radius"] = np.concatenate(
+            [state["particle_radius"], np.full(extra, _system_radius(model))]
+        )
+        if _varying_color(model):
+            fields["color"] = np.concatenate([_colors(model, state), np.ones((extra, 3))]).astype(
+                np.float32
+            )
+    return fields
+
+
+def _colors(model: Model, state: State) -> np.ndarray:
+    """Particle colours: each emitter's ramp at its particles' age fractions."""
+    colors = np.array(model.particle_color)
+    age, lifetime = state["particle_age"], state["particle_lifetime"]
+    for spec in model.emitters:
+        slots = slice(spec.first_slot, spec.first_slot + spec.capacity)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            fraction = np.nan_to_num(age[slots] / lifetime[slots])
+        colors[slots] = ramp_values(spec.color_ramp, fraction)
+    return colors
+
+
+def _system_radius(model: Model) -> float:
+    """The radius drawn for systems' points beside particles: the particles' median."""
+    return float(np.median(model.particle_radius)) if model.particle_count else 0.05
+
+
+def static_fields(model: Model) -> dict[str, np.ndarray]:
+    """Arrays recorded once (see the module docstring)."""
+    static: dict[str, np.ndarray] = {}
+    start = model.initial_state()
+    extra = sum(p.shape[0] for p in _system_points(model, start))
+    count = model.particle_count
+    if count:
+        static["mass"] = np.array(model.particle_mass)
+        if not model.emitters:
+            static["radius"] = np.concatenate(
+                [model.particle_radius, np.full(extra, _system_radius(model))]
+            )
+        if not _varying_color(model) and (model.emitters or np.any(model.particle_color != 1.0)):
+            static["color"] = np.concatenate([_colors(model, start), np.ones((extra, 3))])
+    edges, first = [], count
+    for system, points in zip(
+        [s for s in model.systems if SYSTEMS[s.system].draw is not None],
+        _system_points(model, start),
+        strict=True,
+    ):
+        own = SYSTEMS[system.system].edges
+        if own is not None:
+            edges.append(np.array(own, dtype=np.int64) + first)
+        first += points.shape[0]
+    if edges:
+        static["edges"] = np.concatenate(edges)
+    return static

@@ -1,0 +1,298 @@
+"""The pieces a Model is made of, each from its scene entities: particle arrays, emitters,
+forces, the collision stage.
+
+Every builder here takes the already-checked scene (:mod:`.build` runs the cross-entity checks
+first) and refuses what only the physics code can judge — a mesh that is not closed, a
+quaternion that is not a rotation — by raising :class:`Located` with the entity's path.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import ModelError, SceneProblem
+from ..forces import (
+    Attractor,
+    Damping,
+    Drag,
+    Force,
+    Gravitation,
+    QuadraticDrag,
+    Targets,
+    UniformGravity,
+    Vortex,
+)
+from ..mechanics.gravity import GRAVITATIONAL_CONSTANT
+from ..particles.emitters import SHAPES, EmitterSpec, unit_vector, value_range
+from .model import ParticleGroup
+from .scene import Collider, Emitter, ForceField, ParticleCloud, Particles, Scene
+
+__all__ = [
+    "Located",
+    "collision_stage",
+    "emitter_specs",
+    "force_objects",
+    "particle_arrays",
+    "penalty_forces",
+]
+
+
+class Located(Exception):
+    """A refusal of an entity's values, located at the entity (``entities[i]...``)."""
+
+    def __init__(self, where: str, message: str) -> None:
+        super().__init__(message)
+        self.problem = SceneProblem(where, message)
+
+
+def emitter_specs(scene: Scene, names: list[str], duration: float) -> list[EmitterSpec]:
+    """The scene's emitters in numbers; slots are assigned by :func:`particle_arrays`
+    (``first_slot`` here is their order among emitters, fixed up there)."""
+    specs = []
+    for index, entity in enumerate(scene.entities):
+        if isinstance(entity, Emitter):
+            specs.append(_spec(entity, len(specs), names[index], duration, f"entities[{index}]"))
+    return specs
+
+
+def _spec(e: Emitter, index: int, name: str, duration: float, where: str) -> EmitterSpec:
+    triangles = np.zeros((0, 3, 3))
+    try:
+        if e.shape == "mesh":
+            vertices = np.asarray(e.vertices, dtype=np.float64)
+            corners = np.asarray(e.triangles, dtype=np.int64)
+            if corners.min() < 0 or corners.max() >= len(vertices):
+                raise ModelError(
+                    f"`triangles` refer to vertices outside 0..{len(vertices) - 1}: each index "
+                    "must name one of the `vertices`"
+                )
+            triangles = vertices[corners]
+            sides = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+            if not np.linalg.norm(sides, axis=1).sum() > 0.0:
+                raise ModelError("the emitter's mesh has no area: its triangles are degenerate")
+        spec = EmitterSpec(
+            index=index,
+            name=name,
+            first_slot=0,
+            capacity=0,
+            rate=e.rate,
+            start=e.start,
+            stop=math.inf if e.stop is None else e.stop,
+            burst_times=np.array([b.time for b in e.bursts], dtype=np.float64),
+            burst_counts=np.array([b.count for b in e.bursts], dtype=np.int64),
+            shape=SHAPES[e.shape],
+            position=np.asarray(e.position, dtype=np.float64),
+            radius=e.radius,
+            extent=np.asarray(e.extent, dtype=np.float64),
+            normal=unit_vector("normal", e.normal),
+            surface=e.surface,
+            triangles=triangles,
+            direction=unit_vector("direction", e.direction),
+            spread=math.radians(e.spread),
+            speed=value_range("speed", e.speed, positive=False),
+            lifetime=value_range("lifetime", e.lifetime, positive=True),
+            particle_radius=value_range("particle_radius", e.particle_radius, positive=True),
+            mass=e.particle_mass,
+            color_ramp=np.asarray(e.color_ramp or [(0.0, *e.color)], dtype=np.float64),
+            size_ramp=np.asarray(e.size_ramp or [(0.0, 1.0)], dtype=np.float64),
+            seed=e.seed,
+        )
+    except ModelError as error:
+        raise Located(where, str(error)) from None
+    capacity = e.capacity or max(1, spec.most_alive(duration))
+    return _with(spec, capacity=capacity)
+
+
+def _with(spec: EmitterSpec, **changes: Any) -> EmitterSpec:
+    return EmitterSpec(**(vars(spec) | changes))
+
+
+def particle_arrays(
+    scene: Scene, names: list[str], specs: list[EmitterSpec]
+) -> tuple[dict[str, np.ndarray], list[ParticleGroup]]:
+    """Initial particle state and properties of every particle entity, in entity order; an
+    emitter's slots start dead. ``specs`` get their ``first_slot`` (in place in the list)."""
+    columns: dict[str, list[np.ndarray]] = {
+        k: [] for k in ("position", "velocity", "mass", "radius", "color", "alive")
+    }
+    groups: list[ParticleGroup] = []
+    start = 0
+    emitted = iter(range(len(specs)))
+    for index, entity in enumerate(scene.entities):
+        if isinstance(entity, Particles):
+            x = np.array(entity.positions, dtype=np.float64)
+            count = x.shape[0]
+            v = np.zeros_like(x) if entity.velocities is None else np.array(entity.velocities)
+            color = entity.color
+        elif isinstance(entity, ParticleCloud):
+            count = entity.count
+            rng = np.random.default_rng(entity.seed)
+            x = np.asarray(entity.center) + (rng.random((count, 3)) - 0.5) * np.asarray(entity.size)
+            v = np.asarray(entity.velocity) + entity.velocity_jitter * rng.standard_normal(
+                (count, 3)
+            )
+            color = entity.color
+        elif isinstance(entity, Emitter):
+            k = next(emitted)
+            specs[k] = _with(specs[k], first_slot=start)
+            count = specs[k].capacity
+            x = v = np.zeros((count, 3))
+            color = tuple(specs[k].color_ramp[0, 1:])
+        else:
+            continue
+        columns["position"].append(x)
+        columns["velocity"].append(np.asarray(v, dtype=np.float64))
+        mass = specs[k].mass if isinstance(entity, Emitter) else entity.mass
+        radius = specs[k].particle_radius[0] if isinstance(entity, Emitter) else entity.radius
+        columns["mass"].append(np.broadcast_to(np.asarray(mass, dtype=np.float64), (count,)))
+        columns["radius"].append(np.broadcast_to(np.asarray(radius, dtype=np.float64), (count,)))
+        columns["color"].append(np.broadcast_to(np.asarray(color, dtype=np.float64), (count, 3)))
+        columns["alive"].append(np.full(count, not isinstance(entity, Emitter)))
+        groups.append(
+            ParticleGroup(names[index], index, start, count, emitted=isinstance(entity, Emitter))
+        )
+        start += count
+    empty = {"position": (0, 3), "velocity": (0, 3), "color": (0, 3)}
+    arrays = {
+        name: np.concatenate(parts) if parts else np.zeros(empty.get(name, (0,)))
+        for name, parts in columns.items()
+    }
+    arrays["alive"] = arrays["alive"].astype(bool)
+    return arrays, groups
+
+
+def _targets(entity: ForceField | Collider, groups: Sequence[ParticleGroup], count: int) -> Targets:
+    if entity.targets is None:
+        return Targets(count)
+    chosen = [g for g in groups if g.name in entity.targets]
+    indices = [np.arange(g.start, g.start + g.count) for g in chosen]
+    return Targets(count, np.concatenate(indices) if indices else np.zeros(0, np.int64))
+
+
+def force_objects(scene: Scene, groups: Sequence[ParticleGroup], mass: np.ndarray) -> list[Force]:
+    """World gravity (on every particle, if not zero) and each force entity."""
+    count = mass.shape[0]
+    forces: list[Force] = []
+    if count and any(scene.world.gravity):
+        forces.append(UniformGravity(scene.world.gravity, mass))
+    for index, entity in enumerate(scene.entities):
+        if isinstance(entity, ForceField):
+            try:
+                forces.append(_force(entity, _targets(entity, groups, count), mass))
+            except ModelError as error:
+                raise Located(f"entities[{index}]", str(error)) from None
+    return forces
+
+
+def _force(e: ForceField, targets: Targets, mass: np.ndarray) -> Force:
+    zero = (0.0, 0.0, 0.0)
+    if e.kind in ("drag", "wind"):
+        return Drag(e.coefficient, mass, targets, air_velocity=e.velocity or zero)  # type: ignore[arg-type]
+    if e.kind == "quadratic_drag":
+        return QuadraticDrag(e.coefficient, mass, targets, air_velocity=e.velocity or zero)  # type: ignore[arg-type]
+    if e.kind == "damping":
+        return Damping(e.rate, mass, targets)  # type: ignore[arg-type]
+    if e.kind == "attractor":
+        softening = 0.1 if e.softening is None else e.softening
+        return Attractor(e.point, e.strength, mass, targets, softening=softening)  # type: ignore[arg-type]
+    if e.kind == "vortex":
+        return Vortex(
+            e.point or zero,
+            e.axis or (0.0, 1.0, 0.0),
+            e.circulation,  # type: ignore[arg-type]
+            e.coefficient,  # type: ignore[arg-type]
+            mass,
+            targets,
+            core_radius=0.5 if e.core_radius is None else e.core_radius,
+        )
+    return Gravitation(
+        mass,
+        targets,
+        G=GRAVITATIONAL_CONSTANT if e.G is None else e.G,
+        softening=e.softening or 0.0,
+        method=e.method or "direct",
+        theta=0.5 if e.theta is None else e.theta,
+    )
+
+
+def _colliders(scene: Scene, response: str) -> list[tuple[int, Collider]]:
+    return [
+        (i, e)
+        for i, e in enumerate(scene.entities)
+        if isinstance(e, Collider) and e.response == response
+    ]
+
+
+def _shape(e: Collider, where: str) -> Any:
+    from ..collision import Box, Plane, Sphere, TriangleMesh
+
+    zero = (0.0, 0.0, 0.0)
+    try:
+        if e.shape == "plane":
+            thickness = math.inf if e.thickness is None else e.thickness
+            return Plane(e.point or zero, e.normal or (0.0, 1.0, 0.0), thickness)
+        if e.shape == "sphere":
+            return Sphere(e.center or zero, e.radius)
+        if e.shape == "box":
+            return Box(e.center or zero, e.size, e.orientation or (1.0, 0.0, 0.0, 0.0))
+        return TriangleMesh(np.asarray(e.vertices), np.asarray(e.triangles))
+    except ModelError as error:
+        raise Located(where, str(error)) from None
+
+
+def collision_stage(scene: Scene, groups: Sequence[ParticleGroup], count: int, h: float) -> Any:
+    """The collision stage of the impulse colliders, or ``None`` if there are none."""
+    from ..collision import MAX_COLLIDERS, ColliderResponse, ColliderSet, ParticleCollisions
+
+    chosen = _colliders(scene, "impulse")
+    if not chosen or not count:
+        return None
+    if len(chosen) > MAX_COLLIDERS:
+        raise Located(
+            f"entities[{chosen[MAX_COLLIDERS][0]}]",
+            f"a scene may hold at most {MAX_COLLIDERS} impulse colliders",
+        )
+    shapes = [_shape(e, f"entities[{i}]") for i, e in chosen]
+    gravity = float(np.linalg.norm(scene.world.gravity))
+    masks = np.zeros(count, dtype=np.uint64)
+    for bit, (_, e) in enumerate(chosen):
+        masks[_targets(e, groups, count).indices] |= np.uint64(1) << np.uint64(bit)
+    response = ColliderResponse(
+        restitution=[e.restitution for _, e in chosen],
+        friction=[e.friction for _, e in chosen],
+        # A contact rests below the speed gravity gives in two steps (Mirtich & Canny 1995).
+        resting_speed=[
+            2.0 * gravity * h if e.resting_speed is None else e.resting_speed for _, e in chosen
+        ],
+        time_of_impact=[e.time_of_impact for _, e in chosen],
+    )
+    return ParticleCollisions(ColliderSet(shapes), response, masks)
+
+
+def penalty_forces(
+    scene: Scene, groups: Sequence[ParticleGroup], mass: np.ndarray, radius: np.ndarray
+) -> list[Force]:
+    """The penalty-contact force of the penalty colliders (empty list if there are none)."""
+    from ..collision import ColliderSet, PenaltyContact
+
+    chosen = _colliders(scene, "penalty")
+    count = mass.shape[0]
+    if not chosen or not count:
+        return []
+    shapes = [_shape(e, f"entities[{i}]") for i, e in chosen]
+    masks = np.zeros(count, dtype=np.uint64)
+    for bit, (_, e) in enumerate(chosen):
+        masks[_targets(e, groups, count).indices] |= np.uint64(1) << np.uint64(bit)
+    return [
+        PenaltyContact(
+            ColliderSet(shapes),
+            stiffness=[e.stiffness for _, e in chosen],  # type: ignore[misc]
+            damping=[e.damping or 0.0 for _, e in chosen],
+            masks=masks,
+            radius=radius,
+        )
+    ]

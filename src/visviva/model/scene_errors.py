@@ -1,0 +1,100 @@
+"""Validation problems of a scene, as the user wrote it: one per field, with did-you-mean.
+
+Pydantic reports a problem at a location such as ``("entities", 3, "particles", "mass")`` and
+once per branch of a union; :func:`scene_problems` turns that into one
+:class:`~visviva.errors.SceneProblem` per field at the path the user wrote
+(``entities[3].mass``), names the allowed keys of a misspelt one, and leaves the line number to
+the caller that has the file (``line_of``).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from typing import Any
+
+from pydantic import BaseModel, ValidationError
+
+from .._validation import describe, did_you_mean
+from ..errors import SceneProblem
+from .scene import ENTITY_TYPES, Integration, Output, Scene, SceneInfo, World
+
+__all__ = ["scene_problems"]
+
+#: Names pydantic gives the branches of a union in error locations (never scene keys).
+_UNION_BRANCH = re.compile(r"^(float|int|str|bool|list|tuple|dict|[a-z]+(-[a-z]+)+)$|\[")
+_TABLES: dict[str, type[BaseModel]] = {
+    "scene": SceneInfo,
+    "world": World,
+    "integration": Integration,
+    "output": Output,
+}
+
+
+def scene_problems(
+    exc: ValidationError, raw: dict[str, Any], line_of: Callable[[tuple[Any, ...]], Any]
+) -> list[SceneProblem]:
+    """One problem per field: pydantic reports each branch of a union; keep the telling one."""
+    chosen: dict[tuple[Any, ...], Any] = {}
+    for error in exc.errors(include_url=False):
+        path = _field_path(error["loc"])
+        previous = chosen.get(path)
+        if previous is None or (
+            previous["type"].endswith("_type") and not error["type"].endswith("_type")
+        ):
+            chosen[path] = error
+    problems = []
+    for path, error in chosen.items():
+        message = error["msg"].replace("Input should be", "must be", 1)
+        got: str | None = describe(error["input"])
+        if isinstance(error["input"], dict):
+            got = None  # a rule of the whole entity (its message names the fields)
+            if error["type"] == "not_a_parameter":
+                path = (*path, error["ctx"]["field"])
+        if error["type"] == "extra_forbidden":
+            key = str(path[-1])
+            allowed = _allowed_keys(path[:-1], raw)
+            message = f"unknown key.{did_you_mean(key, allowed)} Allowed: {', '.join(allowed)}"
+            got = None
+        elif error["type"] == "missing":
+            got = None
+        elif error["type"] == "union_tag_invalid":
+            message = f"unknown entity type; valid types: {', '.join(ENTITY_TYPES)}"
+            tag = error["input"].get("type") if isinstance(error["input"], dict) else None
+            got = describe(tag)
+        elif error["type"] == "finite_number":
+            message = "must be a finite number (numbers beyond ±1.8e308 overflow to inf)"
+        problems.append(SceneProblem(_dotted(path), message, got, line_of(path)))
+    return problems
+
+
+def _field_path(loc: tuple[Any, ...]) -> tuple[Any, ...]:
+    """The error's location as the user wrote it: no union-branch or entity-tag segments."""
+    path: list[Any] = []
+    for position, segment in enumerate(loc):
+        if isinstance(segment, str) and _UNION_BRANCH.search(segment):
+            continue  # a union branch name such as "constrained-float", not a key
+        if position == 2 and loc[0] == "entities" and segment in ENTITY_TYPES:
+            continue  # the discriminator's branch, not a key
+        path.append(segment)
+    return tuple(path)
+
+
+def _allowed_keys(path: tuple[Any, ...], raw: dict[str, Any]) -> list[str]:
+    model: type[BaseModel] | None = Scene
+    if len(path) == 1:
+        model = _TABLES.get(str(path[0]))
+    elif len(path) == 2 and path[0] == "entities":
+        entities = raw.get("entities")
+        entity = entities[path[1]] if isinstance(entities, list) else None
+        model = ENTITY_TYPES.get(str(entity.get("type"))) if isinstance(entity, dict) else None
+    elif path:
+        model = None
+    return list(model.model_fields) if model is not None else []
+
+
+def _dotted(path: tuple[Any, ...]) -> str:
+    text = ""
+    for segment in path:
+        text += f"[{segment}]" if isinstance(segment, int) else f".{segment}" if text else segment
+    return text

@@ -1,0 +1,201 @@
+"""The view of a scene that an integrator steps: one second-order system over every entity.
+
+The integrated arrays are ``q`` and ``v`` of length ``3N + m``: the ``N`` particles' positions
+(and velocities) flattened, then the ``m`` generalized coordinates of the named systems, in
+scene order. Named parts are views into them (:class:`~visviva.ode.state.Layout`):
+
+    particle_position     (N, 3) [m]      q[0 : 3N]
+    particle_velocity     (N, 3) [m/s]    v[0 : 3N]
+    generalized_position  (m,)            q[3N :]
+    generalized_velocity  (m,)            v[3N :]
+
+so a particle scene's integrator works on its particle arrays without a copy. The force is the
+particle forces' sum (:class:`~visviva.forces.ForceSum`) beside each system's own equations;
+the mass matrix is diagonal (each particle's mass on its three coordinates, and 1 for the
+systems, which give accelerations); the Jacobian, when every piece has an analytic one, is the
+block-diagonal of the particle forces' sparse Jacobian and the systems' dense ones. A scene
+made of a first-order system alone (Dahlquist's test equation) is that system, part ``y``.
+"""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import ModelError
+from ..forces.assembly import ForceSum
+from ..ode.mass import Mass
+from ..ode.problems import Problem, SecondOrderProblem
+from ..ode.state import Layout, PartView, State
+from ..ode.system import FirstOrderSystem, SecondOrderSystem
+
+if TYPE_CHECKING:
+    from ..ode.system import System
+    from .model import Model
+
+__all__ = ["SceneSystem", "as_problem", "initial_state", "layout", "scene_system"]
+
+
+def _first_order(model: Model) -> bool:
+    return len(model.systems) == 1 and model.systems[0].problem.kind == "first_order"
+
+
+def layout(model: Model) -> Layout:
+    """The names of a scene's parts (see the module docstring)."""
+    if _first_order(model):
+        return Layout.first_order()
+    n, end = 3 * model.particle_count, 3 * model.particle_count + model.coordinate_count
+    shape = (model.particle_count, 3)
+    views = []
+    if model.particle_count:
+        views += [
+            PartView("particle_position", 0, 0, n, shape, "m"),
+            PartView("particle_velocity", 1, 0, n, shape, "m/s"),
+        ]
+    if model.systems:
+        views += [
+            PartView("generalized_position", 0, n, end),
+            PartView("generalized_velocity", 1, n, end),
+        ]
+    return Layout(True, tuple(views))
+
+
+def initial_state(model: Model) -> State:
+    """The state a run of ``model`` starts from."""
+    if _first_order(model):
+        problem = model.systems[0].problem
+        return State(problem.t0, (problem.y0.copy(),), layout(model))
+    q = np.concatenate(
+        [model.particle_position.ravel()] + [s.problem.q0 for s in model.systems]  # type: ignore[attr-defined]
+    )
+    v = np.concatenate(
+        [model.particle_velocity.ravel()] + [s.problem.v0 for s in model.systems]  # type: ignore[attr-defined]
+    )
+    carried: dict[str, np.ndarray] = {}
+    if model.particle_count:
+        carried["particle_alive"] = model.particle_alive.copy()
+        carried["particle_radius"] = model.particle_radius.copy()
+    if model.emitters:
+        count, emitters = model.particle_count, len(model.emitters)
+        carried["particle_age"] = np.zeros(count)
+        carried["particle_lifetime"] = np.where(model.particle_alive, np.inf, 0.0)
+        carried["particle_size"] = model.particle_radius.copy()
+        carried["emitter_serial"] = np.zeros(emitters, dtype=np.int64)
+        carried["emitter_dropped"] = np.zeros(emitters, dtype=np.int64)
+    return State(0.0, (q, v), layout(model), MappingProxyType(carried))
+
+
+def scene_system(model: Model) -> System:
+    """The system an integrator steps for ``model`` (see the module docstring)."""
+    names = layout(model)
+    if _first_order(model):
+        only = model.systems[0].problem.system()
+        return FirstOrderSystem(
+            only.rhs,
+            jacobian=only.jacobian if only.has_jacobian else None,
+            energy=(lambda t, y: only.energy(State(t, (y,)))) if only.has_energy else None,
+            layout=names,
+        )
+    count = model.particle_count
+    n = 3 * count
+    forces = ForceSum(model.forces, count)
+    pieces = [(s.offset + n, s.offset + n + s.size, s.problem.system()) for s in model.systems]
+    mass = Mass(
+        np.concatenate([np.repeat(model.particle_mass, 3), np.ones(model.coordinate_count)]),
+        np.zeros(n + model.coordinate_count),
+    )
+
+    def force(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        out = np.zeros_like(q)
+        if count:
+            shape = (count, 3)
+            forces.accumulate(t, q[:n].reshape(shape), v[:n].reshape(shape), out[:n].reshape(shape))
+        for a, b, piece in pieces:
+            out[a:b] = piece.acceleration(t, q[a:b], v[a:b])
+        return out
+
+    def jacobian(t: float, q: np.ndarray, v: np.ndarray) -> tuple[Any, Any]:
+        import scipy.sparse as sp
+
+        stiffness, damping = [], []
+        if count:
+            shape = (count, 3)
+            dfdx, dfdv = forces.jacobian(t, q[:n].reshape(shape), v[:n].reshape(shape))
+            stiffness.append(dfdx)
+            damping.append(dfdv if dfdv is not None else sp.csr_matrix((n, n)))
+        for a, b, piece in pieces:
+            dq, dv = piece.force_jacobian(t, q[a:b], v[a:b])
+            stiffness.append(sp.csr_matrix(dq))
+            damping.append(sp.csr_matrix((b - a, b - a)) if dv is None else sp.csr_matrix(dv))
+        return sp.block_diag(stiffness, format="csr"), (
+            sp.block_diag(damping, format="csr") if velocity_dependent else None
+        )
+
+    def energy(t: float, q: np.ndarray, v: np.ndarray, carried: Any) -> float:
+        total = 0.0
+        if count:
+            alive = carried["particle_alive"]
+            x, u = q[:n].reshape(count, 3), v[:n].reshape(count, 3)
+            total += 0.5 * float(np.einsum("i,ij,ij->", model.particle_mass * alive, u, u))
+            total += forces.potential(t, x, alive)
+        for a, b, piece in pieces:
+            value = piece.energy(State(t, (q[a:b], v[a:b])))
+            total += 0.0 if value is None else float(value)
+        return total
+
+    velocity_dependent = forces.velocity_dependent or any(p.velocity_dependent for *_, p in pieces)
+    analytic = forces.has_jacobian and all(p.has_jacobian for *_, p in pieces)
+    return SceneSystem(
+        force,
+        mass=mass,
+        velocity_dependent=velocity_dependent,
+        jacobian=jacobian if analytic else None,
+        energy=energy,
+        layout=names,
+    )
+
+
+class SceneSystem(SecondOrderSystem):
+    """A scene's second-order system; its energy counts only live particles (it reads the
+    state's carried ``particle_alive``)."""
+
+    def energy(self, state: State) -> np.ndarray | None:
+        """Kinetic plus potential energy [J] of ``state``: live particles and systems."""
+        q, v = state.parts
+        return np.asarray(self._energy(state.t, q, v, state.carried), dtype=np.float64)  # type: ignore[misc]
+
+
+def as_problem(model: Model) -> Problem:
+    """The scene's smooth dynamics as a plain problem, for ``vv.solve``, comparisons of
+    methods and convergence studies: the one system of a scene that holds nothing else, or
+    every entity as one second-order problem over the coordinates of :func:`layout`.
+
+    Raises:
+        ModelError: For a scene with stages (collisions, emitters), which a plain problem cannot
+            express.
+    """
+    if model.stages:
+        raise ModelError(
+            "this scene has collisions or emitters, which change its state between steps: run "
+            "it with vv.Simulation or visviva run (a plain problem has only smooth dynamics)"
+        )
+    if len(model.systems) == 1 and not model.particle_count:
+        return model.systems[0].problem
+    system = scene_system(model)
+    start = initial_state(model)
+    q0, v0 = start.parts
+
+    def energy(t: float, q: np.ndarray, v: np.ndarray) -> Any:
+        return system._energy(t, q, v, start.carried)
+
+    def moving(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return system._force(t, q, v)
+
+    def still(t: float, q: np.ndarray) -> np.ndarray:
+        return system._force(t, q, v0)  # a force that ignores the velocities
+
+    force = moving if system.velocity_dependent else still
+    mass = system.mass.values  # type: ignore[union-attr]  # a scene system always has one
+    return SecondOrderProblem.from_force(force, mass, q0, v0, energy=energy, name=model.name)

@@ -1,0 +1,12 @@
+"""Particle systems: emitters, their births and deaths, and counter-based random numbers.
+
+* :mod:`~visviva.particles.emitters`: an emitter in numbers (:class:`EmitterSpec`);
+* :mod:`~visviva.particles.emission`: the stage that makes particles live and die;
+* :mod:`~visviva.particles.random`: random numbers that depend on who a particle is, not on
+  when or where it was computed.
+"""
+
+from .emission import Emission
+from .emitters import EmitterSpec
+
+__all__ = ["Emission", "EmitterSpec"]

@@ -1,0 +1,254 @@
+"""The emission stage: particles are born, age and die (seed 002, "Particle animation").
+
+After each integrator step, for each emitter, in order:
+
+1. every live particle ages by the step; those whose age reached their lifetime die, and dead
+   slots are parked at rest at the origin (dead particles feel forces like live ones, so
+   parking them keeps their numbers small; every output hides them);
+2. the particles born during the step ``[t0, t1)`` (continuous births at ``start + k/rate``,
+   and bursts) take the lowest free slots of the emitter; each draws its position on the
+   emitter's shape, a direction in the cone, a speed, a lifetime and a radius from the
+   counter-based generator of :mod:`visviva.particles.random`, and has already flown for
+   ``t1 − τ`` seconds since its birth time ``τ`` (so a stream of particles leaves evenly spaced,
+   not in clumps at each step);
+3. the radius of every live particle follows its size ramp.
+
+The carried parts: ``particle_alive``, ``particle_age`` [s], ``particle_lifetime`` [s],
+``particle_size`` (the radius drawn at birth) [m], ``particle_radius`` (after the ramp) [m];
+per emitter, ``emitter_serial`` (births so far: the random state) and ``emitter_dropped``
+(births that found no free slot).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, ClassVar
+
+import numpy as np
+from numba import njit
+
+from .emitters import EmitterSpec, ramp_values
+from .random import uniform
+
+if TYPE_CHECKING:
+    from ..ode.state import State
+
+__all__ = ["Emission"]
+
+
+class Emission:
+    """The emission stage of a scene's emitters (see the module docstring).
+
+    Args:
+        emitters: The emitters, in scene order (their slot ranges do not overlap).
+    """
+
+    compiled: ClassVar[bool] = True
+
+    def __init__(self, emitters: Sequence[EmitterSpec]) -> None:
+        self.emitters = tuple(emitters)
+
+    def apply(self, before: State, after: State, h: float) -> State:
+        """Age, kill, give birth and ramp sizes (see the module docstring)."""
+        t0, t1 = before.t, after.t
+        parts = tuple(np.array(part) for part in after.parts)
+        result = after.from_parts(t1, parts)
+        x, v = result["particle_position"], result["particle_velocity"]
+        alive = after["particle_alive"].copy()
+        age = after["particle_age"] + np.where(alive, t1 - t0, 0.0)
+        lifetime = after["particle_lifetime"].copy()
+        size = after["particle_size"].copy()
+        radius = after["particle_radius"].copy()
+        serial = after["emitter_serial"].copy()
+        dropped = after["emitter_dropped"].copy()
+        alive &= age < lifetime
+        for spec in self.emitters:
+            slots = slice(spec.first_slot, spec.first_slot + spec.capacity)
+            parked = ~alive[slots]
+            x[slots][parked] = 0.0
+            v[slots][parked] = 0.0
+            times = _birth_times(spec, t0, t1)
+            free = spec.first_slot + np.flatnonzero(parked)[: times.shape[0]]
+            dropped[spec.index] += times.shape[0] - free.shape[0]
+            born = times[: free.shape[0]]
+            serials = serial[spec.index] + np.arange(born.shape[0], dtype=np.int64)
+            serial[spec.index] += times.shape[0]
+            _sample(spec, serials, t1 - born, free, x, v, lifetime, size)
+            age[free] = t1 - born
+            alive[free] = age[free] < lifetime[free]
+            ramped = spec.first_slot + np.flatnonzero(alive[slots])
+            factor = ramp_values(spec.size_ramp, age[ramped] / lifetime[ramped])[:, 0]
+            radius[ramped] = size[ramped] * factor
+        return result.with_carried(
+            particle_alive=alive,
+            particle_age=age,
+            particle_lifetime=lifetime,
+            particle_size=size,
+            particle_radius=radius,
+            emitter_serial=serial,
+            emitter_dropped=dropped,
+        )
+
+
+def _birth_times(spec: EmitterSpec, t0: float, t1: float) -> np.ndarray:
+    """The birth times in ``[t0, t1)``, sorted (bursts before continuous births at a tie)."""
+    first, last = spec.births_before(t0), spec.births_before(t1)
+    continuous = (
+        spec.start + np.arange(first, last, dtype=np.float64) / spec.rate
+        if last > first
+        else np.zeros(0)
+    )
+    in_step = (spec.burst_times >= t0) & (spec.burst_times < t1)
+    bursts = np.repeat(spec.burst_times[in_step], spec.burst_counts[in_step])
+    return np.sort(np.concatenate([bursts, continuous]), kind="stable")
+
+
+def _sample(
+    spec: EmitterSpec,
+    serials: np.ndarray,
+    flown: np.ndarray,
+    slots: np.ndarray,
+    x: np.ndarray,
+    v: np.ndarray,
+    lifetime: np.ndarray,
+    size: np.ndarray,
+) -> None:
+    """Draw each newborn's state and attributes into its slot (see :func:`_sample_kernel`)."""
+    if slots.shape[0] == 0:
+        return
+    areas = np.zeros(0)
+    if spec.triangles.shape[0]:
+        t = spec.triangles
+        areas = np.cumsum(
+            0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+        )
+    _sample_kernel(
+        spec.seed,
+        spec.index,
+        serials,
+        flown,
+        slots,
+        spec.shape,
+        spec.position,
+        spec.radius,
+        spec.extent,
+        _basis(spec.normal),
+        spec.surface,
+        spec.triangles,
+        areas,
+        _basis(spec.direction),
+        math.cos(spec.spread),
+        np.array(spec.speed),
+        np.array(spec.lifetime),
+        np.array(spec.particle_radius),
+        x,
+        v,
+        lifetime,
+        size,
+    )
+
+
+def _basis(axis: np.ndarray) -> np.ndarray:
+    """``(3, 3)``: two unit vectors perpendicular to ``axis``, then ``axis`` itself."""
+    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    first = np.cross(axis, helper)
+    first /= np.linalg.norm(first)
+    return np.stack([first, np.cross(axis, first), axis])
+
+
+#: Draw indices of each particle's random numbers.
+_POSITION, _DIRECTION, _SPEED, _LIFETIME, _RADIUS = 0, 4, 6, 7, 8
+
+
+@njit(cache=True, error_model="numpy")
+def _between(low_high, u):  # pragma: no cover - compiled
+    return low_high[0] + u * (low_high[1] - low_high[0])
+
+
+@njit(cache=True, error_model="numpy")
+def _position(
+    seed, stream, serial, shape, centre, radius, extent, plane, surface, triangles, areas
+):  # pragma: no cover
+    """A point drawn uniformly on (or in) the emitter's shape."""
+    u0 = uniform(seed, stream, serial, _POSITION)
+    u1 = uniform(seed, stream, serial, _POSITION + 1)
+    u2 = uniform(seed, stream, serial, _POSITION + 2)
+    u3 = uniform(seed, stream, serial, _POSITION + 3)
+    p = centre.copy()
+    if shape == 1:  # disc: uniform by area, r = R √u
+        r = radius * math.sqrt(u0)
+        angle = 2.0 * math.pi * u1
+        p += r * (math.cos(angle) * plane[0] + math.sin(angle) * plane[1])
+    elif shape == 2:  # sphere: uniform direction; r = R ∛u inside, R on the surface
+        z = 1.0 - 2.0 * u0
+        ring = math.sqrt(max(0.0, 1.0 - z * z))
+        angle = 2.0 * math.pi * u1
+        r = radius if surface else radius * u2 ** (1.0 / 3.0)
+        p[0] += r * ring * math.cos(angle)
+        p[1] += r * ring * math.sin(angle)
+        p[2] += r * z
+    elif shape == 3:  # box: uniform inside, or on a face chosen by its area
+        offset = np.array([u0 - 0.5, u1 - 0.5, u2 - 0.5]) * extent
+        if surface:
+            faces = np.array([extent[1] * extent[2], extent[0] * extent[2], extent[0] * extent[1]])
+            pick = u3 * faces.sum()
+            axis = 0 if pick < faces[0] else (1 if pick < faces[0] + faces[1] else 2)
+            side = 1.0 if (pick * 2.0) % 2.0 < 1.0 else -1.0
+            offset[axis] = 0.5 * side * extent[axis]
+        p += offset
+    elif shape == 4:  # mesh surface: a triangle by its area, then uniform on it
+        k = np.searchsorted(areas, u3 * areas[-1], side="right")
+        k = min(k, areas.shape[0] - 1)
+        s = math.sqrt(u0)
+        a, b = 1.0 - s, s * (1.0 - u1)
+        p = a * triangles[k, 0] + b * triangles[k, 1] + (1.0 - a - b) * triangles[k, 2]
+    return p
+
+
+@njit(cache=True, error_model="numpy")
+def _sample_kernel(
+    seed,
+    stream,
+    serials,
+    flown,
+    slots,
+    shape,
+    centre,
+    radius,
+    extent,
+    plane,
+    surface,
+    triangles,
+    areas,
+    cone,
+    cos_spread,
+    speed,
+    life,
+    size_range,
+    x,
+    v,
+    lifetime,
+    size,
+):  # pragma: no cover - compiled
+    for j in range(slots.shape[0]):
+        n = serials[j]
+        i = slots[j]
+        p = _position(
+            seed, stream, n, shape, centre, radius, extent, plane, surface, triangles, areas
+        )
+        # A direction uniform on the cone's cap: cos θ uniform in [cos α, 1].
+        cos_theta = 1.0 - uniform(seed, stream, n, _DIRECTION) * (1.0 - cos_spread)
+        sin_theta = math.sqrt(max(0.0, 1.0 - cos_theta * cos_theta))
+        angle = 2.0 * math.pi * uniform(seed, stream, n, _DIRECTION + 1)
+        direction = (
+            sin_theta * math.cos(angle) * cone[0]
+            + sin_theta * math.sin(angle) * cone[1]
+            + cos_theta * cone[2]
+        )
+        velocity = _between(speed, uniform(seed, stream, n, _SPEED)) * direction
+        for k in range(3):
+            v[i, k] = velocity[k]
+            x[i, k] = p[k] + flown[j] * velocity[k]
+        lifetime[i] = _between(life, uniform(seed, stream, n, _LIFETIME))
+        size[i] = _between(size_range, uniform(seed, stream, n, _RADIUS))

@@ -1,0 +1,292 @@
+"""Driving a scene from Python: ``vv.Simulation(model)``, step by step.
+
+For people who write their own loop around a simulation (as with MuJoCo's ``mj_step`` or
+pymunk's ``space.step``)::
+
+    sim = vv.Simulation(model)
+    sim.step()                          # one step of dt
+    sim.run(until=2.0)                  # lands exactly on t = 2 s
+    sim.time, sim.energy()
+    sim.state["particle_position"]      # the live particles, (n, 3), in slot order
+    blob = sim.checkpoint()             # bytes
+    again = vv.Simulation.restore(model, blob)   # continues bit for bit
+
+Each step is the pipeline's (:class:`~visviva.simulation.stepper.Stepper`): the integrator,
+then the model's stages (collisions, births and deaths), then the divergence watch; the runs of
+``visviva run`` go through :meth:`Simulation.run` too. Time is counted on the grid
+``origin + k·dt/substeps`` from integer counters, so a run split into pieces — or checkpointed,
+restored and continued — takes exactly the steps of one long run.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import math
+from collections.abc import Iterator, Mapping
+from types import MappingProxyType
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .._validation import real_number, whole_number
+from ..errors import ModelError, SimulationError
+from ..integrators import Integrator, get
+from ..ode.state import State
+from .interrupt import Interrupted
+from .loop import MAX_STEPS, Schedule, advance
+from .progress import Progress
+from .recorder import FrameCallback, FrameRecorder
+from .stepper import Stepper
+from .watch import DivergenceWatch
+
+if TYPE_CHECKING:
+    from ..model import Model
+
+__all__ = ["CHECKPOINT_FORMAT", "Simulation", "SimulationState"]
+
+#: Format tag and version of checkpoints (:meth:`Simulation.checkpoint`).
+CHECKPOINT_FORMAT = "visviva.checkpoint"
+CHECKPOINT_VERSION = 1
+#: Parts that describe particles one per slot: :class:`SimulationState` shows the live ones.
+_PER_PARTICLE = ("particle_",)
+
+
+class SimulationState(Mapping[str, np.ndarray]):
+    """A read-only view of a simulation's state by part name.
+
+    Particle parts (``particle_position``, ``particle_velocity``, ``particle_radius``, ...)
+    hold the live particles only, in slot order: ``(n, 3)`` or ``(n,)``. Other parts
+    (``generalized_position``, ...) are whole. Values are copies, safe to keep.
+
+    Attributes:
+        t: Time [s].
+    """
+
+    def __init__(self, state: State) -> None:
+        self._state = state
+        self.t = state.t
+        alive = state.carried.get("particle_alive")
+        self._alive = None if alive is None or alive.all() else alive
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        values = np.array(self._state[name])
+        if self._alive is not None and name.startswith(_PER_PARTICLE):
+            values = values[self._alive]
+        values.flags.writeable = False
+        return values
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._state.names())
+
+    def __len__(self) -> int:
+        return len(self._state.names())
+
+    def __repr__(self) -> str:
+        return f"SimulationState(t={self.t!r}, parts: {', '.join(self)})"
+
+
+class Simulation:
+    """A scene in motion (see the module docstring).
+
+    Args:
+        model: The built scene (``vv.load_model(path)`` or ``vv.SceneBuilder(...).build()``).
+        method: Integrator name or instance (default: the scene's).
+        dt: Step [s] (default: the scene's); each step is the scene's ``substeps``
+            integrator steps.
+        divergence_limit: Largest allowed ``|component|`` before the run counts as diverged
+            (default ``1e10 × max(1, max |initial state|)``).
+
+    Raises:
+        ModelError: If the method cannot integrate the scene or an argument is invalid.
+    """
+
+    def __init__(
+        self,
+        model: Model,
+        *,
+        method: str | Integrator | None = None,
+        dt: float | None = None,
+        divergence_limit: float | None = None,
+    ) -> None:
+        settings = model.integration
+        self.model = model
+        self.integrator = get(settings.method if method is None else method)
+        self.dt = settings.dt if dt is None else real_number("dt", dt, positive=True, unit=" s")
+        self.substeps = settings.substeps
+        self.system = model.system()
+        self.integrator.check(self.system)
+        state = model.initial_state()
+        if divergence_limit is not None:
+            divergence_limit = real_number("divergence_limit", divergence_limit, positive=True)
+        watch = DivergenceWatch(self.system, self.integrator, self.dt, state, divergence_limit)
+        self._stepper = Stepper(self.system, self.integrator, watch, model.stages)
+        self._state = state
+        self._origin = state.t
+        self._steps = 0  # steps of dt since the origin
+
+    @property
+    def time(self) -> float:
+        """The simulated time [s]."""
+        return self._state.t
+
+    @property
+    def state(self) -> SimulationState:
+        """The current state by part name (live particles only; see :class:`SimulationState`)."""
+        return SimulationState(self._state)
+
+    @property
+    def raw_state(self) -> State:
+        """The whole state: every particle slot, dead ones included, and the carried parts."""
+        return self._state
+
+    def energy(self) -> float:
+        """Kinetic plus potential energy [J] of the live particles and the systems."""
+        energy = self.system.energy(self._state)
+        return math.nan if energy is None else float(energy)
+
+    def step(self, count: int = 1) -> None:
+        """Advance ``count`` steps of ``dt``.
+
+        Raises:
+            SimulationDiverged: If the state blows up (the simulation keeps the state at the
+                end of the last whole step that was good).
+            NewtonConvergenceError: If an implicit step fails (likewise).
+        """
+        count = whole_number("count", count, minimum=1)
+        self._check_budget(count)
+        schedule = Schedule(
+            self._origin,
+            self._origin + (self._steps + count) * self.dt,
+            self.dt,
+            self.substeps,
+            count,
+            0.0,
+            self._steps,
+        )
+        self._advance(schedule, None, 1, False)
+
+    def run(
+        self,
+        until: float,
+        *,
+        record_every: int = 1,
+        on_frame: FrameCallback | None = None,
+        progress: bool | None = False,
+    ) -> None:
+        """Advance to time ``until`` [s] exactly (the last step shortened if it must be).
+
+        Args:
+            until: The time to reach [s], not before :attr:`time`.
+            record_every: Call ``on_frame`` after every k-th step counted from the start, and
+                after the last step.
+            on_frame: Called with ``(state, energy)`` for each recorded step.
+            progress: Show a progress bar (``None``: if stderr is a terminal).
+        """
+        until = real_number("until", until, unit=" s")
+        if until < self.time:
+            raise ModelError(f"`until` ({until!r} s) is before the current time {self.time!r} s")
+        if until == self.time:
+            return
+        record_every = whole_number("record_every", record_every, minimum=1)
+        schedule = Schedule.build(self._origin, until, self.dt, self.substeps, self._steps)
+        self._check_budget(schedule.steps)
+        self._advance(schedule, on_frame, record_every, progress)
+
+    def _check_budget(self, steps: int) -> None:
+        if steps * self.substeps > MAX_STEPS:
+            raise ModelError(
+                f"{steps * self.substeps:.3g} integrator steps in one call; the limit is "
+                f"{MAX_STEPS:.0e} (use a larger dt, or run in pieces)"
+            )
+
+    def _advance(
+        self,
+        schedule: Schedule,
+        on_frame: FrameCallback | None,
+        record_every: int,
+        progress: bool | None,
+    ) -> None:
+        recorder = None
+        if on_frame is not None:
+            recorder = FrameRecorder(self.system, self._state, False, on_frame, keep=False)
+        with Progress(schedule.steps, self.integrator.name, progress) as bar:
+            try:
+                self._state = advance(
+                    self._stepper, self._state, schedule, record_every, recorder, bar
+                )
+            except (SimulationError, Interrupted) as stopped:
+                # Keep the last good state, on the grid: the next step continues from it.
+                self._state = stopped.state
+                self._steps = schedule.first + stopped.steps_done
+                raise
+        if schedule.last_dt > 0.0:
+            self._origin, self._steps = schedule.t_end, 0
+        else:
+            self._steps = schedule.first + schedule.full_steps
+
+    def checkpoint(self) -> bytes:
+        """Everything needed to continue this simulation bit for bit, as bytes.
+
+        Restore with :meth:`Simulation.restore` on the same model (checked by a fingerprint of
+        the scene).
+        """
+        header = {
+            "format": CHECKPOINT_FORMAT,
+            "version": CHECKPOINT_VERSION,
+            "model": fingerprint(self.model),
+            "method": self.integrator.name,
+            "dt": self.dt,
+            "origin": self._origin,
+            "steps": self._steps,
+            "t": self._state.t,
+            "derivative": self._state.derivative is not None,
+            "carried": list(self._state.carried),
+        }
+        arrays = {f"part{i}": part for i, part in enumerate(self._state.parts)}
+        arrays |= {f"carried_{name}": value for name, value in self._state.carried.items()}
+        if self._state.derivative is not None:
+            arrays |= {f"derivative{i}": d for i, d in enumerate(self._state.derivative)}
+        buffer = io.BytesIO()
+        np.savez(buffer, header=np.frombuffer(json.dumps(header).encode(), np.uint8), **arrays)
+        return buffer.getvalue()
+
+    @classmethod
+    def restore(
+        cls, model: Model, blob: bytes, *, method: str | Integrator | None = None
+    ) -> Simulation:
+        """The simulation a :meth:`checkpoint` of ``model`` saved, ready to continue.
+
+        Raises:
+            ModelError: If ``blob`` is not a checkpoint, or one of another scene.
+        """
+        try:
+            with np.load(io.BytesIO(blob), allow_pickle=False) as saved:
+                header = json.loads(bytes(saved["header"]).decode())
+                arrays = {name: np.array(saved[name]) for name in saved.files}
+        except (OSError, ValueError, KeyError, TypeError, UnicodeDecodeError) as error:
+            raise ModelError(f"this is not a visviva checkpoint ({type(error).__name__})") from None
+        if header.get("format") != CHECKPOINT_FORMAT or header.get("version") != CHECKPOINT_VERSION:
+            raise ModelError("this is not a visviva checkpoint of a version this visviva reads")
+        if header["model"] != fingerprint(model):
+            raise ModelError(
+                "this checkpoint was made with another scene: restore it with the model it was "
+                "saved from"
+            )
+        simulation = cls(model, method=method or header["method"], dt=header["dt"])
+        template = simulation._state
+        parts = tuple(arrays[f"part{i}"] for i in range(len(template.parts)))
+        carried = MappingProxyType({name: arrays[f"carried_{name}"] for name in header["carried"]})
+        derivative = None
+        if header["derivative"]:
+            derivative = tuple(arrays[f"derivative{i}"] for i in range(len(template.parts)))
+        simulation._state = State(header["t"], parts, template.layout, carried, derivative)
+        simulation._origin, simulation._steps = header["origin"], header["steps"]
+        return simulation
+
+
+def fingerprint(model: Model) -> str:
+    """A digest of the scene description a model was built from."""
+    text = model.scene.model_dump_json()
+    return hashlib.sha256(text.encode()).hexdigest()
