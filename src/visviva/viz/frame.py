@@ -14,6 +14,11 @@ then takes the steps:
 
 A geometry kind is a *layer*: an object with ``cast_shadows`` and ``draw``. Rigid bodies will
 be a new layer, not a change to the others.
+
+Points that are born and die (:mod:`visviva.viz.lifetimes`): each frame draws and shadows only
+its live points, at that frame's radius and colour; a trail goes back no further than the start
+of its point's current life; the framing and the ground come from live points only. Edges and
+faces are drawn between their points in every frame (emitters' particles have none).
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ import numpy as np
 
 from ..simulation.recording import Geometry
 from . import ground, raster
+from .lifetimes import Appearance, life_starts
 from .timescale import format_time
 
 if TYPE_CHECKING:
@@ -70,12 +76,19 @@ NEAR_FRACTION = 1e-3
 
 
 def drawn_bounds(geometry: Geometry) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper corners [m] of every point of every frame as drawn (radii included)."""
-    low, high = geometry.bounds()
-    if geometry.radius is None:
-        pad = float(geometry.drawn_radius().max(initial=0.0))
-        low, high = low - pad, high + pad
-    return low, high
+    """Lower and upper corners [m] of the box holding every live point of every frame as
+    drawn: each point padded by its drawn radius in that frame. Dead points count for nothing;
+    with no live point at all, both corners are the origin."""
+    return Appearance.of(geometry).live_bounds(geometry.points)
+
+
+def _live_radii(look: Appearance) -> np.ndarray:
+    """Drawn radii [m] of every live point in any frame, flat (sizes the shadow map)."""
+    if look.alive is None:
+        return look.radius.ravel()
+    if look.varying_radius:
+        return look.radius[look.alive]
+    return look.radius[look.alive.any(axis=0)]
 
 
 @dataclass
@@ -84,6 +97,9 @@ class _Frame:
     positions: np.ndarray  # (P, 3) world [m]
     view: np.ndarray  # (P, 3) camera coordinates: right, up, forward [m]
     screen: np.ndarray  # (P, 3) pixel x, y (NaN behind the camera) and view depth [m]
+    live: np.ndarray | None  # indices of the live points, or None: all of them
+    radius: np.ndarray  # (P,) drawn radius [m] in this frame
+    colour: np.ndarray  # (P, 3) float32 sRGB in this frame
 
 
 class _Stage:
@@ -184,38 +200,42 @@ class _Layer(Protocol):
 
 
 class _Spheres:
-    def __init__(self, radius: np.ndarray, colour: np.ndarray) -> None:
-        self.radius = radius
-        self.colour = colour
+    def __init__(self) -> None:
         self.material = np.array(MATERIAL)
 
     def cast_shadows(self, stage: _Stage, frame: _Frame, shadows: _ShadowMap) -> None:
-        height = frame.positions[:, 1] - stage.ground_y
+        positions, radius = frame.positions, frame.radius
+        if frame.live is not None:
+            positions, radius = positions[frame.live], radius[frame.live]
+        height = positions[:, 1] - stage.ground_y
         weight = 1.0 / (1.0 + SHADOW_FADE * np.maximum(height, 0.0) / stage.scene)
         ground.splat_discs(
             shadows.occlusion,
             shadows.origin,
             shadows.cell,
-            stage.on_ground(frame.positions),
-            SHADOW_SIZE * self.radius,
+            stage.on_ground(positions),
+            SHADOW_SIZE * radius,
             weight,
         )
 
     def draw(self, stage: _Stage, frame: _Frame, color: np.ndarray, depth: np.ndarray) -> None:
-        z = frame.screen[:, 2]
+        z, radius = frame.screen[:, 2], frame.radius
         with np.errstate(invalid="ignore", divide="ignore"):
             # Apparent radius of a sphere centred on the axis: f·r / sqrt(z² − r²).
-            size = stage.focal * self.radius / np.sqrt(z * z - self.radius * self.radius)
-        size[~(z - self.radius > stage.near) | np.isnan(frame.screen[:, 0])] = np.nan
-        order = np.argsort(-z, kind="stable")
+            size = stage.focal * radius / np.sqrt(z * z - radius * radius)
+        size[~(z - radius > stage.near) | np.isnan(frame.screen[:, 0])] = np.nan
+        if frame.live is None:
+            order = np.argsort(-z, kind="stable")
+        else:  # dead points are neither in the order nor of any size
+            order = frame.live[np.argsort(-z[frame.live], kind="stable")]
         raster.draw_spheres(
             color,
             depth,
             frame.screen,
-            self.radius,
+            radius,
             size,
             order,
-            self.colour,
+            frame.colour,
             stage.light,
             self.material,
             MIN_SPHERE_PIXELS,
@@ -253,13 +273,15 @@ def _screen_segments(stage: _Stage, start: np.ndarray, end: np.ndarray) -> np.nd
 
 
 class _Trails:
-    """Each point's path over the last ``trail`` simulated seconds, a line of its colour."""
+    """Each point's path over the last ``trail`` simulated seconds, a line of its colour; a
+    point that is born draws from its birth on (a reused slot does not join two lives)."""
 
     def __init__(
-        self, points: np.ndarray, times: np.ndarray, trail: float, colour: np.ndarray, height: int
+        self, points: np.ndarray, times: np.ndarray, trail: float, look: Appearance, height: int
     ) -> None:
         self.points, self.times, self.trail = points, times, trail
-        self.colour = 0.6 * colour + 0.4  # paler than the point
+        self.alive = look.alive
+        self.starts = None if look.alive is None else life_starts(look.alive)
         self.half_width = 0.5 * max(1.0, height / 540.0)
 
     def cast_shadows(self, stage: _Stage, frame: _Frame, shadows: _ShadowMap) -> None:
@@ -273,11 +295,17 @@ class _Trails:
             return
         path = self.points[picks.astype(np.int64)]  # (n, P, 3)
         view = stage.to_view(path.reshape(-1, 3)).reshape(path.shape)
+        colour = 0.6 * frame.colour + 0.4  # paler than the point
         for p in range(path.shape[1]):
-            segments = _screen_segments(stage, view[:-1, p], view[1:, p])
-            raster.draw_lines(
-                color, depth, segments, self.half_width, self.colour[p], LINE_DEPTH_BIAS
-            )
+            start = 0
+            if self.alive is not None and self.starts is not None:
+                if not self.alive[k, p]:
+                    continue
+                start = int(np.searchsorted(picks, self.starts[k, p]))
+                if picks.size - start < 2:
+                    continue
+            segments = _screen_segments(stage, view[start:-1, p], view[start + 1 :, p])
+            raster.draw_lines(color, depth, segments, self.half_width, colour[p], LINE_DEPTH_BIAS)
 
 
 class _Faces:
@@ -341,13 +369,12 @@ class FramePainter:
     ) -> None:
         self.geometry = geometry
         self.width, self.height = size
-        radius = geometry.drawn_radius()
-        colour = (
-            np.tile(np.array(SPHERE_COLOUR, dtype=np.float32), (radius.size, 1))
-            if geometry.color is None
-            else np.asarray(geometry.color, dtype=np.float32)
+        look = Appearance.of(geometry)
+        self.look = look
+        self.default_colour = np.tile(
+            np.array(SPHERE_COLOUR, dtype=np.float32), (geometry.points.shape[1], 1)
         )
-        low, high = drawn_bounds(geometry)
+        low, high = look.live_bounds(geometry.points)
         scene = max(float(np.linalg.norm(high - low)), 1e-9)
         stage = _Stage(camera, self.width, self.height, min(0.0, float(low[1])), scene)
         self.stage = stage
@@ -357,8 +384,8 @@ class FramePainter:
         if geometry.edges is not None and len(geometry.edges):
             self.layers.append(_Edges(geometry.edges, self.height))
         if trail > 0.0:
-            self.layers.append(_Trails(geometry.points, times, trail, colour, self.height))
-        self.layers.append(_Spheres(radius, colour))
+            self.layers.append(_Trails(geometry.points, times, trail, look, self.height))
+        self.layers.append(_Spheres())
         self.span = float(times[-1] - times[0]) if times.size else 0.0
         shape = (self.height, self.width)
         self.background = np.empty((*shape, 3), dtype=np.float32)
@@ -378,7 +405,7 @@ class FramePainter:
             np.array(ENVIRONMENT),
             BACKGROUND_SAMPLES,
         )
-        self.shadows = _ShadowMap(stage, low, high, radius)
+        self.shadows = _ShadowMap(stage, low, high, _live_radii(look))
         self.color = np.empty_like(self.background)
         self.depth = np.empty_like(self.background_depth)
         self._label = _Label(self.height)
@@ -393,7 +420,18 @@ class FramePainter:
         """Image of recorded frame ``index`` labelled with ``time`` [s]: uint8, ``(H, W, 3)``."""
         positions = np.asarray(self.geometry.points[index], dtype=np.float64)
         view = self.stage.to_view(positions)
-        frame = _Frame(index, positions, view, self.stage.to_screen(view))
+        look = self.look
+        alive = None if look.alive is None else np.flatnonzero(look.alive[index])
+        colour = look.color_at(index)
+        frame = _Frame(
+            index,
+            positions,
+            view,
+            self.stage.to_screen(view),
+            alive,
+            look.radius_at(index),
+            self.default_colour if colour is None else colour,
+        )
         shadows = self.shadows
         shadows.occlusion.fill(0.0)
         for layer in self.layers:

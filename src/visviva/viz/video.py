@@ -19,11 +19,12 @@ What a frame shows (:class:`FramePainter` in :mod:`visviva.viz.frame`): a sky gr
 checkered ground plane at ``y = min(0, lowest point)``, points as shaded spheres of their
 recorded radius and colour (or the viewer's default radius and blue; a recording's display
 radii, for bodies too small to see, are drawn instead and the label says "sizes not to
-scale"), optional trails behind the points, edges as lines, faces as Gouraud-shaded triangles,
-shadows from a light above, and the time of the recorded frame shown in the unit that reads
-best, ``t = 1.234 s`` or ``t = 182.6 days``. Output frame ``k`` shows the recorded frame
-nearest ``t0 + k/fps`` (:func:`visviva.io.timeline.frames_at_rate`), so the video plays in
-real time whatever the recording's frame spacing.
+scale"), only the points alive in the frame (particles of emitters are born and die; see
+:mod:`visviva.viz.lifetimes`), optional trails behind the points, edges as lines, faces as
+Gouraud-shaded triangles, shadows from a light above, and the time of the recorded frame
+shown in the unit that reads best, ``t = 1.234 s`` or ``t = 182.6 days``. Output frame ``k``
+shows the recorded frame nearest ``t0 + k/fps`` (:func:`visviva.io.timeline.frames_at_rate`),
+so the video plays in real time whatever the recording's frame spacing.
 
 References: ITU-T H.264 (libx264 via ffmpeg); GIF89a specification (delays in hundredths of a
 second, hence the frame delays below alternate so that their sum keeps time).
@@ -45,7 +46,7 @@ from .._validation import describe, real_number
 from ..errors import ModelError
 from ..io.files import atomic_path
 from ..io.timeline import frames_at_rate
-from ..simulation.recording import Recording
+from ..simulation.recording import Geometry, Recording
 from .frame import FramePainter, drawn_bounds
 
 __all__ = [
@@ -207,13 +208,14 @@ def render_video(
 
     Args:
         recording: A recording with drawable geometry (``points``, optional ``radius``,
-            ``edges``, ``faces``; see :meth:`Recording.geometry`).
+            ``color``, ``edges``, ``faces``, and ``alive``, ``radius`` and ``color`` per frame
+            for points that are born and die; see :meth:`Recording.geometry`).
         path: Output file; ``.mp4`` or ``.gif`` chooses the format. Its directory must exist.
             Written atomically: a temporary file renamed when complete.
         fps: Output frames per second [1/s]; at most 50 for GIF.
         size: ``(width, height)`` [px]; both even for mp4 (yuv420p halves the colour planes).
-        camera: The view; default :meth:`Camera.framing` of the bounds of all frames, so that
-            everything stays in view for the whole clip.
+        camera: The view; default :meth:`Camera.framing` of the bounds of the live points of
+            all frames, so that everything stays in view for the whole clip.
         progress: Show a progress bar on stderr for long renders; ``None`` (default): only
             when stderr is a terminal.
         speed: Simulated seconds per second of video (1: real time; 86400: a day per
@@ -264,7 +266,7 @@ def render_video(
     if not isinstance(recording, Recording):
         raise ModelError(f"`recording` must be a visviva Recording (got {describe(recording)})")
     geometry = recording.geometry()
-    _check_finite(geometry.points, geometry.radius)
+    _check_finite(geometry)
     if trail > 0.0 and geometry.points.shape[1] > MAX_TRAIL_POINTS:
         raise ModelError(
             f"`trail` draws a path behind each point, for at most {MAX_TRAIL_POINTS} points "
@@ -320,18 +322,28 @@ def _checked_size(size: Any, *, even: bool) -> tuple[int, int]:
     return width, height
 
 
-def _check_finite(points: np.ndarray, radius: np.ndarray | None) -> None:
-    bad = ~np.isfinite(points)
+def _check_finite(geometry: Geometry) -> None:
+    """Refuse non-finite live positions and bad radii; dead points may hold anything."""
+    points, radius, alive = geometry.points, geometry.radius, geometry.alive
+    bad = ~np.isfinite(points).all(axis=2)
+    if alive is not None:
+        bad &= alive
     if bad.any():
-        frame, point, _ = (int(i) for i in np.argwhere(bad)[0])
+        frame, point = (int(i) for i in np.argwhere(bad)[0])
         raise ModelError(
             f"`points` must be finite to be drawn: frame {frame}, point {point} is "
             f"{describe(points[frame, point])}; cut the recording before the run diverged"
         )
-    if radius is not None and not (np.isfinite(radius).all() and (radius >= 0.0).all()):
-        index = int(np.argwhere(~(np.isfinite(radius) & (radius >= 0.0)))[0, 0])
+    if radius is None:
+        return
+    wrong = ~(np.isfinite(radius) & (radius >= 0.0))
+    if alive is not None and radius.ndim == 2:
+        wrong &= alive
+    if wrong.any():
+        where = tuple(int(i) for i in np.argwhere(wrong)[0])
+        place = f"point {where[-1]}" + (f" in frame {where[0]}" if len(where) == 2 else "")
         raise ModelError(
-            f"`radius` must be finite and ≥ 0 [m]: point {index} has {describe(radius[index])}"
+            f"`radius` must be finite and ≥ 0 [m]: {place} has {describe(radius[where])}"
         )
 
 

@@ -13,7 +13,10 @@ rate; then one writer module writes the files, each atomically (see ``_files.py`
 
 Every format shows output frame ``k`` at ``k/fps`` seconds after the first recorded frame,
 using the recorded frame :func:`visviva.io.timeline.frames_at_rate` picks. Positions are in
-metres, Y up, as recorded; ``docs/export.md`` shows how to import each file.
+metres, Y up, as recorded; ``docs/export.md`` shows how to import each file. Particles that are
+born and die (a recording's ``alive``) never appear as points while dead: USD and OBJ write only
+the live points of each frame, glTF hides dead ones (a sphere scaled to 0, or a vertex moved
+onto a live point), PC2 holds them where they were last alive (see each writer's module).
 """
 
 from __future__ import annotations

@@ -7,7 +7,12 @@ writer reads positions one output frame at a time (:meth:`ExportFrames.points_at
 format needs a resampled copy of the whole recording unless its layout demands one (glTF).
 
 The drawable parts follow the recording's convention (``points``, ``radius``, ``edges``,
-``faces``; see :mod:`visviva.io.recording`). A future kind (rigid bodies: a position and a
+``faces``; see :mod:`visviva.simulation.recording`). Points that are born and die
+(``alive``, with radii and colours that may change per frame) are read through
+:class:`visviva.viz.lifetimes.Appearance`, as the video and the viewer read them: each writer
+asks which points are alive in an output frame (:meth:`ExportFrames.alive_at`), their radius
+and colour there, and, if its format keeps every slot in every frame, where a dead slot is held
+(:meth:`ExportFrames.held_points_at`). A future kind (rigid bodies: a position and a
 quaternion per body per frame) becomes one more field here and one more part in each writer.
 """
 
@@ -15,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -22,6 +28,7 @@ import numpy as np
 from ..._validation import real_number
 from ...errors import ModelError
 from ...simulation.recording import Geometry, Recording
+from ...viz.lifetimes import Appearance, held_frames, held_points
 from ..timeline import MAX_OUTPUT_FRAMES, frames_at_rate
 
 __all__ = ["FALLBACK_FPS", "MAX_OUTPUT_FRAMES", "ExportFrames", "default_fps", "prepare"]
@@ -129,9 +136,46 @@ class ExportFrames:
         """
         return np.arange(self.count) / self.fps
 
-    def radius(self) -> np.ndarray:
-        """Point radii [m], shape ``(P,)``: as drawn everywhere (:meth:`Geometry.drawn_radius`)."""
-        return self.geometry.drawn_radius()
+    @cached_property
+    def look(self) -> Appearance:
+        """Which points are alive in each recorded frame, their drawn radii and colours."""
+        return Appearance.of(self.geometry)
+
+    @property
+    def lifecycle(self) -> bool:
+        """True if points are born and die (the recording has ``alive``)."""
+        return self.look.alive is not None
+
+    def alive_at(self, k: int) -> np.ndarray:
+        """Which points exist at output frame ``k``: bool, shape ``(P,)``."""
+        return self.look.alive_at(int(self.shown[k]))
+
+    def radius_at(self, k: int) -> np.ndarray:
+        """Point radii [m] at output frame ``k``, shape ``(P,)``: as drawn everywhere
+        (:meth:`Geometry.drawn_radius`), the same in every frame unless radii change."""
+        return self.look.radius_at(int(self.shown[k]))
+
+    def color_at(self, k: int) -> np.ndarray | None:
+        """sRGB point colours in [0, 1] at output frame ``k``, float32 ``(P, 3)``, or ``None``."""
+        return self.look.color_at(int(self.shown[k]))
+
+    @cached_property
+    def _held(self) -> tuple[np.ndarray, np.ndarray] | None:
+        alive = self.look.alive
+        if alive is None:
+            return None
+        low, high = self.look.live_bounds(self.geometry.points)
+        return held_frames(alive), 0.5 * (low + high)
+
+    def held_points_at(self, k: int) -> np.ndarray:
+        """Positions [m] of every point at output frame ``k``, float64 ``(P, 3)``, dead ones
+        where they were last alive (before their first life, where they are first born; a
+        slot never alive at the centre of the live points' bounds): for formats that keep
+        every point in every frame."""
+        if self._held is None:
+            return self.points_at(k)
+        held, centre = self._held
+        return held_points(self.geometry.points, held, int(self.shown[k]), centre)
 
     def loose_points(self, *, faces: bool = True, edges: bool = False) -> np.ndarray:
         """Indices of the points used by no face (and, if ``edges``, by no edge), int64.
@@ -163,7 +207,7 @@ def prepare(recording: Recording, fps: float | None, speed: float = 1.0) -> Expo
     Raises:
         ModelError: If the recording has no points or no frames, ``fps`` is not a positive
             number or gives more than :data:`MAX_OUTPUT_FRAMES` frames, or a shown frame holds
-            a non-finite position.
+            a non-finite position of a live point.
     """
     if not isinstance(recording, Recording):
         raise ModelError(
@@ -187,7 +231,9 @@ def prepare(recording: Recording, fps: float | None, speed: float = 1.0) -> Expo
         rate = real_number("fps", fps, positive=True, unit=" frames/s")
     shown = frames_at_rate(time, rate, speed=speed)
     for k in np.unique(shown):
-        bad = ~np.isfinite(points[k])
+        bad = ~np.isfinite(points[k]).all(axis=1)
+        if geometry.alive is not None:
+            bad &= geometry.alive[k]  # dead points hold no position worth checking
         if bad.any():
             point = int(np.argwhere(bad)[0][0])
             raise ModelError(

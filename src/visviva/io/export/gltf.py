@@ -19,6 +19,21 @@ with ``pygltflib``. Two layouts, chosen by what the recording shows:
   attribute ``_RADIUS`` [m] (§ 3.7.2.1: names starting with an underscore), for instancing
   spheres on them (Blender: Geometry Nodes → Instance on Points, radius from the attribute).
 
+Colours (§ 3.9: glTF colours are linear, so the recording's sRGB is converted): bodies get one
+material per distinct colour (``baseColorFactor``, not metallic), which every importer applies
+to a triangle mesh; the points of the mesh layout carry ``COLOR_0`` (§ 3.7.2.1), as points have
+no material worth the name. Neither can change over time: a colour that changes is written as
+the point's colour in the first frame it is alive.
+
+Points that are born and die (particles of emitters; :mod:`visviva.viz.lifetimes`): glTF has
+no varying point count. Bodies get a ``STEP`` animation of each node's ``scale``: the point's
+radius while it lives (and as it changes), 0 while it is dead, which collapses its sphere to
+nothing; a dead node's translation holds where the point was last alive (before its first
+life, where it is first born), so it never glides across the scene. In the mesh layout a dead
+point is moved onto the live point of the largest radius in the same frame (onto one place,
+the first-born point's, in a frame with no live point at all), so it adds no dot of its own
+and no extent; its ``_RADIUS`` and ``COLOR_0`` are those of its first life.
+
 Both: glTF time starts at 0 (the recording's first frame); every ``POSITION`` accessor and the
 animation input have ``min`` and ``max`` (§ 3.6.2.5, § 3.11); buffer views start on 4-byte
 boundaries (§ 3.6.2.4); the scene's rate, speed and start time are in ``asset.extras``.
@@ -210,35 +225,95 @@ class _Buffer:
         return b"".join(self.parts)
 
 
-def _bodies(frames: ExportFrames, data: _Buffer) -> tuple[list[Any], list[Any], Any]:
-    """Nodes (root first), the sphere mesh and the animation of the bodies layout."""
+def _linear(srgb: np.ndarray) -> np.ndarray:
+    """sRGB values in [0, 1] as linear ones (IEC 61966-2-1), which glTF colours are."""
+    srgb = np.asarray(srgb, dtype=np.float64)
+    return np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
+
+
+class _Layout:
+    """What one layout adds to the document: nodes (root first), meshes, materials and the
+    animation."""
+
+    def __init__(
+        self, nodes: list[Any], meshes: list[Any], animation: Any, materials: list[Any]
+    ) -> None:
+        self.nodes, self.meshes, self.animation, self.materials = (
+            nodes,
+            meshes,
+            animation,
+            materials,
+        )
+
+
+def _sphere_meshes(frames: ExportFrames, data: _Buffer) -> tuple[list[Any], list[Any], np.ndarray]:
+    """The unit-sphere meshes (one per distinct colour, sharing the sphere's accessors), their
+    materials, and the mesh each point shows."""
     import pygltflib as gl
 
     vertices, triangles = _unit_sphere()
     position = data.floats(vertices, gl.VEC3, bounds=True, target=gl.ARRAY_BUFFER)
     normal = data.floats(vertices, gl.VEC3, target=gl.ARRAY_BUFFER)
-    sphere = gl.Mesh(
-        name="sphere",
-        primitives=[
-            gl.Primitive(
-                attributes=gl.Attributes(POSITION=position, NORMAL=normal),
-                indices=data.indices(triangles.ravel()),
-                mode=gl.TRIANGLES,
+    indices = data.indices(triangles.ravel())
+    colours = frames.look.first_color()
+    if colours is None:
+        palette, which = [None], np.zeros(frames.point_count, dtype=np.intp)
+    else:
+        unique, which = np.unique(colours, axis=0, return_inverse=True)
+        palette = list(unique)
+    meshes: list[Any] = []
+    materials: list[Any] = []
+    for j, colour in enumerate(palette):
+        material = None
+        if colour is not None:
+            material = len(materials)
+            materials.append(
+                gl.Material(
+                    name=f"colour_{j:03d}",
+                    pbrMetallicRoughness=gl.PbrMetallicRoughness(
+                        baseColorFactor=[*_linear(colour).tolist(), 1.0],
+                        metallicFactor=0.0,
+                        roughnessFactor=0.5,
+                    ),
+                )
             )
-        ],
-    )
+        meshes.append(
+            gl.Mesh(
+                name="sphere" if colour is None else f"sphere_{j:03d}",
+                primitives=[
+                    gl.Primitive(
+                        attributes=gl.Attributes(POSITION=position, NORMAL=normal),
+                        indices=indices,
+                        mode=gl.TRIANGLES,
+                        material=material,
+                    )
+                ],
+            )
+        )
+    return meshes, materials, np.ravel(which)
+
+
+def _bodies(frames: ExportFrames, data: _Buffer) -> _Layout:
+    """Nodes (root first), sphere meshes, materials and the animation of the bodies layout."""
+    import pygltflib as gl
+
+    meshes, materials, which = _sphere_meshes(frames, data)
     times = data.floats(frames.output_times(), gl.SCALAR, bounds=True)
-    tracks = np.stack([frames.points_at(k) for k in range(frames.count)], axis=1)  # (P, N, 3)
-    radius = frames.radius()
+    # Dead points held where they were last alive: translations never streak while hidden.
+    tracks = np.stack([frames.held_points_at(k) for k in range(frames.count)], axis=1)  # (P, N, 3)
+    animated_size = frames.lifecycle or frames.look.varying_radius
+    sizes = np.stack(
+        [frames.radius_at(k) * frames.alive_at(k) for k in range(frames.count)], axis=1
+    )  # (P, N): 0 while dead
     nodes = [gl.Node(name=frames.name, children=list(range(1, frames.point_count + 1)))]
     samplers, channels = [], []
     for i in range(frames.point_count):
         nodes.append(
             gl.Node(
                 name=f"point_{i:04d}",
-                mesh=0,
+                mesh=int(which[i]),
                 translation=tracks[i, 0].tolist(),
-                scale=[float(radius[i])] * 3,
+                scale=[float(sizes[i, 0])] * 3,
             )
         )
         samplers.append(
@@ -251,31 +326,80 @@ def _bodies(frames: ExportFrames, data: _Buffer) -> tuple[list[Any], list[Any], 
                 sampler=i, target=gl.AnimationChannelTarget(node=i + 1, path=gl.TRANSLATION)
             )
         )
+    if animated_size:
+        # STEP: a point appears and vanishes at its frame, not over the interval before.
+        for i in range(frames.point_count):
+            scale = np.repeat(sizes[i][:, None], 3, axis=1)
+            channels.append(
+                gl.AnimationChannel(
+                    sampler=len(samplers),
+                    target=gl.AnimationChannelTarget(node=i + 1, path=gl.SCALE),
+                )
+            )
+            samplers.append(
+                gl.AnimationSampler(
+                    input=times, output=data.floats(scale, gl.VEC3), interpolation=gl.ANIM_STEP
+                )
+            )
     animation = gl.Animation(name="simulation", samplers=samplers, channels=channels)
-    return nodes, [sphere], animation
+    return _Layout(nodes, meshes, animation, materials)
 
 
-def _mesh(frames: ExportFrames, data: _Buffer) -> tuple[list[Any], list[Any], Any]:
+def _collapsed_points_at(frames: ExportFrames, k: int, gathering: int) -> np.ndarray:
+    """Positions [m] at output frame ``k`` with every dead point moved onto the live point of
+    the largest radius (onto slot ``gathering``'s held position if none is alive)."""
+    positions = frames.held_points_at(k)
+    alive = frames.alive_at(k)
+    if alive.all():
+        return positions
+    if alive.any():
+        radius = np.where(alive, frames.radius_at(k), -np.inf)
+        positions[~alive] = positions[int(np.argmax(radius))]
+    else:
+        positions[:] = positions[gathering]
+    return positions
+
+
+def _mesh(frames: ExportFrames, data: _Buffer) -> _Layout:
     """Node, mesh with morph targets and the weight animation of the mesh layout."""
     import pygltflib as gl
 
     primitives = _primitive_indices(frames)
     _check_size(frames, sum(0 if i is None else i.size for _, i in primitives))
     count = frames.count
-    first = frames.points_at(0)
+    if frames.lifecycle:
+        alive = frames.look.alive
+        gathering = int(np.argmax(alive.any(axis=0))) if alive is not None else 0
+        positions = [_collapsed_points_at(frames, k, gathering) for k in range(count)]
+        first = positions[0]
+    else:
+        positions = None
+        first = frames.points_at(0)
     # Displacements are rounded once, from float64: base + target k is frame k to within
     # float32 rounding of the position and of the displacement.
     base = data.floats(first, gl.VEC3, bounds=True, target=gl.ARRAY_BUFFER)
     targets = [
-        gl.Attributes(POSITION=data.floats(frames.points_at(k) - first, gl.VEC3, bounds=True))
+        gl.Attributes(
+            POSITION=data.floats(
+                (frames.points_at(k) if positions is None else positions[k]) - first,
+                gl.VEC3,
+                bounds=True,
+            )
+        )
         for k in range(count)
     ]
-    radius = data.floats(frames.radius(), gl.SCALAR, target=gl.ARRAY_BUFFER)
+    radius = data.floats(frames.look.first_radius(), gl.SCALAR, target=gl.ARRAY_BUFFER)
+    colours = frames.look.first_color()
+    colour = None
+    if colours is not None:
+        colour = data.floats(_linear(colours), gl.VEC3, target=gl.ARRAY_BUFFER)
     mesh_primitives = []
     for mode, indices in primitives:
         attributes = gl.Attributes(POSITION=base)
         if mode == gl.POINTS:
             attributes._RADIUS = radius
+            if colour is not None:
+                attributes.COLOR_0 = colour
         mesh_primitives.append(
             gl.Primitive(
                 attributes=attributes,
@@ -313,7 +437,7 @@ def _mesh(frames: ExportFrames, data: _Buffer) -> tuple[list[Any], list[Any], An
             )
         ],
     )
-    return [gl.Node(mesh=0, name=frames.name)], [mesh], animation
+    return _Layout([gl.Node(mesh=0, name=frames.name)], [mesh], animation, [])
 
 
 def write_gltf(frames: ExportFrames, path: Path, *, binary: bool) -> list[Path]:
@@ -335,7 +459,7 @@ def write_gltf(frames: ExportFrames, path: Path, *, binary: bool) -> list[Path]:
     import pygltflib as gl
 
     data = _Buffer()
-    nodes, meshes, animation = (_bodies if _as_bodies(frames) else _mesh)(frames, data)
+    layout = (_bodies if _as_bodies(frames) else _mesh)(frames, data)
     document = gl.GLTF2(
         asset=gl.Asset(
             generator=f"visviva {__version__}",
@@ -350,11 +474,12 @@ def write_gltf(frames: ExportFrames, path: Path, *, binary: bool) -> list[Path]:
         ),
         scene=0,
         scenes=[gl.Scene(nodes=[0])],
-        nodes=nodes,
-        meshes=meshes,
+        nodes=layout.nodes,
+        meshes=layout.meshes,
+        materials=layout.materials,
         accessors=data.accessors,
         bufferViews=data.views,
-        animations=[animation],
+        animations=[layout.animation],
     )
     blob = data.blob()
     if binary:

@@ -18,6 +18,12 @@ per edge and ``f a b c`` per triangle, with 1-based indices. Coordinates are wri
 Python's ``repr``, the shortest decimal that reads back as the same float64, so the files hold
 the recording's positions exactly (``%.9g`` would only keep float32 precision) at the cost of a
 few more characters than needed for display. Units are metres, Y up.
+
+Points that are born and die (particles of emitters): each file holds only the points alive in
+its frame, in point order, with a comment saying how many of the recording's slots they are;
+edges and triangles are kept where all their points are alive, renumbered to match. Vertex
+``n`` of one file and of the next may then be different particles: a mesh cache (PC2) cannot be
+laid on such a sequence.
 """
 
 from __future__ import annotations
@@ -25,6 +31,8 @@ from __future__ import annotations
 import contextlib
 import re
 from pathlib import Path
+
+import numpy as np
 
 from ._files import all_or_nothing
 from ._frames import ExportFrames
@@ -52,13 +60,17 @@ def obj_sequence_paths(path: Path, count: int) -> list[Path]:
     return [folder / f"{stem}_{k:0{digits}d}.obj" for k in range(count)]
 
 
-def _topology_text(frames: ExportFrames) -> str:
-    """The ``l`` and ``f`` lines, the same in every file (1-based indices)."""
+def _topology_text(frames: ExportFrames, live: np.ndarray | None = None) -> str:
+    """The ``l`` and ``f`` lines (1-based indices): the same in every file, or, given the
+    ``live`` mask of a frame, those whose points are all alive, numbered among the live."""
     lines: list[str] = []
-    if frames.edges is not None:
-        lines.extend(f"l {a + 1} {b + 1}\n" for a, b in frames.edges.tolist())
-    if frames.faces is not None:
-        lines.extend(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in frames.faces.tolist())
+    number = None if live is None else np.cumsum(live)  # 1-based vertex number of live points
+    for kind, topology in (("l", frames.edges), ("f", frames.faces)):
+        if topology is None:
+            continue
+        if number is not None and live is not None:
+            topology = number[topology[live[topology].all(axis=1)]] - 1
+        lines.extend(f"{kind} {' '.join(str(i + 1) for i in row)}\n" for row in topology.tolist())
     return "".join(lines)
 
 
@@ -95,8 +107,14 @@ def write_obj_sequence(frames: ExportFrames, path: Path) -> list[Path]:
                     "# units: metres, Y up\n"
                     f"o {name}\n"
                 )
-                values = tuple(frames.points_at(k).ravel().tolist())
-                vertices = (vertex_line * frames.point_count) % values
+                positions = frames.points_at(k)
+                if frames.lifecycle:
+                    live = frames.alive_at(k)
+                    positions = positions[live]
+                    header += f"# {positions.shape[0]} of {frames.point_count} points alive\n"
+                    topology = _topology_text(frames, live)
+                values = tuple(positions.ravel().tolist())
+                vertices = (vertex_line * positions.shape[0]) % values
                 temporary.write_text(header + vertices + topology, encoding="utf-8")
     except BaseException:
         if created:

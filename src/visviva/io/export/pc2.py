@@ -15,6 +15,12 @@ Positions are float32 [m] in visviva's frame (Y up, unconverted): in Blender, ap
 to a mesh imported from the first file of an OBJ export, which keeps the point order and puts
 the Y-up to Z-up rotation on the object (see ``docs/export.md``). A cache holds no topology and
 no time unit: set the scene's frame rate to the export's ``fps``.
+
+The point count is fixed by the format. Points that are born and die (particles of emitters)
+keep their slot in every sample: a dead point is written where it was last alive, or, before
+its first life, where it is first born (:meth:`ExportFrames.held_points_at`), so it stands
+still instead of streaking to the recorder's parking place and back. A PC2 file cannot say
+that a point is dead: an importer shows such a point where it is held.
 """
 
 from __future__ import annotations
@@ -49,5 +55,5 @@ def write_pc2(frames: ExportFrames, path: Path) -> list[Path]:
     with all_or_nothing([path]) as (temporary,), temporary.open("wb") as file:
         file.write(header)
         for k in range(frames.count):
-            file.write(np.ascontiguousarray(frames.points_at(k), dtype="<f4").tobytes())
+            file.write(np.ascontiguousarray(frames.held_points_at(k), dtype="<f4").tobytes())
     return [path]

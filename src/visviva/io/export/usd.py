@@ -10,7 +10,17 @@ Written with Pixar's ``usd-core`` (``pxr``), following the UsdGeom schemas (open
 * ``/World`` (an ``Xform``) is the default prim, so importers that load only the default prim
   (Blender, references without a prim path) get everything;
 * ``/World/points`` (``UsdGeom.Points``): the points not used by any face, with time-sampled
-  ``points`` and ``extent`` and per-point ``widths`` (2 × radius, constant in time);
+  ``points`` and ``extent``, per-point ``widths`` (2 × radius) and, for a recording with
+  colours, ``primvars:displayColor`` (``vertex`` interpolation, sRGB as recorded); widths and
+  colours are time-sampled when they change;
+* points that are born and die (particles of emitters): each time sample of ``points``,
+  ``widths``, ``primvars:displayColor`` and ``ids`` holds only the points alive at that frame,
+  ``ids`` being each one's slot in the recording (int64), so a particle keeps its id while it
+  lives. UsdGeomPoints has no ``invisibleIds`` (that is UsdGeomPointInstancer's), and arrays
+  whose length changes from sample to sample are what Blender's point-cloud reader (it
+  reallocates the cloud when the count changes, and reads widths and primvars per frame) and
+  Houdini (``ids`` becomes its ``id`` attribute) import; a frame with no live point has empty
+  arrays and the empty extent usd-core itself computes for no points;
 * ``/World/edges`` (``UsdGeom.BasisCurves``, ``type = linear``, ``wrap = nonperiodic``): one
   two-vertex curve per edge, time-sampled ``points`` (the two ends of every edge, in edge
   order) and ``extent``, and a constant width of half the thinnest diameter among points
@@ -46,8 +56,14 @@ USD_ENCODINGS = ("usda", "usdc")
 _EDGE_WIDTH_FRACTION = 0.5
 
 
+#: The extent of no points, as usd-core computes it: an empty (inverted) box.
+_EMPTY_EXTENT = np.array([[np.finfo(np.float32).max] * 3, [-np.finfo(np.float32).max] * 3])
+
+
 def _extent(positions: np.ndarray, half_width: np.ndarray | float) -> np.ndarray:
     """Bounding box [m] of one frame, float32 ``(2, 3)``: lower and upper corner, widths in."""
+    if positions.shape[0] == 0:
+        return _EMPTY_EXTENT.astype(np.float32)
     pad = np.asarray(half_width, dtype=np.float64).reshape(-1, 1)
     return np.stack([(positions - pad).min(axis=0), (positions + pad).max(axis=0)]).astype(
         np.float32
@@ -85,11 +101,47 @@ def _add_points(stage: Any, frames: ExportFrames, loose: np.ndarray) -> Callable
     from pxr import UsdGeom, Vt
 
     prim = UsdGeom.Points.Define(stage, "/World/points")
-    radius = frames.radius()[loose]
-    prim.CreateWidthsAttr(Vt.FloatArray.FromNumpy((2.0 * radius).astype(np.float32)))
+    widths = prim.CreateWidthsAttr()
     prim.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
-    chosen = None if loose.size == frames.point_count else loose
-    return _animate(prim, frames, chosen, radius)
+    look = frames.look
+    colour = None
+    if look.color is not None:
+        colour = prim.CreateDisplayColorPrimvar(UsdGeom.Tokens.vertex)
+    if not (frames.lifecycle or look.varying_radius or look.varying_color):
+        radius = frames.radius_at(0)[loose]
+        widths.Set(Vt.FloatArray.FromNumpy((2.0 * radius).astype(np.float32)))
+        if colour is not None and look.color is not None:
+            colour.Set(Vt.Vec3fArray.FromNumpy(look.color[loose]))
+        chosen = None if loose.size == frames.point_count else loose
+        return _animate(prim, frames, chosen, radius)
+    return _animate_points(prim, frames, loose, widths, colour)
+
+
+def _animate_points(
+    prim: Any, frames: ExportFrames, loose: np.ndarray, widths: Any, colour: Any
+) -> Callable[[int], None]:
+    """A writer of every per-frame attribute of ``/World/points``: only the live points."""
+    from pxr import Vt
+
+    points, extent = prim.CreatePointsAttr(), prim.CreateExtentAttr()
+    ids = prim.CreateIdsAttr() if frames.lifecycle else None
+    on_loose = np.zeros(frames.point_count, dtype=bool)
+    on_loose[loose] = True
+
+    def write(k: int) -> None:
+        chosen = np.flatnonzero(on_loose & frames.alive_at(k))
+        positions = frames.points_at(k)[chosen]
+        radius = frames.radius_at(k)[chosen]
+        points.Set(Vt.Vec3fArray.FromNumpy(positions.astype(np.float32)), k)
+        widths.Set(Vt.FloatArray.FromNumpy((2.0 * radius).astype(np.float32)), k)
+        extent.Set(Vt.Vec3fArray.FromNumpy(_extent(positions, radius)), k)
+        if ids is not None:
+            ids.Set(Vt.Int64Array.FromNumpy(chosen.astype(np.int64)), k)
+        rgb = frames.color_at(k)
+        if colour is not None and rgb is not None:
+            colour.Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(rgb[chosen])), k)
+
+    return write
 
 
 def _add_edges(stage: Any, frames: ExportFrames, edges: np.ndarray) -> Callable[[int], None]:
@@ -100,7 +152,7 @@ def _add_edges(stage: Any, frames: ExportFrames, edges: np.ndarray) -> Callable[
     prim.CreateWrapAttr(UsdGeom.Tokens.nonperiodic)
     counts = np.full(edges.shape[0], 2, dtype=np.int32)
     prim.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(counts))
-    radius = frames.radius()
+    radius = frames.look.radius
     thinnest = float(radius[radius > 0.0].min()) if (radius > 0.0).any() else None
     width = _EDGE_WIDTH_FRACTION * 2.0 * (thinnest or frames.geometry.default_radius())
     prim.CreateWidthsAttr(Vt.FloatArray([width]))

@@ -29,7 +29,7 @@ from ..._validation import describe, real_number
 from ...errors import ModelError
 from ...io.files import atomic_path
 from ...io.timeline import check_playback, frames_at_rate
-from ...simulation.recording import Recording
+from ...simulation.recording import Geometry, Recording
 from ..video import MAX_TRAIL_POINTS
 from ._payload import encode_payload, to_json
 
@@ -145,8 +145,12 @@ def _check_target(path: str | os.PathLike[str]) -> Path:
     return target
 
 
-def _check_finite(points: np.ndarray) -> None:
-    bad = ~np.isfinite(points).all(axis=(1, 2))
+def _check_finite(geometry: Geometry) -> None:
+    """Refuse frames with a non-finite live position (dead points are never drawn)."""
+    finite = np.isfinite(geometry.points).all(axis=2)
+    if geometry.alive is not None:
+        finite |= ~geometry.alive
+    bad = ~finite.all(axis=1)
     if bad.any():
         frame = int(np.argmax(bad))
         raise ModelError(
@@ -184,7 +188,8 @@ def write_viewer(
     """Write ``recording``'s animation as one self-contained HTML file.
 
     The page plays the points (spheres of ``static["radius"]``), edges (lines) and faces
-    (a shaded surface) of :meth:`Recording.geometry` in real time, with an orbit camera, a
+    (a shaded surface) of :meth:`Recording.geometry` in real time (points that are born and
+    die only while alive, at each frame's radius and colour), with an orbit camera, a
     play/pause button (and the space bar), a frame slider, the time ``t`` [s] of the recorded
     frame shown, a speed selector and a legend. See ``docs/viewer.md``.
 
@@ -219,7 +224,7 @@ def write_viewer(
     if title is not None and not isinstance(title, str):
         raise ModelError(f"`title` must be a string or None (got {describe(title)})")
     target = _check_target(path)
-    _check_finite(geometry.points)
+    _check_finite(geometry)
     rate = _check_fps(recording, fps, speed)
     trail = real_number("trail", trail, nonnegative=True, unit=" s")
     if trail > 0.0 and geometry.points.shape[1] > MAX_TRAIL_POINTS:

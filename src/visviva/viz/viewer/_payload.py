@@ -14,6 +14,16 @@ compressed with zlib (deflate), which the page inflates with the browser's own
 ``DecompressionStream``. The galaxy demo's 6002 points × 301 frames take 8.5 MB instead of
 29 MB of float32 base64.
 
+Points that are born and die (:mod:`visviva.viz.lifetimes`) add, only when the recording has
+them: ``alive``, which points exist in each frame, as bits (one per point per frame, XOR with
+the previous frame, so a frame costs only its births and deaths before zlib); ``births``, with a
+trail, the bits of points that start a new life in a frame (a reused slot's trail starts
+afresh); ``radii``, radii that change, as 16-bit levels of ``step`` [m] in frame differences
+like the positions; ``frame_colors``, colours that change, as 8-bit sRGB in frame differences.
+Dead points are stored where they were last alive (before their first life, where they are
+born), so they neither stretch the position grid nor cost differences; the page does not draw
+them.
+
 Each kind of geometry is one *layer* with its own encoder here and its own builder in
 ``viewer.js`` (``LAYERS``): ``points`` (moving spheres), ``edges`` (lines between points) and
 ``faces`` (triangles between points). A new kind (rigid bodies: a position and a quaternion per
@@ -30,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from ...simulation.recording import Geometry
+from ..lifetimes import Appearance, held_frames, held_points, life_starts
 from ..timescale import time_unit
 
 __all__ = [
@@ -42,8 +53,8 @@ __all__ = [
 ]
 
 PAYLOAD_FORMAT = "visviva.viewer"
-PAYLOAD_VERSION = 2
-#: Quantization levels of a position coordinate: 16 bits.
+PAYLOAD_VERSION = 3
+#: Quantization levels of a position coordinate, and of a radius that changes: 16 bits.
 POSITION_LEVELS = 65535
 
 
@@ -58,18 +69,85 @@ def _base64(array: np.ndarray, dtype: str) -> str:
 
 def _points_layer(geometry: Geometry, shown: np.ndarray, trail_frames: int) -> dict[str, Any]:
     count = geometry.points.shape[1]
-    origin, step, data = quantized_positions(geometry.points[shown])
-    layer = {
+    look = Appearance.of(geometry)
+    if look.alive is None:
+        held, points = None, geometry.points[shown]
+    else:
+        held = held_frames(look.alive)
+        low, high = look.live_bounds(geometry.points)
+        centre = 0.5 * (low + high)
+        points = np.stack([held_points(geometry.points, held, k, centre) for k in shown])
+    origin, step, data = quantized_positions(points)
+    layer: dict[str, Any] = {
         "count": count,
         "origin": [float(v) for v in origin],
         "step": [float(v) for v in step],
         "positions": data,
-        "radius": _base64(geometry.drawn_radius(), "<f4"),
         "trail": trail_frames,
     }
-    if geometry.color is not None:
-        layer["colors"] = _base64(np.round(255 * geometry.color), "u1")
+    if look.varying_radius:
+        layer["radii"] = _quantized_radii(_held_values(look.radius, shown, held))
+    else:
+        layer["radius"] = _base64(look.radius, "<f4")
+    if look.color is not None and look.varying_color:
+        layer["frame_colors"] = _differences_u8(_held_values(look.color, shown, held))
+    elif look.color is not None:
+        layer["colors"] = _base64(np.round(255 * look.color), "u1")
+    if look.alive is not None:
+        alive = look.alive[shown]
+        changed = alive.copy()
+        changed[1:] ^= alive[:-1]
+        layer["alive"] = _deflated(np.packbits(changed, axis=None, bitorder="little"))
+        if trail_frames > 0:
+            births = _births(alive, life_starts(look.alive)[shown], shown)
+            layer["births"] = _deflated(np.packbits(births, axis=None, bitorder="little"))
     return layer
+
+
+def _births(alive: np.ndarray, starts: np.ndarray, shown: np.ndarray) -> np.ndarray:
+    """Bits of the points that start a life at each output frame: alive, and not alive in the
+    previous output frame or born again since (a slot reused between two shown frames)."""
+    births = alive.copy()
+    births[1:] &= ~alive[:-1] | (starts[1:] > shown[:-1, None])
+    return births
+
+
+def _held_values(values: np.ndarray, shown: np.ndarray, held: np.ndarray | None) -> np.ndarray:
+    """Per-frame ``values`` ``(frames, P, ...)`` at the shown frames, each dead point holding
+    its value where it was last alive (0 for slots never alive): no difference to store."""
+    if held is None:
+        return values[shown]
+    source = held[shown]
+    frames = values[np.maximum(source, 0), np.arange(source.shape[1])]
+    frames[source < 0] = 0
+    return frames
+
+
+def _quantized_radii(radii: np.ndarray) -> dict[str, Any]:
+    """Radii ``(frames, P)`` [m] as 16-bit levels of ``step`` [m], in frame differences."""
+    top = float(radii.max(initial=0.0))
+    step = top / POSITION_LEVELS if top > 0.0 else 1.0
+    levels = np.rint(radii / step).astype(np.uint16)
+    return {"step": step, "data": _difference_planes(levels)}
+
+
+def _differences_u8(colors: np.ndarray) -> str:
+    """sRGB colours ``(frames, P, 3)`` in [0, 1] as 8-bit frame differences (modulo 256)."""
+    levels = np.round(255 * colors).astype(np.uint8)
+    return _deflated(np.diff(levels, axis=0, prepend=np.zeros_like(levels[:1])))
+
+
+def _deflated(data: np.ndarray) -> str:
+    """Base64 text of the zlib-compressed bytes of ``data``."""
+    return base64.b64encode(zlib.compress(np.ascontiguousarray(data).tobytes(), 6)).decode("ascii")
+
+
+def _difference_planes(levels: np.ndarray) -> str:
+    """uint16 ``levels`` ``(frames, ...)`` as compressed frame differences, low and high bytes
+    in two planes (see the module docstring)."""
+    # Unsigned differences wrap modulo 2¹⁶, and so does the page's running sum: exact.
+    differences = np.diff(levels, axis=0, prepend=np.zeros_like(levels[:1]))
+    return _deflated(differences.astype("<u2").view(np.uint8).reshape(-1, 2).T)
 
 
 def decoded_positions(layer: dict[str, Any], frames: int) -> np.ndarray:
@@ -94,11 +172,7 @@ def quantized_positions(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, str
     step = (flat.max(axis=0) - origin) / POSITION_LEVELS
     inverse = np.divide(1.0, step, out=np.zeros(3), where=step > 0.0)
     levels = np.rint((points - origin) * inverse).astype(np.uint16)
-    # Unsigned differences wrap modulo 2¹⁶, and so does the page's running sum: exact.
-    differences = np.diff(levels, axis=0, prepend=np.zeros_like(levels[:1]))
-    planes = differences.astype("<u2").view(np.uint8).reshape(-1, 2).T
-    data = base64.b64encode(zlib.compress(planes.tobytes(), 6)).decode("ascii")
-    return origin, step, data
+    return origin, step, _difference_planes(levels)
 
 
 def _index_layer(indices: np.ndarray) -> dict[str, Any]:
@@ -115,6 +189,9 @@ def _legend(attrs: dict[str, Any], geometry: Geometry, fps: float) -> list[list[
             text = f"{value:.6g}" if isinstance(value, (float, np.floating)) else str(value)
             rows.append([label, text + unit])
     parts = [f"{geometry.points.shape[1]} points"]
+    if geometry.alive is not None:
+        most = int(geometry.alive.sum(axis=1).max(initial=0))
+        parts[0] = f"up to {most} of {parts[0]} at once"
     for name in ("edges", "faces"):
         value = getattr(geometry, name)
         if value is not None:
@@ -150,7 +227,8 @@ def encode_payload(
     Returns:
         A JSON-serialisable dict (see the module docstring).
     """
-    low, high = geometry.bounds()
+    # The live points as drawn: the page's camera, grid and light are placed from this box.
+    low, high = Appearance.of(geometry).live_bounds(geometry.points)
     layers: dict[str, Any] = {"points": _points_layer(geometry, shown, trail_frames)}
     unit, seconds, decimals = time_unit(float(time[-1] - time[0]))
     if geometry.edges is not None and geometry.edges.shape[0]:

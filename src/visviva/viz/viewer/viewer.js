@@ -7,6 +7,10 @@
  *
  * Each kind of geometry is one entry of LAYERS (points, edges, faces): a builder that adds
  * its objects to the scene and returns an update() called after every frame change.
+ *
+ * Points that are born and die come with per-frame alive bits (and, with a trail, birth bits),
+ * radii and colours when the recording has them: a frame draws only its live points, at that
+ * frame's radius and colour, and a trail starts at its point's birth.
  */
 (async function () {
   "use strict";
@@ -49,13 +53,18 @@
     return new Type(bytes.buffer, bytes.byteOffset, bytes.byteLength / Type.BYTES_PER_ELEMENT);
   }
 
+  /* Base64 text of a zlib stream -> its inflated bytes (the browser's DecompressionStream). */
+  async function inflate(text) {
+    const stream = new Blob([base64Bytes(text)])
+      .stream().pipeThrough(new DecompressionStream("deflate"));
+    return new Uint8Array(await new Response(stream).arrayBuffer());
+  }
+
   /* Quantized positions (see _payload.py) -> Float32Array (frames, P, 3) [m]: inflate the
    * zlib stream, join the low- and high-byte planes, add up the frame differences (Uint16Array
    * arithmetic wraps modulo 2^16, as the encoder's differences do) and scale onto the grid. */
   async function decodePositions(layer, frameCount, stride) {
-    const stream = new Blob([base64Bytes(layer.positions)])
-      .stream().pipeThrough(new DecompressionStream("deflate"));
-    const planes = new Uint8Array(await new Response(stream).arrayBuffer());
+    const planes = await inflate(layer.positions);
     const n = frameCount * stride;
     if (planes.length !== 2 * n) throw new Error("corrupt position data");
     const positions = new Float32Array(n);
@@ -75,6 +84,43 @@
     return positions;
   }
 
+  /* Radii that change: 16-bit levels in frame differences -> Float32Array (frames, P) [m]. */
+  async function decodeRadii(radii, frameCount, count) {
+    const planes = await inflate(radii.data);
+    const n = frameCount * count;
+    if (planes.length !== 2 * n) throw new Error("corrupt radius data");
+    const out = new Float32Array(n);
+    const level = new Uint16Array(count);
+    for (let i = 0; i < n; i++) {
+      level[i % count] += planes[i] | (planes[n + i] << 8);
+      out[i] = level[i % count] * radii.step;
+    }
+    return out;
+  }
+
+  /* Colours that change: 8-bit sRGB frame differences -> Uint8Array (frames, P, 3). */
+  async function decodeFrameColours(text, frameCount, count) {
+    const rgb = await inflate(text);
+    const stride = 3 * count;
+    if (rgb.length !== frameCount * stride) throw new Error("corrupt colour data");
+    for (let i = stride; i < rgb.length; i++) rgb[i] += rgb[i - stride]; // wraps modulo 256
+    return rgb;
+  }
+
+  /* Bits, one per point per frame (little-endian bit order) -> Uint8Array (frames, P) of 0/1;
+   * with xor, each frame's bits are its changes from the previous frame. */
+  async function decodeBits(text, frameCount, count, xor) {
+    const bytes = await inflate(text);
+    const n = frameCount * count;
+    if (bytes.length !== Math.ceil(n / 8)) throw new Error("corrupt alive data");
+    const bits = new Uint8Array(n);
+    for (let i = 0; i < n; i++) {
+      bits[i] = (bytes[i >> 3] >> (i & 7)) & 1;
+      if (xor && i >= count) bits[i] ^= bits[i - count];
+    }
+    return bits;
+  }
+
   const data = JSON.parse(document.getElementById("visviva-data").textContent);
   const frames = data.frames;
   const fps = data.fps;
@@ -83,6 +129,15 @@
   const pointCount = pointData.count;
   const stride = pointCount * 3;
   const allPositions = await decodePositions(pointData, frames, stride); // (frames, P, 3) [m]
+  // Present only for points that are born and die, or whose radii or colours change.
+  const alive = pointData.alive ? await decodeBits(pointData.alive, frames, pointCount, true)
+    : null; // (frames, P) 0/1
+  const births = pointData.births
+    ? await decodeBits(pointData.births, frames, pointCount, false) : null;
+  const frameRadii = pointData.radii ? await decodeRadii(pointData.radii, frames, pointCount)
+    : null; // (frames, P) [m]
+  const frameColours = pointData.frame_colors
+    ? await decodeFrameColours(pointData.frame_colors, frames, pointCount) : null;
 
   const low = new THREE.Vector3().fromArray(data.bounds[0]);
   const high = new THREE.Vector3().fromArray(data.bounds[1]);
@@ -112,18 +167,27 @@
   }
 
   /* Colour i of 8-bit sRGB triples (setHex reads sRGB, as the recording's colours are). */
-  function srgb(rgb, i) {
-    return new THREE.Color().setHex((rgb[3 * i] << 16) | (rgb[3 * i + 1] << 8) | rgb[3 * i + 2]);
+  function srgb(rgb, i, target = new THREE.Color()) {
+    return target.setHex((rgb[3 * i] << 16) | (rgb[3 * i + 1] << 8) | rgb[3 * i + 2]);
+  }
+
+  /* The 8-bit sRGB colours of frame k's points, or null for the default colour. */
+  function coloursAt(k, staticRgb) {
+    if (frameColours) return frameColours.subarray(3 * pointCount * k, 3 * pointCount * (k + 1));
+    return staticRgb;
   }
 
   /* Each point's path over the last layer.trail frames: one polyline per point (segments
-   * j, j+1), paler than the point, refilled from the decoded positions when the frame changes. */
+   * j, j+1), paler than the point, refilled from the decoded positions when the frame changes.
+   * A point that is born starts a new path: a reused slot never joins two lives. */
   function trailLines(layer) {
     const length = layer.trail + 1;
     const rgb = layer.colors ? decode(layer.colors, Uint8Array) : null;
     const chain = new Uint32Array(2 * (length - 1));
     for (let j = 0; j < length - 1; j++) { chain[2 * j] = j; chain[2 * j + 1] = j + 1; }
     const lines = [];
+    const materials = [];
+    const background = new THREE.Color(BACKGROUND);
     for (let i = 0; i < pointCount; i++) {
       const geometry = new THREE.BufferGeometry();
       const path = new THREE.BufferAttribute(new Float32Array(3 * length), 3);
@@ -131,25 +195,39 @@
       geometry.setAttribute("position", path);
       geometry.setIndex(new THREE.BufferAttribute(chain, 1));
       const colour = rgb ? srgb(rgb, i) : new THREE.Color(POINT_COLOUR);
-      colour.lerp(new THREE.Color(BACKGROUND), 0.4);
-      const line = new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: colour }));
+      colour.lerp(background, 0.4);
+      const material = new THREE.LineBasicMaterial({ color: colour });
+      const line = new THREE.LineSegments(geometry, material);
       line.frustumCulled = false;
       scene.add(line);
       lines.push(geometry);
+      materials.push(material);
     }
     return function (k) {
       const first = Math.max(0, k - layer.trail);
+      const rgbNow = frameColours ? coloursAt(k, null) : null;
       for (let i = 0; i < pointCount; i++) {
+        let start = first;
+        if (alive) {
+          if (!alive[k * pointCount + i]) {
+            lines[i].setDrawRange(0, 0);
+            continue;
+          }
+          // Back from k to the frame the point was born in, or to the trail's first frame.
+          start = k;
+          while (start > first && !(births && births[start * pointCount + i])) start--;
+        }
+        if (rgbNow) srgb(rgbNow, i, materials[i].color).lerp(background, 0.4);
         const path = lines[i].getAttribute("position");
         const out = path.array;
-        for (let f = first, j = 0; f <= k; f++, j += 3) {
+        for (let f = start, j = 0; f <= k; f++, j += 3) {
           const from = f * stride + 3 * i;
           out[j] = allPositions[from];
           out[j + 1] = allPositions[from + 1];
           out[j + 2] = allPositions[from + 2];
         }
         path.needsUpdate = true;
-        lines[i].setDrawRange(0, 2 * (k - first));
+        lines[i].setDrawRange(0, 2 * (k - start));
       }
     };
   }
@@ -163,19 +241,24 @@
   }
 
   const LAYERS = {
-    /* Spheres of the recorded radii: one instanced mesh, a matrix per point per frame. */
+    /* Spheres of the recorded radii: one instanced mesh, a matrix per point per frame. When
+     * points are born and die, the live ones of a frame fill the first instances (mesh.count),
+     * each with its radius and colour in that frame. */
     points(layer) {
-      const radius = decode(layer.radius, Float32Array);
+      const radius = layer.radius ? decode(layer.radius, Float32Array) : null;
       // The finest sphere whose triangles, over all points, fit the budget.
       let around = SPHERE_SEGMENTS.find((n) => pointCount * n * n <= SPHERE_TRIANGLE_BUDGET);
       if (around === undefined) around = SPHERE_SEGMENTS[SPHERE_SEGMENTS.length - 1];
       const sphere = new THREE.SphereGeometry(1, around, around / 2 + 1);
+      const coloured = Boolean(layer.colors || frameColours);
       const material = new THREE.MeshLambertMaterial({
-        color: layer.colors ? 0xffffff : POINT_COLOUR }); // white: instance colours multiply
+        color: coloured ? 0xffffff : POINT_COLOUR }); // white: instance colours multiply
       const mesh = new THREE.InstancedMesh(sphere, material, pointCount);
-      if (layer.colors) { // per-point sRGB colours of the recording
-        const rgb = decode(layer.colors, Uint8Array);
-        for (let i = 0; i < pointCount; i++) mesh.setColorAt(i, srgb(rgb, i));
+      const staticRgb = layer.colors ? decode(layer.colors, Uint8Array) : null;
+      // Colours move with their points between instances when points die, or change per frame.
+      const recolour = coloured && Boolean(alive || frameColours);
+      if (staticRgb && !recolour) { // per-point sRGB colours of the recording, set once
+        for (let i = 0; i < pointCount; i++) mesh.setColorAt(i, srgb(staticRgb, i));
       }
       const trail = layer.trail > 0 ? trailLines(layer) : null;
       mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
@@ -183,18 +266,33 @@
       const matrices = mesh.instanceMatrix.array; // column-major 4x4 per point
       for (let i = 0; i < pointCount; i++) {
         matrices.fill(0, 16 * i, 16 * i + 16);
-        matrices[16 * i] = matrices[16 * i + 5] = matrices[16 * i + 10] = radius[i];
+        if (radius) matrices[16 * i] = matrices[16 * i + 5] = matrices[16 * i + 10] = radius[i];
         matrices[16 * i + 15] = 1;
       }
       scene.add(mesh);
+      pointMesh = mesh;
+      const colour = new THREE.Color();
       return function update() {
         const xyz = current.array;
+        const base = frame * pointCount;
+        const rgb = recolour ? coloursAt(frame, staticRgb) : null;
+        let n = 0; // instances drawn
         for (let i = 0; i < pointCount; i++) {
-          matrices[16 * i + 12] = xyz[3 * i];
-          matrices[16 * i + 13] = xyz[3 * i + 1];
-          matrices[16 * i + 14] = xyz[3 * i + 2];
+          if (alive && !alive[base + i]) continue;
+          const m = 16 * n;
+          if (alive || frameRadii) {
+            const r = frameRadii ? frameRadii[base + i] : radius[i];
+            matrices[m] = matrices[m + 5] = matrices[m + 10] = r;
+          }
+          matrices[m + 12] = xyz[3 * i];
+          matrices[m + 13] = xyz[3 * i + 1];
+          matrices[m + 14] = xyz[3 * i + 2];
+          if (rgb) mesh.setColorAt(n, srgb(rgb, i, colour));
+          n++;
         }
+        mesh.count = n;
         mesh.instanceMatrix.needsUpdate = true;
+        if (rgb && mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
         if (trail) trail(frame);
       };
     },
@@ -220,6 +318,7 @@
     },
   };
 
+  let pointMesh = null; // the points layer's instanced mesh, read back by visviva.drawn()
   const updates = [];
   for (const [name, layer] of Object.entries(data.layers)) {
     if (!(name in LAYERS)) throw new Error("this viewer cannot draw layer " + name);
@@ -406,6 +505,22 @@
     playing: () => playing,
     /* Positions [m] of output frame k as a flat array (P * 3), as decoded (float32). */
     points: (k) => Array.from(allPositions.subarray(k * stride, (k + 1) * stride)),
+    /* The spheres drawn in the frame shown: centres [m], radii [m] and 8-bit sRGB colours
+     * (null for the default colour), read back from the instanced mesh. */
+    drawn: () => {
+      const m = pointMesh.instanceMatrix.array;
+      const c = pointMesh.instanceColor;
+      const out = { count: pointMesh.count, centres: [], radii: [], colours: c ? [] : null };
+      for (let j = 0; j < pointMesh.count; j++) {
+        out.centres.push([m[16 * j + 12], m[16 * j + 13], m[16 * j + 14]]);
+        out.radii.push(m[16 * j]);
+        if (c) {
+          const hex = new THREE.Color().fromArray(c.array, 3 * j).getHex();
+          out.colours.push([hex >> 16, (hex >> 8) & 255, hex & 255]);
+        }
+      }
+      return out;
+    },
     ready: false,
     readyTime: null, // performance.now() [ms since navigation start] at the first draw
   };
