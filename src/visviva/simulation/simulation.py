@@ -6,6 +6,7 @@ pymunk's ``space.step``)::
     sim = vv.Simulation(model)
     sim.step()                          # one step of dt
     sim.run(until=2.0)                  # lands exactly on t = 2 s
+    recording = sim.record(until=3.0)   # the same, keeping the frames in memory
     sim.time, sim.energy()
     sim.state["particle_position"]      # the live particles, (n, 3), in slot order
     blob = sim.checkpoint()             # bytes
@@ -38,6 +39,7 @@ from .interrupt import Interrupted
 from .loop import MAX_STEPS, Schedule, advance
 from .progress import Progress
 from .recorder import FrameCallback, FrameRecorder
+from .recording import Recording
 from .stepper import Stepper
 from .watch import DivergenceWatch
 
@@ -193,6 +195,61 @@ class Simulation:
         schedule = Schedule.build(self._origin, until, self.dt, self.substeps, self._steps)
         self._check_budget(schedule.steps)
         self._advance(schedule, on_frame, record_every, progress)
+
+    def record(
+        self, until: float, *, record_every: int | None = None, progress: bool | None = False
+    ) -> Recording:
+        """Run to ``until`` [s] like :meth:`run`, keeping the frames in memory.
+
+        Each frame is what a recording file keeps of the state (``points``, ``alive``, ...:
+        :meth:`Model.frame <visviva.model.Model.frame>`) plus ``energy``; the current state is
+        the first frame. For notebooks, demos and small scenes: a long run of many particles
+        streams its frames to a file instead (``vv.run_scene``).
+
+        Args:
+            until: The time to reach [s].
+            record_every: Keep every k-th step (default: the scene's ``record_every``).
+            progress: Show a progress bar (``None``: if stderr is a terminal).
+
+        Raises:
+            SimulationDiverged, NewtonConvergenceError, Interrupted: As :meth:`run`; the error's
+                ``recording`` holds the frames kept so far.
+        """
+        every = self.model.integration.record_every if record_every is None else record_every
+        times: list[float] = []
+        frames: list[dict[str, np.ndarray]] = []
+
+        def keep(state: State, energy: np.ndarray | None) -> None:
+            fields = {name: np.array(value) for name, value in self.model.frame(state).items()}
+            if energy is not None:
+                fields["energy"] = np.asarray(energy, dtype=np.float64)
+            times.append(state.t)
+            frames.append(fields)
+
+        def recording() -> Recording:
+            fields = {name: np.stack([f[name] for f in frames]) for name in frames[0]}
+            attrs = {
+                "method": self.integrator.name,
+                "dt": self.dt,
+                "substeps": self.substeps,
+                "scene_name": self.model.name,
+                "steps": self.system.counters.accepted_steps,
+            } | self.system.counters.as_dict()
+            return Recording(
+                np.array(times),
+                fields,
+                units=self.model.units(),
+                attrs=attrs,
+                static=self.model.static(),
+            )
+
+        keep(self._state, self.system.energy(self._state))
+        try:
+            self.run(until, record_every=every, on_frame=keep, progress=progress)
+        except (SimulationError, Interrupted) as stopped:
+            stopped.recording = recording()
+            raise
+        return recording()
 
     def _check_budget(self, steps: int) -> None:
         if steps * self.substeps > MAX_STEPS:
