@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 import visviva as vv
 from visviva.cli.main import app
 from visviva.mechanics import classic
+from visviva.viz.plots import comparison_figures
 
 
 @pytest.fixture(scope="module")
@@ -41,7 +42,9 @@ def test_table_figures_and_summary(comparison):
     table = comparison.table().splitlines()
     assert table[0].split()[:3] == ["method", "order", "measured"]
     assert len(table) == 2 + len(comparison.results)
-    assert comparison.energy_figure().axes and comparison.convergence_figure().axes
+    figures = comparison_figures(comparison)
+    assert list(figures) == ["energy", "convergence"]
+    assert all(figure.axes for figure in figures.values())
     summary = comparison.as_dict()
     assert summary["dt_s"] == 0.01 and len(summary["methods"]) == 4
     assert np.isfinite([m["measured_order"] for m in summary["methods"]]).all()

@@ -142,7 +142,7 @@ def test_a_count_given_as_text_is_refused(tmp_path):
 # Nothing left behind.
 
 
-def test_a_demo_that_fails_midway_leaves_nothing(tmp_path, monkeypatch):
+def test_a_demo_that_fails_midway_leaves_nothing(tmp_path):
     from visviva.demos import demos
 
     def run_then_fail(output, duration):
@@ -150,10 +150,12 @@ def test_a_demo_that_fails_midway_leaves_nothing(tmp_path, monkeypatch):
         raise vv.ModelError("stopped for the test")
 
     demo = demos()["pendulum"]
-    failing = dataclasses.replace(demo, run=run_then_fail)
-    monkeypatch.setitem(vv.demos._DEMOS, "pendulum", failing)
-    with pytest.raises(vv.ModelError, match="stopped for the test"):
-        vv.demos.run_demo("pendulum", tmp_path / "out")
+    vv.demos.register_demo(dataclasses.replace(demo, run=run_then_fail), replace=True)
+    try:
+        with pytest.raises(vv.ModelError, match="stopped for the test"):
+            vv.demos.run_demo("pendulum", tmp_path / "out")
+    finally:
+        vv.demos.register_demo(demo, replace=True)
     assert list((tmp_path / "out").iterdir()) == []
 
 

@@ -1,6 +1,7 @@
-"""Analysis of integrators and runs: stability, convergence order, invariants."""
+"""Analysis of integrators and runs: stability, convergence order, invariants, chaos measures."""
 
 from .advisor import largest_stable_step, matrix_free_eigenvalues
+from .chaos import LyapunovEstimate, lyapunov_exponent, separation
 from .compare import Comparison, MethodResult, compare_methods
 from .convergence import ConvergenceStudy, convergence_order
 from .invariants import (
@@ -23,6 +24,7 @@ from .stability import (
 __all__ = [
     "Comparison",
     "ConvergenceStudy",
+    "LyapunovEstimate",
     "MethodResult",
     "angular_momentum",
     "center_of_mass",
@@ -31,10 +33,12 @@ __all__ = [
     "energy_drift",
     "largest_stable_step",
     "linear_momentum",
+    "lyapunov_exponent",
     "matrix_free_eigenvalues",
     "max_energy_error",
     "max_stable_dt",
     "relative_change",
+    "separation",
     "spectrum",
     "stability_function",
     "stability_interval",

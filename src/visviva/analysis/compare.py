@@ -2,8 +2,9 @@
 
 :func:`compare_methods` runs every method on the same problem at the same step for the whole
 duration (energy over time), measures each method's order on a shorter span against a tight
-reference (error against step size), and counts the work. The result draws the two figures
-the notes teach from — energy drift and convergence — and prints a table.
+reference (error against step size), and counts the work. The result prints a table;
+:func:`visviva.viz.plots.comparison_figures` draws its two figures the notes teach from —
+energy drift and convergence.
 """
 
 from __future__ import annotations
@@ -20,8 +21,6 @@ from .convergence import ConvergenceStudy, convergence_order
 from .invariants import energy_drift, max_energy_error
 
 if TYPE_CHECKING:
-    from matplotlib.figure import Figure
-
     from ..ode.problems import Problem
     from ..simulation.recording import Recording
 
@@ -62,7 +61,8 @@ class Comparison:
     Attributes:
         results: One :class:`MethodResult` per method, in the order given.
         runs: The full runs' recordings by method (for :func:`~visviva.viz.plots.plot_energy`).
-        studies: The convergence studies (for :func:`~visviva.viz.plots.plot_convergence`).
+        studies: The convergence studies (for :func:`~visviva.viz.plots.plot_convergence`);
+            :func:`~visviva.viz.plots.comparison_figures` draws both.
         dt: Step of the full runs [s].
         t_end: End of the full runs [s].
     """
@@ -103,18 +103,6 @@ class Comparison:
             "t_end_s": self.t_end,
             "methods": [asdict(r) for r in self.results],
         }
-
-    def energy_figure(self, title: str | None = None) -> Figure:
-        """``E(t)/E(0)`` of every full run (see :func:`~visviva.viz.plots.plot_energy`)."""
-        from ..viz.plots import plot_energy
-
-        return plot_energy(self.runs, title=title or f"Energy, h = {self.dt:g} s")
-
-    def convergence_figure(self) -> Figure:
-        """Error against step size with each method's fitted order."""
-        from ..viz.plots import plot_convergence
-
-        return plot_convergence(self.studies)
 
 
 def _number(value: float | None) -> str:

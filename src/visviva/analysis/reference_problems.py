@@ -15,8 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import did_you_mean
-from ..errors import ModelError
+from .._registry import Registry
 from ..ode.problems import FirstOrderProblem, Problem, SecondOrderProblem
 
 __all__ = ["ReferenceProblem", "reference_problem", "reference_problems"]
@@ -145,24 +144,34 @@ def _first_order() -> ReferenceProblem:
     )
 
 
-_BUILDERS: dict[str, Callable[[], ReferenceProblem]] = {
-    "pendulum": _pendulum,
-    "forced": _forced,
-    "damped": _damped,
-    "first-order": _first_order,
-}
+@dataclass(frozen=True)
+class _Builder:
+    """How to build the reference problem called ``name``."""
+
+    name: str
+    build: Callable[..., ReferenceProblem]
+
+
+_BUILDERS: Registry[_Builder] = Registry("reference problem")
+for _name, _build in (
+    ("pendulum", _pendulum),
+    ("forced", _forced),
+    ("damped", _damped),
+    ("first-order", _first_order),
+):
+    _BUILDERS.register(_Builder(_name, _build))
+del _name, _build
 
 
 def reference_problems() -> list[str]:
     """Names of the reference problems."""
-    return list(_BUILDERS)
+    return _BUILDERS.names()
 
 
 def reference_problem(name: str, **parameters: Any) -> ReferenceProblem:
-    """Build the reference problem ``name`` (see :func:`reference_problems`)."""
-    if name not in _BUILDERS:
-        raise ModelError(
-            f"unknown reference problem {name!r}.{did_you_mean(name, _BUILDERS)} "
-            f"Available: {', '.join(_BUILDERS)}"
-        )
-    return _BUILDERS[name](**parameters)
+    """Build the reference problem ``name`` (see :func:`reference_problems`).
+
+    Raises:
+        ModelError: For an unknown name; the message lists the valid names.
+    """
+    return _BUILDERS.get(name).build(**parameters)

@@ -260,6 +260,7 @@ def compare_command(
     from ..model.builder import SceneBuilder
     from ..model.systems import SYSTEMS
     from ..scenes import load_model
+    from ..viz.plots import comparison_figures
 
     if dt is not None:
         dt = real_number("--dt", dt, positive=True, unit=" s")
@@ -295,8 +296,9 @@ def compare_command(
         record_every=max(1, round(span / step / 2000)),
     )
     job.recordings.update(comparison.runs)
-    job.figures["energy"] = comparison.energy_figure(f"{model.name}: energy, h = {step:g} s")
-    job.figures["convergence"] = comparison.convergence_figure()
+    job.figures.update(
+        comparison_figures(comparison, title=f"{model.name}: energy, h = {step:g} s")
+    )
     table = comparison.table()
     typer.echo(table)
     for path in job.write({"target": target, "table": table} | comparison.as_dict()).files:

@@ -82,7 +82,7 @@ class PenaltyContact:
             out,
             np.zeros((0, 3, 3)),
             np.zeros((0, 3, 3)),
-            *self.colliders.kernel_arrays,
+            *self.colliders.kernel_arrays[1:],
         )
 
     def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
@@ -90,7 +90,7 @@ class PenaltyContact:
         index = self._touched if alive is None else self._touched[alive[self._touched]]
         return float(
             _penalty_energy(
-                index, x, self.radius, self.masks, self.stiffness, *self.colliders.kernel_arrays
+                index, x, self.radius, self.masks, self.stiffness, *self.colliders.kernel_arrays[1:]
             )
         )
 
@@ -111,7 +111,7 @@ class PenaltyContact:
             np.zeros((0, 3)),
             dfdx,
             dfdv,
-            *self.colliders.kernel_arrays,
+            *self.colliders.kernel_arrays[1:],
         )
 
 

@@ -30,21 +30,24 @@ References:
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numba import njit, prange
 
-from .colliders import ColliderSet, collider_distance, collider_first_hit
+from .colliders import UNROLLED_PLANES, ColliderSet, collider_distance, collider_first_hit
+from .queries import plane_distance, plane_first_hit
+from .tables import ColliderKind
 
 if TYPE_CHECKING:
     from ..ode.state import State
 
-__all__ = ["MAX_IMPACTS", "ColliderResponse", "ParticleCollisions"]
+__all__ = ["MAX_IMPACTS", "ColliderResponse", "ParticleCollisions", "resolve"]
 
 #: Impacts with time of impact handled per particle per step (a particle in a corner may meet
 #: two walls in one step); what is left is resolved by contact.
 MAX_IMPACTS = 4
+_PLANE = int(ColliderKind.PLANE)
 #: Bisection steps: enough to halve a step to round-off.
 BISECTION_STEPS = 60
 #: Relative tolerance of the bisection on ``d − r``, times the step's travel or the radius.
@@ -112,13 +115,29 @@ class ParticleCollisions:
             r.restitution,
             r.friction,
             r.resting_speed,
-            r.time_of_impact,
-            *self.colliders.kernel_arrays,
+            *self.kernel_arguments(),
         )
         return result
 
+    def kernel_arguments(self) -> tuple[Any, ...]:
+        """``(toi, planes, rows, others, everything)``, how :func:`resolve` takes the
+        colliders: the time-of-impact flags (``None`` if no collider has them), the number of
+        leading planes, the colliders' rows, every collider's arrays for the general path
+        (``None`` if all colliders are leading planes), and those arrays again (for impacts)."""
+        colliders = self.colliders
+        everything = colliders.kernel_arrays[1:]
+        toi = self.response.time_of_impact
+        unrolled = min(colliders.planes, UNROLLED_PLANES)
+        return (
+            toi if toi.any() else None,
+            colliders.planes,
+            colliders.rows,
+            everything if len(colliders) > unrolled else None,
+            everything,
+        )
 
-@njit(cache=True, error_model="numpy")
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _bounce(vx, vy, vz, nx, ny, nz, e, mu, resting):  # pragma: no cover - compiled
     """The velocity after an impulse along ``n`` (restitution ``e``, friction ``mu``)."""
     vn = vx * nx + vy * ny + vz * nz
@@ -169,96 +188,268 @@ def _touch_fraction(
     return low
 
 
+# fmt: off
 @njit(cache=True, parallel=True, error_model="numpy")
 def _collide(
-    x0,
-    v0,
-    x,
-    v,
-    radius,
-    alive,
-    masks,
+    x0, v0, x, v, radius, alive, masks, h, restitution, friction, resting,
+    toi, planes, rows, others, everything,
+):  # pragma: no cover - compiled
+    for i in prange(x.shape[0]):
+        if masks[i] == 0 or not alive[i]:
+            continue
+        px, py, pz, vx, vy, vz = resolve(
+            x0[i, 0], x0[i, 1], x0[i, 2], v0[i, 0], v0[i, 1], v0[i, 2],
+            x[i, 0], x[i, 1], x[i, 2], v[i, 0], v[i, 1], v[i, 2],
+            radius[i], masks[i], h, restitution, friction, resting,
+            toi, planes, rows, others, everything,
+        )
+        x[i, 0], x[i, 1], x[i, 2] = px, py, pz
+        v[i, 0], v[i, 1], v[i, 2] = vx, vy, vz
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def resolve(
+    sx, sy, sz, svx, svy, svz, px, py, pz, vx, vy, vz, r, mask, h,
+    restitution, friction, resting, toi, planes, rows, others, everything,
+):  # pragma: no cover - compiled
+    """One particle's step from ``(s, sv)`` to ``(p, v)`` made collision-free (see the module
+    docstring): returns the corrected position and velocity. The fused particle step calls
+    this too (:mod:`visviva.particles.fused`). The colliders come as
+    :meth:`ParticleCollisions.kernel_arguments` gives them.
+
+    Inlined into the callers' loops, and written for them to vectorize: the leading planes
+    (up to four) are handled one by one without a loop; the general path (other shapes, and
+    impacts within the step) is compiled only where it is needed, since ``toi`` and
+    ``others`` are ``None`` when no collider asks for it (Numba compiles one loop per case).
+    """
+    unrolled = min(planes, UNROLLED_PLANES)
+    if toi is not None:
+        impact = False
+        for k in range(unrolled):
+            impact = impact or _plane_impact(k, sx, sy, sz, px, py, pz, r, mask, toi, rows)
+        if others is not None:
+            impact = impact or _impact_possible(
+                unrolled, sx, sy, sz, px, py, pz, r, mask, toi, everything
+            )
+        if impact:
+            px, py, pz, vx, vy, vz = _impacts(
+                sx, sy, sz, svx, svy, svz, px, py, pz, vx, vy, vz, r, mask, h,
+                restitution, friction, resting, toi, everything,
+            )
+    if unrolled > 0:
+        px, py, pz, vx, vy, vz = _plane_contact(
+            0, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
+        )
+    if unrolled > 1:
+        px, py, pz, vx, vy, vz = _plane_contact(
+            1, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
+        )
+    if unrolled > 2:
+        px, py, pz, vx, vy, vz = _plane_contact(
+            2, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
+        )
+    if unrolled > 3:
+        px, py, pz, vx, vy, vz = _plane_contact(
+            3, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
+        )
+    if others is not None:
+        px, py, pz, vx, vy, vz = _other_contacts(
+            unrolled, px, py, pz, vx, vy, vz, r, mask, restitution, friction, resting, others
+        )
+    return px, py, pz, vx, vy, vz
+
+
+@njit(cache=True, error_model="numpy")
+def _other_contacts(
+    first, px, py, pz, vx, vy, vz, r, mask, restitution, friction, resting, colliders,
+):  # pragma: no cover - compiled
+    """The contacts of the colliders from ``first`` on (the general path)."""
+    kinds, rows, offsets, nb, nl, tp, tn = colliders
+    for k in range(first, kinds.shape[0]):
+        if not (mask >> np.uint64(k)) & np.uint64(1):
+            continue
+        d, nx, ny, nz = collider_distance(k, px, py, pz, kinds, rows, offsets, nb, nl, tp, tn)
+        depth = r - d
+        if depth > 0.0:
+            px, py, pz = px + depth * nx, py + depth * ny, pz + depth * nz
+            vx, vy, vz = _bounce(vx, vy, vz, nx, ny, nz, restitution[k], friction[k], resting[k])
+    return px, py, pz, vx, vy, vz
+
+
+@njit(cache=True, error_model="numpy")
+def _impact_possible(first, sx, sy, sz, px, py, pz, r, mask, toi, colliders):  # pragma: no cover
+    """True if, for a collider from ``first`` on with time of impact, the particle was clearly
+    outside at the start and either ends inside or its path crossed the collider."""
+    kinds, rows, offsets, nb, nl, tp, tn = colliders
+    for k in range(first, kinds.shape[0]):
+        if not toi[k] or not (mask >> np.uint64(k)) & np.uint64(1):
+            continue
+        d1, _, _, _ = collider_distance(k, px, py, pz, kinds, rows, offsets, nb, nl, tp, tn)
+        if d1 >= r and kinds[k] == _PLANE and rows[k, 6] == np.inf:
+            continue  # ends clear of a half-space, which cannot be jumped over
+        d0, _, _, _ = collider_distance(k, sx, sy, sz, kinds, rows, offsets, nb, nl, tp, tn)
+        if d0 - r <= _tolerance(sx, sy, sz, px, py, pz, r):
+            continue  # touching at the start: a resting contact
+        if d1 < r:
+            return True
+        hit = collider_first_hit(k, sx, sy, sz, px, py, pz, kinds, rows, offsets, nb, nl, tp, tn)
+        if hit <= 1.0:
+            return True
+    return False
+# fmt: on
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _plane_contact(
+    k, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
+):  # pragma: no cover - compiled
+    """The contact of plane ``k`` (out along its normal, the impulse if moving in)."""
+    if (mask >> np.uint64(k)) & np.uint64(1):
+        d, nx, ny, nz = plane_distance(
+            px,
+            py,
+            pz,
+            rows[k, 0],
+            rows[k, 1],
+            rows[k, 2],
+            rows[k, 3],
+            rows[k, 4],
+            rows[k, 5],
+            rows[k, 6],
+        )
+        depth = r - d
+        if depth > 0.0:
+            px, py, pz = px + depth * nx, py + depth * ny, pz + depth * nz
+            vx, vy, vz = _bounce(vx, vy, vz, nx, ny, nz, restitution[k], friction[k], resting[k])
+    return px, py, pz, vx, vy, vz
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _plane_impact(k, sx, sy, sz, px, py, pz, r, mask, toi, rows):  # pragma: no cover - compiled
+    """True if plane ``k`` (with time of impact) was met within the step from clearly outside:
+    the end inside, or a thin plane crossed."""
+    if not toi[k] or not (mask >> np.uint64(k)) & np.uint64(1):
+        return False
+    d1, _, _, _ = plane_distance(
+        px,
+        py,
+        pz,
+        rows[k, 0],
+        rows[k, 1],
+        rows[k, 2],
+        rows[k, 3],
+        rows[k, 4],
+        rows[k, 5],
+        rows[k, 6],
+    )
+    if d1 >= r and rows[k, 6] == np.inf:
+        return False  # ends clear of a half-space, which cannot be jumped over
+    d0, _, _, _ = plane_distance(
+        sx,
+        sy,
+        sz,
+        rows[k, 0],
+        rows[k, 1],
+        rows[k, 2],
+        rows[k, 3],
+        rows[k, 4],
+        rows[k, 5],
+        rows[k, 6],
+    )
+    if d0 - r <= _tolerance(sx, sy, sz, px, py, pz, r):
+        return False  # touching at the start: a resting contact
+    if d1 < r:
+        return True
+    hit = plane_first_hit(
+        sx,
+        sy,
+        sz,
+        px,
+        py,
+        pz,
+        rows[k, 0],
+        rows[k, 1],
+        rows[k, 2],
+        rows[k, 3],
+        rows[k, 4],
+        rows[k, 5],
+        rows[k, 6],
+    )
+    return hit <= 1.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _tolerance(sx, sy, sz, px, py, pz, r):  # pragma: no cover - compiled
+    """The bisection's tolerance on ``d − r`` [m] for a step from ``s`` to ``p``."""
+    dx, dy, dz = px - sx, py - sy, pz - sz
+    return BISECTION_TOLERANCE * max(np.sqrt(dx * dx + dy * dy + dz * dz), r) + 1e-300
+
+
+@njit(cache=True, error_model="numpy")
+def _impacts(
+    sx,
+    sy,
+    sz,
+    svx,
+    svy,
+    svz,
+    px,
+    py,
+    pz,
+    vx,
+    vy,
+    vz,
+    r,
+    mask,
     h,
     restitution,
     friction,
     resting,
     toi,
-    kinds,
-    rows,
-    offsets,
-    nb,
-    nl,
-    tp,
-    tn,
+    colliders,
 ):  # pragma: no cover - compiled
-    colliders = (kinds, rows, offsets, nb, nl, tp, tn)
-    count = kinds.shape[0]
-    for i in prange(x.shape[0]):
-        mask = masks[i]
-        if mask == 0 or not alive[i]:
-            continue
-        r = radius[i]
-        # The flight of this step: from (sx, sv) over `left` seconds with acceleration a.
-        sx, sy, sz = x0[i, 0], x0[i, 1], x0[i, 2]
-        svx, svy, svz = v0[i, 0], v0[i, 1], v0[i, 2]
-        px, py, pz = x[i, 0], x[i, 1], x[i, 2]
-        vx, vy, vz = v[i, 0], v[i, 1], v[i, 2]
-        ax, ay, az = (vx - svx) / h, (vy - svy) / h, (vz - svz) / h
-        left = h
-        for _ in range(MAX_IMPACTS):
-            dx, dy, dz = px - sx, py - sy, pz - sz
-            travel = np.sqrt(dx * dx + dy * dy + dz * dz)
-            tolerance = BISECTION_TOLERANCE * max(travel, r) + 1e-300
-            best, chosen = np.inf, -1
-            for k in range(count):
-                if not toi[k] or not (mask >> np.uint64(k)) & np.uint64(1):
-                    continue
-                d0, _, _, _ = collider_distance(k, sx, sy, sz, kinds, rows, offsets, nb, nl, tp, tn)
-                if d0 - r <= tolerance:
-                    continue  # already touching: a resting contact, handled below
-                d1, _, _, _ = collider_distance(k, px, py, pz, kinds, rows, offsets, nb, nl, tp, tn)
-                high = 1.0
-                if d1 - r >= 0.0:
-                    # Outside at both ends: did the centre jump over a thin collider?
-                    high = collider_first_hit(
-                        k, sx, sy, sz, px, py, pz, kinds, rows, offsets, nb, nl, tp, tn
-                    )
-                    if not high <= 1.0:
-                        continue
-                s = _touch_fraction(k, sx, sy, sz, dx, dy, dz, high, r, tolerance, colliders)
-                if s < best:
-                    best, chosen = s, k
-            if chosen < 0:
-                break
-            # The state at the impact, the impulse, and the rest of the step flown again.
-            cx, cy, cz = sx + best * dx, sy + best * dy, sz + best * dz
-            cvx, cvy, cvz = (
-                svx + best * (vx - svx),
-                svy + best * (vy - svy),
-                svz + best * (vz - svz),
-            )
-            _, nx, ny, nz = collider_distance(
-                chosen, cx, cy, cz, kinds, rows, offsets, nb, nl, tp, tn
-            )
-            cvx, cvy, cvz = _bounce(
-                cvx, cvy, cvz, nx, ny, nz, restitution[chosen], friction[chosen], resting[chosen]
-            )
-            rest = (1.0 - best) * left
-            sx, sy, sz, svx, svy, svz = cx, cy, cz, cvx, cvy, cvz
-            px = cx + rest * cvx + 0.5 * rest * rest * ax
-            py = cy + rest * cvy + 0.5 * rest * rest * ay
-            pz = cz + rest * cvz + 0.5 * rest * rest * az
-            vx, vy, vz = cvx + rest * ax, cvy + rest * ay, cvz + rest * az
-            left = rest
-        for k in range(count):
-            if not (mask >> np.uint64(k)) & np.uint64(1):
+    """Impacts within the step (seed 003): the earliest touch by bisection, the impulse there,
+    and the rest of the step flown again, up to :data:`MAX_IMPACTS` times."""  # fmt: skip
+    kinds, rows, offsets, nb, nl, tp, tn = colliders
+    # The flight of this step: from (s, sv) over `left` seconds with acceleration a.
+    ax, ay, az = (vx - svx) / h, (vy - svy) / h, (vz - svz) / h
+    left = h
+    for _ in range(MAX_IMPACTS):
+        dx, dy, dz = px - sx, py - sy, pz - sz
+        tolerance = _tolerance(sx, sy, sz, px, py, pz, r)
+        best, chosen = np.inf, -1
+        for k in range(kinds.shape[0]):
+            if not toi[k] or not (mask >> np.uint64(k)) & np.uint64(1):
                 continue
-            d, nx, ny, nz = collider_distance(k, px, py, pz, kinds, rows, offsets, nb, nl, tp, tn)
-            depth = r - d
-            if depth > 0.0:
-                px, py, pz = px + depth * nx, py + depth * ny, pz + depth * nz
-                vx, vy, vz = _bounce(
-                    vx, vy, vz, nx, ny, nz, restitution[k], friction[k], resting[k]
+            d0, _, _, _ = collider_distance(k, sx, sy, sz, kinds, rows, offsets, nb, nl, tp, tn)
+            if d0 - r <= tolerance:
+                continue  # already touching: a resting contact, left to the caller
+            d1, _, _, _ = collider_distance(k, px, py, pz, kinds, rows, offsets, nb, nl, tp, tn)
+            high = 1.0
+            if d1 - r >= 0.0:
+                # Outside at both ends: did the centre jump over a thin collider?
+                high = collider_first_hit(
+                    k, sx, sy, sz, px, py, pz, kinds, rows, offsets, nb, nl, tp, tn
                 )
-        x[i, 0], x[i, 1], x[i, 2] = px, py, pz
-        v[i, 0], v[i, 1], v[i, 2] = vx, vy, vz
+                if not high <= 1.0:
+                    continue
+            s = _touch_fraction(k, sx, sy, sz, dx, dy, dz, high, r, tolerance, colliders)
+            if s < best:
+                best, chosen = s, k
+        if chosen < 0:
+            break
+        # The state at the impact, the impulse, and the rest of the step flown again.
+        cx, cy, cz = sx + best * dx, sy + best * dy, sz + best * dz
+        cvx, cvy, cvz = svx + best * (vx - svx), svy + best * (vy - svy), svz + best * (vz - svz)
+        _, nx, ny, nz = collider_distance(chosen, cx, cy, cz, kinds, rows, offsets, nb, nl, tp, tn)
+        cvx, cvy, cvz = _bounce(
+            cvx, cvy, cvz, nx, ny, nz, restitution[chosen], friction[chosen], resting[chosen]
+        )
+        rest = (1.0 - best) * left
+        sx, sy, sz, svx, svy, svz = cx, cy, cz, cvx, cvy, cvz
+        px = cx + rest * cvx + 0.5 * rest * rest * ax
+        py = cy + rest * cvy + 0.5 * rest * rest * ay
+        pz = cz + rest * cvz + 0.5 * rest * rest * az
+        vx, vy, vz = cvx + rest * ax, cvy + rest * ay, cvz + rest * az
+        left = rest
+    return px, py, pz, vx, vy, vz

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._validation import did_you_mean, real_number
+from .._registry import Registry
+from .._validation import real_number
 from ..errors import ModelError
 from ..io.job import JobOutput, JobReport, python_warnings, run_summary
 from ..io.outputs import output_names, write_output
@@ -49,23 +50,26 @@ class Demo:
     trail: float = 0.0
 
 
-_DEMOS: dict[str, Demo] = {}
+_DEMOS: Registry[Demo] = Registry("demo")
 
 #: A demo runs at most this many times its default duration: demos pick their steps and frame
 #: counts for their default, and 1000× is already minutes of computing for most of them.
 MAX_DURATION_FACTOR = 1000
 
 
-def register_demo(demo: Demo) -> Demo:
-    """Add a demo to the list shown by ``visviva demo``."""
-    _DEMOS[demo.name] = demo
-    return demo
+def register_demo(demo: Demo, *, replace: bool = False) -> Demo:
+    """Add a demo to the list shown by ``visviva demo`` and return it.
+
+    Raises:
+        ModelError: If a demo of that name is registered and ``replace`` is false.
+    """
+    return _DEMOS.register(demo, replace=replace)
 
 
 def demos() -> dict[str, Demo]:
     """Every registered demo by name."""
     _load_builtins()
-    return dict(_DEMOS)
+    return {name: _DEMOS.get(name) for name in _DEMOS}
 
 
 def run_demo(
@@ -96,13 +100,8 @@ def run_demo(
         Interrupted: On SIGINT/SIGTERM: the runs finished so far, the one cut short (marked
             ``-interrupted``) and the summary were written (``error.report``).
     """
-    available = demos()
-    if name not in available:
-        raise ModelError(
-            f"unknown demo {name!r}.{did_you_mean(name, available)} "
-            f"Available: {', '.join(available)}"
-        )
-    demo = available[name]
+    _load_builtins()
+    demo = _DEMOS.get(name)
     seconds = (
         demo.duration
         if duration is None
@@ -119,7 +118,7 @@ def run_demo(
         raise ModelError(
             f"demo {name!r} has no picture, so it cannot be written as "
             f"{', '.join(dict.fromkeys(formats))}; demos with one: "
-            f"{', '.join(d.name for d in available.values() if d.picture)}"
+            f"{', '.join(d.name for d in demos().values() if d.picture)}"
         )
     fps = real_number("fps", fps, positive=True, unit=" frames/s")
     with (
@@ -201,11 +200,14 @@ def _load_builtins() -> None:
         constrained_pendulum,
         dahlquist,
         double_pendulum,
+        fireworks,
+        fountain,
         galaxy,
         kepler,
         oscillator,
         pendulum,
         rock,
+        snow,
         spring_pendulum,
         sun_earth_moon,
     )

@@ -1,10 +1,23 @@
-"""Recordings of gravitating bodies as drawable recordings (shared by the gravitation demos)."""
+"""Recordings of bodies as drawable recordings (shared by the mechanics and gravitation demos)."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..mechanics.lagrangian import LagrangianSystem
 from ..simulation.recording import Recording
+
+
+def drawn_system(system: LagrangianSystem, recording: Recording) -> Recording:
+    """``recording`` of one run of ``system`` (fields ``q`` and ``v``) with the positions of
+    its ``points`` [m] per frame, ``(frames, P, 3)``, and its ``edges``, so that the video,
+    the viewer and the exporters can show it."""
+    fields = dict(recording.fields) | {"points": system.points(recording["q"], recording.time)}
+    units = dict(recording.units) | {"points": "m"}
+    static = dict(recording.static)
+    if system.edges:
+        static["edges"] = np.array(system.edges, dtype=np.int64)
+    return Recording(recording.time, fields, units=units, attrs=recording.attrs, static=static)
 
 
 def drawn_bodies(

@@ -13,10 +13,11 @@ from typing import Any
 
 import numpy as np
 
+from ..analysis.chaos import lyapunov_exponent
 from ..io.job import JobOutput
-from ..mechanics import chaos, classic
+from ..mechanics import classic
 from ..simulation.recording import Recording
-from ..simulation.solve import solve
+from ..simulation.solve import Solution, solve
 from . import Demo, register_demo
 
 Q0 = np.array([2.0, 1.0])  # released from rest [rad]
@@ -29,15 +30,19 @@ PIVOT_AND_BOBS = (
 )
 
 
-def _together(system: Any, first: Recording, second: Recording) -> Recording:
-    """Both pendulums in one recording: six points, four rods, lifted above the ground."""
-    a, b = system.draw(first), system.draw(second)
-    points = np.concatenate([a["points"], b["points"]], axis=1)
+def _together(system: Any, pair: Solution) -> Recording:
+    """Both pendulums in one recording: the first one's ``q`` and ``v``, six points and four
+    rods, lifted above the ground."""
+    points = np.concatenate([system.points(pair.q[:, i], pair.t) for i in range(2)], axis=1)
     points[..., 1] += 2.2
-    edges = np.concatenate([a.static["edges"], b.static["edges"] + 3])
-    fields = dict(first.fields) | {"points": points}
-    static = {"edges": edges, "color": np.array(PIVOT_AND_BOBS[0] + PIVOT_AND_BOBS[1])}
-    return Recording(first.time, fields, units={"points": "m"}, attrs=first.attrs, static=static)
+    edges = np.array(system.edges, dtype=np.int64)
+    static = {
+        "edges": np.concatenate([edges, edges + 3]),
+        "color": np.array(PIVOT_AND_BOBS[0] + PIVOT_AND_BOBS[1]),
+    }
+    fields = {"q": pair.q[:, 0], "v": pair.v[:, 0], "points": points}
+    attrs = pair.recording.attrs
+    return Recording(pair.t, fields, units={"points": "m"}, attrs=attrs, static=static)
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
@@ -48,15 +53,11 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     output.stage("equations.tex").write_text(system.latex() + "\n")
     problem = system.problem(np.stack([Q0, Q0 + [0.0, DELTA]]), np.zeros((2, 2)))
     pair = solve(problem, "rk4", dt=DT, t_end=duration, record_every=10)
-    one, other = (
-        Recording(pair.t, {"q": pair.q[:, i], "v": pair.v[:, i]}, attrs=pair.recording.attrs)
-        for i in range(2)
-    )
-    output.recordings["rk4"] = _together(system, one, other)
+    output.recordings["rk4"] = _together(system, pair)
     difference = np.concatenate([pair.q[:, 1] - pair.q[:, 0], pair.v[:, 1] - pair.v[:, 0]], axis=1)
     separation = np.linalg.norm(difference, axis=1)
-    estimate = chaos.lyapunov_exponent(
-        system, Q0, [0.0, 0.0], t_end=max(duration, 20.0), dt=2e-3, interval=0.5
+    estimate = lyapunov_exponent(
+        system.problem(Q0, [0.0, 0.0]), t_end=max(duration, 20.0), dt=2e-3, interval=0.5
     )
 
     canonical = solve(

@@ -18,6 +18,7 @@ from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.solve import solve
 from . import Demo, register_demo
+from ._bodies import drawn_system
 
 LENGTH = 1.0  # [m]
 THETA0 = 1.0  # released from rest at 1 rad
@@ -30,7 +31,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 
     system = classic.pendulum(length=LENGTH)
     solution = solve(system.problem([THETA0], [0.0]), "rk4", dt=DT, t_end=duration)
-    output.recordings["rk4"] = system.draw(solution.recording)
+    output.recordings["rk4"] = drawn_system(system, solution.recording)
     output.stage("equations.txt").write_text(system.text() + "\n")
     output.stage("equations.tex").write_text(system.latex() + "\n")
     exact = classic.pendulum_period(THETA0, length=LENGTH)

@@ -16,6 +16,7 @@ from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.solve import solve
 from . import Demo, register_demo
+from ._bodies import drawn_system
 
 DT = 0.05  # step [s]
 Q0 = np.array([0.0, 0.0, 0.0])  # thrown from the ground [m]
@@ -33,7 +34,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     errors = {}
     for name in METHODS:
         solution = solve(problem, name, dt=DT, t_end=duration)
-        output.recordings[name] = system.draw(solution.recording)
+        output.recordings[name] = drawn_system(system, solution.recording)
         exact = classic.rock_trajectory(solution.t, Q0, V0)
         height_error = solution.q[:, 1] - exact[:, 1]
         errors[name] = float(np.abs(solution.q - exact).max())

@@ -16,6 +16,7 @@ from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.solve import solve
 from . import Demo, register_demo
+from ._bodies import drawn_system
 
 MASS, REST = 1.0, 1.0  # [kg], [m]
 G = classic.STANDARD_GRAVITY
@@ -36,7 +37,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
         t_end=duration,
         record_every=10,
     )
-    output.recordings["rk4"] = system.draw(solution.recording)
+    output.recordings["rk4"] = drawn_system(system, solution.recording)
     r, theta = solution.q[:, 0], solution.q[:, 1]
     rdot, omega = solution.v[:, 0], solution.v[:, 1]
     spring = 0.5 * STIFFNESS * (r - REST) ** 2

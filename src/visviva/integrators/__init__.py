@@ -16,6 +16,7 @@ through the same solver, analysis tools and conformance tests as the built-in on
 
 from __future__ import annotations
 
+from .._registry import Registry
 from ..errors import ModelError
 from .base import CompiledStep, Integrator
 from .dopri5 import DormandPrince5
@@ -58,7 +59,7 @@ __all__ = [
     "unregister",
 ]
 
-_REGISTRY: dict[str, Integrator] = {}
+_REGISTRY: Registry[Integrator] = Registry("integration method")
 
 
 def register(method: Integrator | type[Integrator], *, replace: bool = False) -> Integrator:
@@ -81,23 +82,17 @@ def register(method: Integrator | type[Integrator], *, replace: bool = False) ->
                 f"integrator {type(instance).__name__} must declare the class attribute "
                 f"`{attribute}`"
             )
-    if instance.name in _REGISTRY and not replace:
-        raise ModelError(
-            f"an integrator named {instance.name!r} is already registered; "
-            "pass replace=True to replace it"
-        )
-    _REGISTRY[instance.name] = instance
-    return instance
+    return _REGISTRY.register(instance, replace=replace)
 
 
 def unregister(name: str) -> None:
     """Remove a registered method (e.g. one a test registered)."""
-    _REGISTRY.pop(name, None)
+    _REGISTRY.unregister(name)
 
 
 def names() -> list[str]:
     """Names of the registered methods, in registration order."""
-    return list(_REGISTRY)
+    return _REGISTRY.names()
 
 
 def get(method: str | Integrator) -> Integrator:
@@ -112,15 +107,7 @@ def get(method: str | Integrator) -> Integrator:
         raise ModelError(
             f"`method` must be a method name or an Integrator (got {type(method).__name__})"
         )
-    try:
-        return _REGISTRY[method]
-    except KeyError:
-        from .._validation import did_you_mean
-
-        raise ModelError(
-            f"unknown integration method {method!r}.{did_you_mean(method, _REGISTRY)} "
-            f"Valid names: {', '.join(_REGISTRY)}"
-        ) from None
+    return _REGISTRY.get(method)
 
 
 for _method in (

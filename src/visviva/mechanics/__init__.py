@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from . import chaos, classic
+from . import classic
 from .barnes_hut import TreeError, tree_force_error
 from .classic import (
     constrained_pendulum,
@@ -29,7 +29,6 @@ __all__: list[str] = [
     "KeplerOrbit",
     "LagrangianSystem",
     "TreeError",
-    "chaos",
     "classic",
     "colliding_disks",
     "constrained_pendulum",

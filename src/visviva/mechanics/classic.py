@@ -231,20 +231,25 @@ def damped_oscillator(
     """``m ẍ + c ẋ + k x = 0``: ``K = ½ m ẋ²``, ``U = ½ k x²`` and the force ``Q = −c ẋ``.
 
     Drawn as a mass on a spring from a wall at ``x = −1.5 m``; the exact motion is
-    :func:`damped_oscillator_solution`.
+    :func:`damped_oscillator_solution`. Without damping there is no force ``Q``: the equations
+    then depend on positions only, which symplectic methods need to be symplectic (and which
+    saves velocity Verlet an evaluation per step).
     """
     m, k, c = sympy.symbols("m k c")
     x = sympy.Function("x")(_t)
+    friction = real_number("damping", damping, nonnegative=True, unit=" N·s/m")
+    parameters = {
+        "m": _positive("mass", mass, " kg"),
+        "k": _positive("stiffness", stiffness, " N/m"),
+    }
+    if friction > 0.0:
+        parameters["c"] = friction
     return LagrangianSystem(
         [x],
         kinetic=m * x.diff(_t) ** 2 / 2,
         potential=k * x**2 / 2,
-        forces=[-c * x.diff(_t)],
-        parameters={
-            "m": _positive("mass", mass, " kg"),
-            "k": _positive("stiffness", stiffness, " N/m"),
-            "c": real_number("damping", damping, nonnegative=True, unit=" N·s/m"),
-        },
+        forces=[-c * x.diff(_t)] if friction > 0.0 else [0],
+        parameters=parameters,
         points=[(-1.5, 0), (x, 0)],
         edges=[(0, 1)],
         name="damped oscillator",

@@ -27,7 +27,6 @@ from sympy.core.function import AppliedUndef
 from .._validation import describe, did_you_mean, real_number, state_array
 from ..errors import ModelError
 from ..ode.problems import FirstOrderProblem, SecondOrderProblem
-from ..simulation.recording import Recording
 from .codegen import FLAVOURS
 from .equations_code import Derived, EquationsCode
 
@@ -298,30 +297,6 @@ class LagrangianSystem:
         out = np.empty(q.shape[:-1] + (len(self._points), 3))
         self._code("numpy").points(np.asarray(t, dtype=float), q, out)
         return out
-
-    def draw(self, recording: Recording) -> Recording:
-        """``recording`` (of one system, from :meth:`problem` or :meth:`canonical_problem`)
-        with the system's ``points`` [m] added per frame and its ``edges``, so the video,
-        viewer and exporters can show it."""
-        if "q" in recording:
-            q = recording["q"]
-        elif "y" in recording:
-            q = recording["y"][..., : self.size]  # (q, p) from the canonical problem
-        else:
-            raise ModelError(
-                f"the recording has no coordinates q (fields: {list(recording.fields)})"
-            )
-        if q.ndim != 2:
-            raise ModelError(
-                f"draw() takes a recording of one system (q of shape (frames, {self.size})); "
-                f"got q of shape {q.shape}"
-            )
-        fields = dict(recording.fields) | {"points": self.points(q, recording.time)}
-        static = dict(recording.static)
-        if self.edges:
-            static["edges"] = np.array(self.edges, dtype=np.int64)
-        units = dict(recording.units) | {"points": "m"}
-        return Recording(recording.time, fields, units=units, attrs=recording.attrs, static=static)
 
     def _state(self, name: str, value: Any) -> np.ndarray:
         array = state_array(name, value)

@@ -80,8 +80,9 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     h = settings.dt / settings.substeps
     try:
         systems = _systems(scene, names)
-        forces = force_objects(scene, groups, arrays["mass"])
-        forces += penalty_forces(scene, groups, arrays["mass"], arrays["radius"])
+        with np.errstate(all="ignore"):  # overflowing values are judged by the start check
+            forces = force_objects(scene, groups, arrays["mass"])
+            forces += penalty_forces(scene, groups, arrays["mass"], arrays["radius"])
         stages = []
         collisions = collision_stage(scene, groups, count, h)
         if collisions is not None:
@@ -89,7 +90,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         if specs:
             from ..particles.emission import Emission
 
-            stages.append(Emission(specs))
+            stages.append(Emission(specs, count))
     except Located as located:
         raise SceneError([located.problem]) from None
     model = Model(

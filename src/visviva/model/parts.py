@@ -220,11 +220,14 @@ def _force(e: ForceField, targets: Targets, mass: np.ndarray) -> Force:
 
 
 def _colliders(scene: Scene, response: str) -> list[tuple[int, Collider]]:
-    return [
+    """The colliders of one response, planes first (the kernels' fast path; see
+    :class:`~visviva.collision.ColliderSet`)."""
+    chosen = [
         (i, e)
         for i, e in enumerate(scene.entities)
         if isinstance(e, Collider) and e.response == response
     ]
+    return sorted(chosen, key=lambda pair: pair[1].shape != "plane")
 
 
 def _shape(e: Collider, where: str) -> Any:

@@ -4,8 +4,8 @@ Each entry knows its parameters (with defaults and units), builds the ordinary
 :mod:`visviva.ode` problem that the one simulation loop runs, and draws itself: it maps the
 recorded coordinates to points (and edges) in the world so the video, viewer and exporters can
 show it. A system without a picture (the test equation) records no geometry. The systems of
-classical mechanics (pendulums, the rock, ...) live in :mod:`.classic_systems`, gravitating
-bodies in :mod:`.gravity_systems`.
+classical mechanics (the oscillator, pendulums, the rock, ...) live in :mod:`.classic_systems`,
+gravitating bodies in :mod:`.gravity_systems`; :data:`SYSTEMS` holds them all.
 """
 
 from __future__ import annotations
@@ -15,41 +15,13 @@ from typing import Any
 
 import numpy as np
 
+from .._registry import Registry
 from ..ode.problems import FirstOrderProblem, Problem, SecondOrderProblem
 from .classic_systems import CLASSIC_SYSTEMS
 from .gravity_systems import GRAVITY_SYSTEMS
 from .system_type import Parameter, SystemType
 
 __all__ = ["SYSTEMS", "Parameter", "SystemType"]
-
-
-def _oscillator(p: Mapping[str, float], gravity: np.ndarray) -> Problem:
-    omega2 = p["omega"] ** 2
-
-    def acceleration(t: float, q: np.ndarray) -> np.ndarray:
-        return -omega2 * q  # q'' = −ω² q
-
-    def jacobian(t: float, q: np.ndarray) -> np.ndarray:
-        return np.full(q.shape + q.shape[-1:], -omega2)
-
-    def energy(t: float, q: np.ndarray, v: np.ndarray) -> Any:
-        return 0.5 * v[..., 0] ** 2 + 0.5 * omega2 * q[..., 0] ** 2  # a 1 kg mass [J]
-
-    return SecondOrderProblem(
-        acceleration, [p["q0"]], [p["v0"]], jacobian=jacobian, energy=energy, name="oscillator"
-    )
-
-
-def _draw_oscillator(
-    p: Mapping[str, float], gravity: np.ndarray, parts: tuple[np.ndarray, ...]
-) -> np.ndarray:
-    q = parts[0][:, 0]
-    amplitude = np.hypot(p["q0"], p["v0"] / p["omega"])
-    points = np.zeros((q.shape[0], 2, 3))
-    points[:, 0, 0] = -2.0 * amplitude  # the wall the spring hangs from
-    points[:, 1, 0] = q
-    points[:, :, 1] = amplitude  # lift the picture off the ground plane
-    return points
 
 
 def _circular(p: Mapping[str, float], gravity: np.ndarray) -> Problem:
@@ -98,45 +70,32 @@ def _test_equation(p: Mapping[str, float], gravity: np.ndarray) -> Problem:
     return FirstOrderProblem(f, [p["y0"]], jacobian=jacobian, name="test equation")
 
 
-#: Every named system, by name.
-SYSTEMS: dict[str, SystemType] = (
-    {
-        system.name: system
-        for system in (
-            SystemType(
-                "oscillator",
-                "a 1 kg mass on a spring: q'' = -omega^2 q",
-                {
-                    "omega": Parameter(2.0 * np.pi, "rad/s", "angular frequency", positive=True),
-                    "q0": Parameter(1.0, "m", "initial displacement"),
-                    "v0": Parameter(0.0, "m/s", "initial velocity"),
-                },
-                _oscillator,
-                _draw_oscillator,
-                ((0, 1),),
-            ),
-            SystemType(
-                "circular",
-                "seed 004's circular motion: 1 kg pulled to the centre, q'' = -omega^2 q",
-                {
-                    "radius": Parameter(1.0, "m", "orbit radius", positive=True),
-                    "omega": Parameter(1.0, "rad/s", "angular velocity", positive=True),
-                },
-                _circular,
-                _draw_circular,
-                ((0, 1),),
-            ),
-            SystemType(
-                "test-equation",
-                "Dahlquist's test equation y' = lambda y (no picture)",
-                {
-                    "lambda": Parameter(-1.0, "1/s", "rate"),
-                    "y0": Parameter(1.0, "", "initial value"),
-                },
-                _test_equation,
-            ),
-        )
-    }
-    | CLASSIC_SYSTEMS
-    | GRAVITY_SYSTEMS
-)
+#: Every named system, by name (``SYSTEMS.get(name)``, ``name in SYSTEMS``, ``SYSTEMS.names()``).
+SYSTEMS: Registry[SystemType] = Registry("system")
+
+for _system in (
+    *CLASSIC_SYSTEMS,
+    SystemType(
+        "circular",
+        "seed 004's circular motion: 1 kg pulled to the centre, q'' = -omega^2 q",
+        {
+            "radius": Parameter(1.0, "m", "orbit radius", positive=True),
+            "omega": Parameter(1.0, "rad/s", "angular velocity", positive=True),
+        },
+        _circular,
+        _draw_circular,
+        ((0, 1),),
+    ),
+    SystemType(
+        "test-equation",
+        "Dahlquist's test equation y' = lambda y (no picture)",
+        {
+            "lambda": Parameter(-1.0, "1/s", "rate"),
+            "y0": Parameter(1.0, "", "initial value"),
+        },
+        _test_equation,
+    ),
+    *GRAVITY_SYSTEMS.values(),
+):
+    SYSTEMS.register(_system)
+del _system

@@ -26,7 +26,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from .emitters import EmitterSpec, ramp_values
 from .random import uniform
@@ -42,34 +42,59 @@ class Emission:
 
     Args:
         emitters: The emitters, in scene order (their slot ranges do not overlap).
+        count: Number of particle slots of the scene.
     """
 
     compiled: ClassVar[bool] = True
 
-    def __init__(self, emitters: Sequence[EmitterSpec]) -> None:
+    def __init__(self, emitters: Sequence[EmitterSpec], count: int) -> None:
         self.emitters = tuple(emitters)
+        #: The emitter owning each slot (−1: a particle that lives for the whole run).
+        self.slot_emitter = np.full(count, -1, dtype=np.int64)
+        longest = max(e.size_ramp.shape[0] for e in self.emitters)
+        #: Each emitter's size ramp, padded with its last stop: ``(E, S, 2)``.
+        self.size_ramps = np.zeros((len(self.emitters), longest, 2))
+        for spec in self.emitters:
+            self.slot_emitter[spec.first_slot : spec.first_slot + spec.capacity] = spec.index
+            stops = spec.size_ramp
+            self.size_ramps[spec.index, : stops.shape[0]] = stops
+            self.size_ramps[spec.index, stops.shape[0] :] = stops[-1]
 
     def apply(self, before: State, after: State, h: float) -> State:
         """Age, kill, give birth and ramp sizes (see the module docstring)."""
-        t0, t1 = before.t, after.t
         parts = tuple(np.array(part) for part in after.parts)
-        result = after.from_parts(t1, parts)
+        result = after.from_parts(after.t, parts)
+        carried = {name: np.array(after[name]) for name in CARRIED}
         x, v = result["particle_position"], result["particle_velocity"]
-        alive = after["particle_alive"].copy()
-        age = after["particle_age"] + np.where(alive, t1 - t0, 0.0)
-        lifetime = after["particle_lifetime"].copy()
-        size = after["particle_size"].copy()
-        radius = after["particle_radius"].copy()
-        serial = after["emitter_serial"].copy()
-        dropped = after["emitter_dropped"].copy()
-        alive &= age < lifetime
+        _age_all(
+            x,
+            v,
+            carried["particle_alive"],
+            carried["particle_age"],
+            carried["particle_lifetime"],
+            carried["particle_size"],
+            carried["particle_radius"],
+            self.slot_emitter,
+            self.size_ramps,
+            h,
+        )
+        self.give_birth(before.t, after.t, x, v, carried)
+        return result.with_carried(**carried)
+
+    def give_birth(
+        self, t0: float, t1: float, x: np.ndarray, v: np.ndarray, carried: dict[str, np.ndarray]
+    ) -> None:
+        """The births of the step ``[t0, t1)``, written in place into the particle arrays
+        ``x``, ``v`` and the ``carried`` parts (the fused particle step calls this too)."""
+        alive, age = carried["particle_alive"], carried["particle_age"]
+        lifetime, size = carried["particle_lifetime"], carried["particle_size"]
+        serial, dropped = carried["emitter_serial"], carried["emitter_dropped"]
         for spec in self.emitters:
-            slots = slice(spec.first_slot, spec.first_slot + spec.capacity)
-            parked = ~alive[slots]
-            x[slots][parked] = 0.0
-            v[slots][parked] = 0.0
             times = _birth_times(spec, t0, t1)
-            free = spec.first_slot + np.flatnonzero(parked)[: times.shape[0]]
+            if not times.shape[0]:
+                continue
+            slots = slice(spec.first_slot, spec.first_slot + spec.capacity)
+            free = spec.first_slot + np.flatnonzero(~alive[slots])[: times.shape[0]]
             dropped[spec.index] += times.shape[0] - free.shape[0]
             born = times[: free.shape[0]]
             serials = serial[spec.index] + np.arange(born.shape[0], dtype=np.int64)
@@ -77,18 +102,65 @@ class Emission:
             _sample(spec, serials, t1 - born, free, x, v, lifetime, size)
             age[free] = t1 - born
             alive[free] = age[free] < lifetime[free]
-            ramped = spec.first_slot + np.flatnonzero(alive[slots])
-            factor = ramp_values(spec.size_ramp, age[ramped] / lifetime[ramped])[:, 0]
-            radius[ramped] = size[ramped] * factor
-        return result.with_carried(
-            particle_alive=alive,
-            particle_age=age,
-            particle_lifetime=lifetime,
-            particle_size=size,
-            particle_radius=radius,
-            emitter_serial=serial,
-            emitter_dropped=dropped,
+            fraction = age[free] / lifetime[free]
+            carried["particle_radius"][free] = (
+                size[free] * ramp_values(spec.size_ramp, fraction)[:, 0]
+            )
+
+
+#: The carried parts the emission stage updates.
+CARRIED = (
+    "particle_alive",
+    "particle_age",
+    "particle_lifetime",
+    "particle_size",
+    "particle_radius",
+    "emitter_serial",
+    "emitter_dropped",
+)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def age_one(alive, age, lifetime, size, emitter, size_ramps, h):  # pragma: no cover - compiled
+    """One slot after a step of ``h``: ``(alive, age, radius)``. A particle whose age reaches
+    its lifetime dies; a live emitted particle's radius follows its emitter's size ramp."""
+    if not alive:
+        return False, age, size
+    age = age + h
+    if not age < lifetime:
+        return False, age, size
+    if emitter < 0:
+        return True, age, size
+    return True, age, size * ramp(size_ramps, emitter, age / lifetime)
+
+
+@njit(cache=True, error_model="numpy")
+def ramp(ramps, e, fraction):  # pragma: no cover - compiled
+    """Ramp ``e``'s value at ``fraction`` (``ramps[e]``: ``(fraction, value)`` stops): linear
+    between stops, constant beyond the first and last (as ``numpy.interp``). Entries are read
+    one by one: a view per particle would cost an atomic reference count in a parallel loop."""
+    if fraction <= ramps[e, 0, 0]:
+        return ramps[e, 0, 1]
+    for k in range(1, ramps.shape[1]):
+        if fraction < ramps[e, k, 0]:
+            a0, a1, b0, b1 = ramps[e, k - 1, 0], ramps[e, k - 1, 1], ramps[e, k, 0], ramps[e, k, 1]
+            return a1 + (fraction - a0) / (b0 - a0) * (b1 - a1)
+    return ramps[e, ramps.shape[1] - 1, 1]
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def _age_all(
+    x, v, alive, age, lifetime, size, radius, slot_emitter, size_ramps, h
+):  # pragma: no cover
+    for i in prange(alive.shape[0]):
+        was = alive[i]
+        alive[i], age[i], radius[i] = age_one(
+            was, age[i], lifetime[i], size[i], slot_emitter[i], size_ramps, h
         )
+        if not alive[i]:  # parked at rest at the origin (see the module docstring)
+            for k in range(3):
+                x[i, k] = 0.0
+                v[i, k] = 0.0
 
 
 def _birth_times(spec: EmitterSpec, t0: float, t1: float) -> np.ndarray:

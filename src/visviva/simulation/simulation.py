@@ -99,6 +99,9 @@ class Simulation:
             integrator steps.
         divergence_limit: Largest allowed ``|component|`` before the run counts as diverged
             (default ``1e10 × max(1, max |initial state|)``).
+        compiled: ``None`` to take the fused particle step when the scene has one
+            (:mod:`visviva.particles.fused`: one parallel pass per step), ``False`` for the
+            generic pipeline, ``True`` to require the fused step.
 
     Raises:
         ModelError: If the method cannot integrate the scene or an argument is invalid.
@@ -111,7 +114,10 @@ class Simulation:
         method: str | Integrator | None = None,
         dt: float | None = None,
         divergence_limit: float | None = None,
+        compiled: bool | None = None,
     ) -> None:
+        from ..particles.fused import FusedParticles
+
         settings = model.integration
         self.model = model
         self.integrator = get(settings.method if method is None else method)
@@ -123,7 +129,13 @@ class Simulation:
         if divergence_limit is not None:
             divergence_limit = real_number("divergence_limit", divergence_limit, positive=True)
         watch = DivergenceWatch(self.system, self.integrator, self.dt, state, divergence_limit)
-        self._stepper = Stepper(self.system, self.integrator, watch, model.stages)
+        fused = None if compiled is False else FusedParticles.of(model, self.integrator.name)
+        if compiled and fused is None:
+            raise ModelError(
+                "compiled=True needs a scene made only of particles under field forces, with "
+                "colliders and emitters, stepped by 'symplectic_euler'; this one has no fused step"
+            )
+        self._stepper = Stepper(self.system, self.integrator, watch, model.stages, fused)
         self._state = state
         self._origin = state.t
         self._steps = 0  # steps of dt since the origin
@@ -139,8 +151,15 @@ class Simulation:
         return SimulationState(self._state)
 
     @property
+    def compiled(self) -> bool:
+        """True if the steps are fused into one compiled pass (see ``compiled`` above)."""
+        return self._stepper.fused is not None
+
+    @property
     def raw_state(self) -> State:
-        """The whole state: every particle slot, dead ones included, and the carried parts."""
+        """The whole state: every particle slot, dead ones included, and the carried parts.
+
+        With the fused step its arrays are reused two steps later: copy what you keep."""
         return self._state
 
     def energy(self) -> float:

@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from ..ode.system import System
     from .watch import DivergenceWatch
 
-__all__ = ["Stage", "Stepper"]
+__all__ = ["FusedStep", "Stage", "Stepper"]
 
 
 class Stage(Protocol):
@@ -43,6 +43,16 @@ class Stage(Protocol):
         ...
 
 
+class FusedStep(Protocol):
+    """A whole step — integrator, stages and the watch's check — in one compiled pass, for
+    models whose every piece has a compiled form (:mod:`visviva.particles.fused`)."""
+
+    def step(self, state: State, h: float, t_after: float, limit: float) -> tuple[State, int]:
+        """The state after a step of ``h`` ending at ``t_after``, and the number of entities
+        beyond the divergence ``limit`` (or not finite) in it."""
+        ...
+
+
 class Stepper:
     """Advances states step by step: integrator, then stages, then the watch.
 
@@ -51,6 +61,8 @@ class Stepper:
         integrator: The time integrator.
         watch: The divergence watch.
         stages: Post-step stages, applied in order.
+        fused: A compiled whole step that takes the place of the integrator and the stages
+            (it must compute what they would).
     """
 
     def __init__(
@@ -59,11 +71,13 @@ class Stepper:
         integrator: Integrator,
         watch: DivergenceWatch,
         stages: Sequence[Stage] = (),
+        fused: FusedStep | None = None,
     ) -> None:
         self.system = system
         self.integrator = integrator
         self.watch = watch
         self.stages = tuple(stages)
+        self.fused = fused
 
     @property
     def compiled_stages(self) -> bool:
@@ -78,6 +92,13 @@ class Stepper:
             SimulationDiverged: If the new state is not finite or beyond the watch's limit.
             SimulationError: If the integrator failed (its ``step`` is set to ``index``).
         """
+        if self.fused is not None:
+            after, bad = self.fused.step(state, h, t_after, self.watch.limit)
+            self.system.counters.f_evaluations += 1
+            self.system.counters.accepted_steps += 1
+            if bad:
+                raise self.watch.diverged(after, index, state)
+            return after
         try:
             after = self.integrator.step(self.system, state, h).at_time(t_after)
         except SimulationError as failure:

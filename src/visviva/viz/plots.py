@@ -1,4 +1,5 @@
-"""Figures for teaching and checking: stability regions, energy, convergence, phase portraits.
+"""Figures for teaching and checking: stability regions, energy, convergence, phase portraits,
+the two figures of an integrator comparison.
 
 Every function returns a :class:`matplotlib.figure.Figure` built without pyplot (no global
 state, no display needed); save it with ``figure.savefig(path)``.
@@ -17,10 +18,12 @@ from ..analysis.invariants import relative_change
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+    from ..analysis.compare import Comparison
     from ..analysis.convergence import ConvergenceStudy
     from ..simulation.recording import Recording
 
 __all__ = [
+    "comparison_figures",
     "plot_convergence",
     "plot_energy",
     "plot_phase",
@@ -215,6 +218,21 @@ def plot_convergence(studies: Sequence[ConvergenceStudy]) -> Figure:
     ax.legend(fontsize=8)
     ax.set_title("Convergence: circled points are in the fitted asymptotic range")
     return figure
+
+
+def comparison_figures(comparison: Comparison, *, title: str | None = None) -> dict[str, Figure]:
+    """The figures of :func:`~visviva.analysis.compare_methods`, by name: ``"energy"``, the
+    energy of every full run (:func:`plot_energy`), and ``"convergence"``, error against step
+    size with each method's fitted order (:func:`plot_convergence`).
+
+    Args:
+        comparison: What :func:`~visviva.analysis.compare_methods` returned.
+        title: Title of the energy figure; default ``"Energy, h = <dt> s"``.
+    """
+    return {
+        "energy": plot_energy(comparison.runs, title=title or f"Energy, h = {comparison.dt:g} s"),
+        "convergence": plot_convergence(comparison.studies),
+    }
 
 
 def plot_momentum(recording: Recording, *, title: str = "Momenta") -> Figure:
