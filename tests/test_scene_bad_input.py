@@ -260,3 +260,112 @@ def _value(value) -> str:
     if isinstance(value, dict):
         return "{" + ", ".join(f"{_quoted(k)} = {_value(v)}" for k, v in value.items()) + "}"
     return _toml_value(value)
+
+
+def entity(text: str) -> str:
+    """The valid scene with one more ``[[entities]]`` table (it becomes entities[2])."""
+    return VALID + "\n[[entities]]\n" + text
+
+
+OPEN_MESH = """type = "collider"
+shape = "mesh"
+vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]
+triangles = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 1]]
+"""
+
+
+@pytest.mark.parametrize(
+    ("text", "fragments"),
+    [
+        (entity('type = "emitter"\nrate = -5.0'), ["entities[2].rate", "-5.0"]),
+        (entity('type = "emitter"\nrate = 5.0\nlifetime = 0.0'), ["entities[2].lifetime", "0.0"]),
+        (
+            entity('type = "emitter"\nrate = 5.0\nlifetime = [2.0, 1.0]'),
+            ["entities[2]", "`lifetime`", "low > high"],
+        ),
+        (entity('type = "emitter"\nspread = 10.0'), ["entities[2]", "emits nothing", "rate"]),
+        (
+            entity('type = "emitter"\nrate = 5.0\ncapacity = 1000000000'),
+            ["entities[2].capacity", "1000000000"],
+        ),
+        (
+            entity('type = "emitter"\nrate = 5.0\ndirection = [0.0, 0.0, 0.0]'),
+            ["entities[2]", "`direction`", "zero vector"],
+        ),
+        (
+            entity('type = "emitter"\nrate = 5.0\ncolor_ramp = [[0.5, 1, 0, 0], [0.1, 0, 0, 1]]'),
+            ["entities[2]", "color_ramp", "increasing"],
+        ),
+        (replaced("mass = 1.0", "mass = 1.0\nradius = -0.1"), ["entities[0].radius", "-0.1"]),
+        (
+            entity('type = "collider"\nshape = "plane"\nrestitution = 1.5'),
+            ["entities[2].restitution", "1.5"],
+        ),
+        (
+            entity('type = "collider"\nshape = "plane"\nfriction = -0.2'),
+            ["entities[2].friction", "-0.2"],
+        ),
+        (
+            entity('type = "collider"\nshape = "plane"\nnormal = [0.0, 0.0, 0.0]'),
+            ["entities[2]", "`normal`", "zero"],
+        ),
+        (entity('type = "collider"\nshape = "sphere"'), ["entities[2]", "needs `radius`"]),
+        (entity(OPEN_MESH), ["entities[2]", "edge"]),
+        (
+            entity(
+                'type = "collider"\nshape = "box"\nsize = [1, 1, 1]\norientation = [2, 0, 0, 0]'
+            ),
+            ["entities[2]", "orientation", "normalize"],
+        ),
+        (
+            entity('type = "collider"\nshape = "plane"\nstiffness = 10.0'),
+            ["entities[2]", "stiffness", "penalty"],
+        ),
+        (
+            entity('type = "force"\nkind = "drag"\ncoefficient = 0.1\ntargets = ["bal"]'),
+            ["entities[2].targets[0]", "'bal'", "'ball'"],
+        ),
+        (entity('type = "force"\nkind = "drgа"\ncoefficient = 0.1'), ["entities[2].kind"]),
+        (entity('type = "force"\nkind = "drag"'), ["entities[2]", "needs `coefficient`"]),
+        (
+            entity('type = "force"\nkind = "drag"\ncoefficient = 0.1\nstrength = 2.0'),
+            ["entities[2].strength", "not a parameter of a drag force"],
+        ),
+        (
+            entity(
+                'type = "force"\nkind = "attractor"\npoint = [0, 0, 0]\nstrength = 1.0\nsoftening = 0.0'
+            ),
+            ["entities[2]", "softening", "positive"],
+        ),
+        (
+            entity('type = "emitter"\nname = "spray"\nrate = 5.0')
+            + '\n[[entities]]\ntype = "force"\nkind = "gravitation"\ntargets = ["spray"]',
+            ["entities[3].targets[0]", "born and die"],
+        ),
+    ],
+    ids=[
+        "negative-rate",
+        "zero-lifetime",
+        "lifetime-range-reversed",
+        "emitter-emits-nothing",
+        "capacity-above-limit",
+        "zero-direction",
+        "ramp-out-of-order",
+        "negative-radius",
+        "restitution-above-one",
+        "negative-friction",
+        "zero-normal",
+        "sphere-without-radius",
+        "open-mesh-collider",
+        "non-unit-quaternion",
+        "stiffness-without-penalty",
+        "unknown-target",
+        "unknown-force-kind",
+        "missing-force-parameter",
+        "parameter-of-another-kind",
+        "attractor-without-softening",
+        "gravitation-among-emitted",
+    ],
+)
+def test_bad_particle_entity_is_refused(monkeypatch, capsys, tmp_path, text, fragments):
+    refused(monkeypatch, capsys, tmp_path, text, *fragments)

@@ -495,7 +495,8 @@ class Collider(_Strict):
         if not penalty and (self.stiffness is not None or self.damping is not None):
             raise PydanticCustomError(
                 "not_a_parameter",
-                '`stiffness` and `damping` belong to response = "penalty"',
+                '`{field}` belongs to response = "penalty"',
+                {"field": "stiffness" if self.stiffness is not None else "damping"},
             )
         if penalty and self.stiffness is None:
             raise PydanticCustomError(

@@ -49,8 +49,9 @@ def scene_problems(
         got: str | None = describe(error["input"])
         if isinstance(error["input"], dict):
             got = None  # a rule of the whole entity (its message names the fields)
-            if error["type"] == "not_a_parameter":
-                path = (*path, error["ctx"]["field"])
+            field = error.get("ctx", {}).get("field")
+            if error["type"] == "not_a_parameter" and field:
+                path = (*path, field)
         if error["type"] == "extra_forbidden":
             key = str(path[-1])
             allowed = _allowed_keys(path[:-1], raw)

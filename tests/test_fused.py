@@ -1,0 +1,94 @@
+"""The fused particle step computes what the generic pipeline computes (forces, symplectic
+Euler, collision stage, emission stage, divergence watch), to round-off."""
+
+import numpy as np
+import pytest
+
+import visviva as vv
+
+
+def _scene(**extra) -> vv.Model:
+    builder = vv.SceneBuilder(name="fused")
+    builder.set_integration(method="symplectic_euler", dt=1 / 240, duration=2.0)
+    builder.add_emitter(
+        rate=400,
+        speed=[3.0, 4.0],
+        spread=20,
+        lifetime=[0.5, 0.9],
+        size_ramp=[[0.0, 1.0], [1.0, 0.3]],
+        seed=5,
+        name="jet",
+    )
+    builder.add_particle_cloud(
+        300, center=(0.0, 1.5, 0.0), velocity_jitter=1.0, seed=2, name="cloud"
+    )
+    builder.add_force("drag", coefficient=0.002)
+    builder.add_force("damping", rate=0.05, targets=["cloud"])
+    builder.add_force("wind", velocity=(1.0, 0.0, 0.0), coefficient=0.001)
+    builder.add_force("attractor", point=(0.5, 1.0, 0.0), strength=0.5, softening=0.3)
+    builder.add_force("vortex", circulation=1.0, coefficient=0.001, targets=["jet"])
+    builder.add_force("quadratic_drag", coefficient=0.0005)
+    builder.add_collider("plane", restitution=0.5, friction=0.3)
+    builder.add_collider("plane", point=(1.0, 0.0, 0.0), normal=(-1.0, 0.0, 0.0), thickness=0.05)
+    builder.add_collider("sphere", center=(0.0, 0.7, 0.3), radius=0.25, restitution=0.8)
+    builder.add_collider("box", center=(-0.6, 0.3, 0.0), size=(0.4, 0.2, 0.6), friction=0.5)
+    for key, value in extra.items():
+        getattr(builder, key)(**value)
+    return builder.build()
+
+
+@pytest.mark.parametrize("steps", [1, 240])
+def test_fused_and_generic_steps_agree_to_round_off(steps):
+    model = _scene()
+    fused, generic = vv.Simulation(model), vv.Simulation(model, compiled=False)
+    assert fused.compiled and not generic.compiled
+    fused.step(steps)
+    generic.step(steps)
+    for name in ("particle_alive", "emitter_serial", "emitter_dropped"):
+        np.testing.assert_array_equal(fused.raw_state[name], generic.raw_state[name], err_msg=name)
+    alive = generic.raw_state["particle_alive"]
+    for name in ("particle_position", "particle_velocity", "particle_radius", "particle_age"):
+        np.testing.assert_allclose(
+            fused.raw_state[name][alive],
+            generic.raw_state[name][alive],
+            rtol=0,
+            atol=1e-9,
+            err_msg=name,
+        )
+    assert fused.energy() == pytest.approx(generic.energy(), rel=1e-9)
+
+
+def test_fused_step_is_taken_only_where_it_applies():
+    model = _scene()
+    assert vv.Simulation(model).compiled
+    assert not vv.Simulation(model, method="velocity_verlet").compiled
+    with pytest.raises(vv.ModelError, match="compiled=True"):
+        vv.Simulation(model, method="rk4", compiled=True)
+    gravitating = _scene(
+        add_force={"kind": "gravitation", "targets": ["cloud"], "G": 1e-3, "softening": 0.1}
+    )
+    assert not vv.Simulation(gravitating).compiled  # n-body gravitation is not a field
+
+
+def test_fused_step_reports_a_blow_up_with_the_offending_part():
+    builder = vv.SceneBuilder(name="explodes")
+    builder.set_integration(method="symplectic_euler", dt=0.1, duration=10.0)
+    builder.add_particles([[0.0, 1.0, 0.0], [0.0, 2.0, 0.0]])
+    # A repulsor of absurd strength flings the particles out beyond the divergence limit.
+    builder.add_force("attractor", point=(0.0, 1.5, 0.0), strength=-1e15, softening=1e-3)
+    simulation = vv.Simulation(builder.build())
+    assert simulation.compiled
+    with pytest.raises(vv.SimulationDiverged, match="particle_position|particle_velocity"):
+        simulation.run(until=10.0)
+    # The simulation keeps the last good state.
+    assert np.isfinite(simulation.raw_state.parts[0]).all()
+
+
+def test_fused_states_stay_valid_for_one_more_step():
+    """The two buffers alternate: the state before a step is intact after it."""
+    simulation = vv.Simulation(_scene())
+    simulation.step(3)
+    before = simulation.raw_state
+    kept = before.parts[0].copy()
+    simulation.step()
+    np.testing.assert_array_equal(before.parts[0], kept)
