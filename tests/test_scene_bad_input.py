@@ -333,7 +333,8 @@ triangles = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 1]]
         ),
         (
             entity(
-                'type = "force"\nkind = "attractor"\npoint = [0, 0, 0]\nstrength = 1.0\nsoftening = 0.0'
+                'type = "force"\nkind = "attractor"\npoint = [0, 0, 0]\nstrength = 1.0\n'
+                "softening = 0.0"
             ),
             ["entities[2]", "softening", "positive"],
         ),
