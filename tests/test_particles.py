@@ -274,3 +274,49 @@ def test_energy_of_a_bouncing_elastic_particle_is_kept():
     start = simulation.energy()
     simulation.run(until=2.0)  # several bounces
     assert simulation.energy() == pytest.approx(start, rel=2e-3)
+
+
+@pytest.mark.parametrize("dt", [0.01, 0.001])
+def test_static_friction_holds_a_particle_on_a_slope(dt):
+    """On a 30° slope with μ = 1 > tan 30°, friction holds the particle where it is: no creep
+    of h² g sin θ a step, and zero velocity."""
+    angle = math.radians(30.0)
+    normal = (-math.sin(angle), math.cos(angle), 0.0)
+    radius = 0.05
+    start = [radius * normal[0], radius * normal[1], 0.0]
+    builder = _builder(dt=dt, duration=2.0)
+    builder.add_particles([start], radius=radius)
+    builder.add_collider("plane", normal=normal, friction=1.0, restitution=0.0)
+    simulation = vv.Simulation(builder.build())
+    simulation.run(until=1.0)
+    np.testing.assert_allclose(simulation.state["particle_position"][0], start, atol=1e-15)
+    np.testing.assert_array_equal(simulation.state["particle_velocity"][0], 0.0)
+
+
+def test_births_beyond_the_capacity_are_dropped_and_counted_without_memory():
+    """A rate of 10¹² per second into 100 slots: 100 born, the rest counted, nothing allocated
+    for them."""
+    builder = _builder(dt=0.01, duration=0.1)
+    builder.add_emitter(rate=1e12, capacity=100)
+    simulation = vv.Simulation(builder.build())
+    simulation.step()
+    assert simulation.raw_state["particle_alive"].sum() == 100
+    assert simulation.raw_state["emitter_dropped"][0] == 1e12 * 0.01 - 100
+
+
+@pytest.mark.parametrize(
+    "emitter",
+    [
+        {"rate": 2.0**62},
+        {"rate": 1.0e9, "lifetime": 1.0e3},
+        {"rate": 1.0, "direction": (1e200, 0, 0)},
+    ],
+)
+def test_emitters_too_large_to_allocate_or_count_are_refused_before_allocation(emitter):
+    builder = _builder()
+    builder.add_emitter(**emitter)
+    if "direction" in emitter:  # a huge but valid direction is just a direction
+        assert builder.build().emitters[0].direction.tolist() == [1.0, 0.0, 0.0]
+        return
+    with pytest.raises(vv.SceneError, match=r"entities\[0\]"):
+        builder.build()

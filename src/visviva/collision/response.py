@@ -139,10 +139,11 @@ class ParticleCollisions:
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _bounce(vx, vy, vz, nx, ny, nz, e, mu, resting):  # pragma: no cover - compiled
-    """The velocity after an impulse along ``n`` (restitution ``e``, friction ``mu``)."""
+    """The velocity after an impulse along ``n`` (restitution ``e``, friction ``mu``), and
+    whether friction held the particle (its tangential velocity stopped)."""
     vn = vx * nx + vy * ny + vz * nz
     if vn >= 0.0:
-        return vx, vy, vz
+        return vx, vy, vz, False
     if -vn < resting:
         e = 0.0
     tx, ty, tz = vx - vn * nx, vy - vn * ny, vz - vn * nz
@@ -151,7 +152,26 @@ def _bounce(vx, vy, vz, nx, ny, nz, e, mu, resting):  # pragma: no cover - compi
     keep = 0.0
     if tangential > 0.0:
         keep = max(0.0, 1.0 - mu * (1.0 + e) * (-vn) / tangential)
-    return keep * tx - e * vn * nx, keep * ty - e * vn * ny, keep * tz - e * vn * nz
+    held = keep == 0.0
+    return keep * tx - e * vn * nx, keep * ty - e * vn * ny, keep * tz - e * vn * nz, held
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _contact(
+    sx, sy, sz, px, py, pz, vx, vy, vz, d, nx, ny, nz, r, e, mu, resting
+):  # pragma: no cover - compiled
+    """A particle at distance ``d`` < ``r`` from a collider with outward normal ``n``: moved
+    out to the surface, given the impulse if it moves in; if static friction holds it, the
+    step's slide along the surface (from ``s``) is taken back too, so that a particle held on
+    a slope stays where it is instead of creeping by ``h² g sin θ`` a step."""
+    depth = r - d
+    px, py, pz = px + depth * nx, py + depth * ny, pz + depth * nz
+    vx, vy, vz, held = _bounce(vx, vy, vz, nx, ny, nz, e, mu, resting)
+    if held:
+        dx, dy, dz = px - sx, py - sy, pz - sz
+        along = dx * nx + dy * ny + dz * nz
+        px, py, pz = sx + along * nx, sy + along * ny, sz + along * nz
+    return px, py, pz, vx, vy, vz
 
 
 @njit(cache=True, error_model="numpy")
@@ -236,32 +256,35 @@ def resolve(
                 sx, sy, sz, svx, svy, svz, px, py, pz, vx, vy, vz, r, mask, h,
                 restitution, friction, resting, toi, everything,
             )
+            # After an impact, what friction may hold is where the particle now is.
+            sx, sy, sz = px, py, pz
     if unrolled > 0:
         px, py, pz, vx, vy, vz = _plane_contact(
-            0, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
+            0, sx, sy, sz, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
         )
     if unrolled > 1:
         px, py, pz, vx, vy, vz = _plane_contact(
-            1, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
+            1, sx, sy, sz, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
         )
     if unrolled > 2:
         px, py, pz, vx, vy, vz = _plane_contact(
-            2, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
+            2, sx, sy, sz, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
         )
     if unrolled > 3:
         px, py, pz, vx, vy, vz = _plane_contact(
-            3, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
+            3, sx, sy, sz, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
         )
     if others is not None:
         px, py, pz, vx, vy, vz = _other_contacts(
-            unrolled, px, py, pz, vx, vy, vz, r, mask, restitution, friction, resting, others
+            unrolled, sx, sy, sz, px, py, pz, vx, vy, vz, r, mask,
+            restitution, friction, resting, others,
         )
     return px, py, pz, vx, vy, vz
 
 
 @njit(cache=True, error_model="numpy")
 def _other_contacts(
-    first, px, py, pz, vx, vy, vz, r, mask, restitution, friction, resting, colliders,
+    first, sx, sy, sz, px, py, pz, vx, vy, vz, r, mask, restitution, friction, resting, colliders,
 ):  # pragma: no cover - compiled
     """The contacts of the colliders from ``first`` on (the general path)."""
     kinds, rows, offsets, nb, nl, tp, tn = colliders
@@ -269,10 +292,11 @@ def _other_contacts(
         if not (mask >> np.uint64(k)) & np.uint64(1):
             continue
         d, nx, ny, nz = collider_distance(k, px, py, pz, kinds, rows, offsets, nb, nl, tp, tn)
-        depth = r - d
-        if depth > 0.0:
-            px, py, pz = px + depth * nx, py + depth * ny, pz + depth * nz
-            vx, vy, vz = _bounce(vx, vy, vz, nx, ny, nz, restitution[k], friction[k], resting[k])
+        if d < r:
+            px, py, pz, vx, vy, vz = _contact(
+                sx, sy, sz, px, py, pz, vx, vy, vz, d, nx, ny, nz, r,
+                restitution[k], friction[k], resting[k],
+            )
     return px, py, pz, vx, vy, vz
 
 
@@ -301,26 +325,19 @@ def _impact_possible(first, sx, sy, sz, px, py, pz, r, mask, toi, colliders):  #
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _plane_contact(
-    k, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
+    k, sx, sy, sz, px, py, pz, vx, vy, vz, r, mask, rows, restitution, friction, resting
 ):  # pragma: no cover - compiled
-    """The contact of plane ``k`` (out along its normal, the impulse if moving in)."""
+    """The contact of plane ``k`` (:func:`_contact`)."""
     if (mask >> np.uint64(k)) & np.uint64(1):
         d, nx, ny, nz = plane_distance(
-            px,
-            py,
-            pz,
-            rows[k, 0],
-            rows[k, 1],
-            rows[k, 2],
-            rows[k, 3],
-            rows[k, 4],
-            rows[k, 5],
+            px, py, pz, rows[k, 0], rows[k, 1], rows[k, 2], rows[k, 3], rows[k, 4], rows[k, 5],
             rows[k, 6],
-        )
-        depth = r - d
-        if depth > 0.0:
-            px, py, pz = px + depth * nx, py + depth * ny, pz + depth * nz
-            vx, vy, vz = _bounce(vx, vy, vz, nx, ny, nz, restitution[k], friction[k], resting[k])
+        )  # fmt: skip
+        if d < r:
+            px, py, pz, vx, vy, vz = _contact(
+                sx, sy, sz, px, py, pz, vx, vy, vz, d, nx, ny, nz, r,
+                restitution[k], friction[k], resting[k],
+            )  # fmt: skip
     return px, py, pz, vx, vy, vz
 
 
@@ -442,7 +459,7 @@ def _impacts(
         cx, cy, cz = sx + best * dx, sy + best * dy, sz + best * dz
         cvx, cvy, cvz = svx + best * (vx - svx), svy + best * (vy - svy), svz + best * (vz - svz)
         _, nx, ny, nz = collider_distance(chosen, cx, cy, cz, kinds, rows, offsets, nb, nl, tp, tn)
-        cvx, cvy, cvz = _bounce(
+        cvx, cvy, cvz, _ = _bounce(
             cvx, cvy, cvz, nx, ny, nz, restitution[chosen], friction[chosen], resting[chosen]
         )
         rest = (1.0 - best) * left

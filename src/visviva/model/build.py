@@ -64,19 +64,27 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         raise SceneError(problems)
     settings = scene.integration
     names = entity_names(scene)
-    specs = emitter_specs(scene, names, settings.duration)
-    arrays, groups = particle_arrays(scene, names, specs)
-    count = arrays["position"].shape[0]
-    if count > MAX_PARTICLES:
+    try:
+        specs = emitter_specs(scene, names, settings.duration)
+    except Located as located:
+        raise SceneError([located.problem]) from None
+    slots = sum(s.capacity for s in specs) + sum(
+        len(e.positions) if isinstance(e, Particles) else e.count
+        for e in scene.entities
+        if isinstance(e, (Particles, ParticleCloud))
+    )
+    if slots > MAX_PARTICLES:
         raise SceneError(
             [
                 SceneProblem(
                     "entities",
-                    f"{count} particle slots in all (emitters count their capacity); the limit "
+                    f"{slots} particle slots in all (emitters count their capacity); the limit "
                     f"is {MAX_PARTICLES}",
                 )
             ]
         )
+    arrays, groups = particle_arrays(scene, names, specs)
+    count = arrays["position"].shape[0]
     h = settings.dt / settings.substeps
     try:
         systems = _systems(scene, names)

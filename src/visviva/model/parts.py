@@ -29,7 +29,7 @@ from ..forces import (
 from ..mechanics.gravity import GRAVITATIONAL_CONSTANT
 from ..particles.emitters import SHAPES, EmitterSpec, unit_vector, value_range
 from .model import ParticleGroup
-from .scene import Collider, Emitter, ForceField, ParticleCloud, Particles, Scene
+from .scene import MAX_PARTICLES, Collider, Emitter, ForceField, ParticleCloud, Particles, Scene
 
 __all__ = [
     "Located",
@@ -103,7 +103,21 @@ def _spec(e: Emitter, index: int, name: str, duration: float, where: str) -> Emi
         )
     except ModelError as error:
         raise Located(where, str(error)) from None
-    capacity = e.capacity or max(1, spec.most_alive(duration))
+    if e.rate * duration >= 2.0**53:
+        raise Located(
+            f"{where}.rate",
+            f"{e.rate * duration:.3g} births over the duration; the most an emitter may count is "
+            "2^53 (9e15): lower the rate",
+        )
+    needed = spec.most_alive(duration)
+    if e.capacity is None and needed > MAX_PARTICLES:
+        raise Located(
+            where,
+            f"this emitter can have {needed:.3g} particles alive at once (rate × lifetime and "
+            f"bursts); the limit is {MAX_PARTICLES}: lower its rate or lifetime, or set "
+            "`capacity` (births beyond it are dropped and counted)",
+        )
+    capacity = e.capacity or max(1, int(needed))
     return _with(spec, capacity=capacity)
 
 

@@ -90,15 +90,16 @@ class Emission:
         lifetime, size = carried["particle_lifetime"], carried["particle_size"]
         serial, dropped = carried["emitter_serial"], carried["emitter_dropped"]
         for spec in self.emitters:
-            times = _birth_times(spec, t0, t1)
-            if not times.shape[0]:
-                continue
             slots = slice(spec.first_slot, spec.first_slot + spec.capacity)
-            free = spec.first_slot + np.flatnonzero(~alive[slots])[: times.shape[0]]
-            dropped[spec.index] += times.shape[0] - free.shape[0]
-            born = times[: free.shape[0]]
+            free = spec.first_slot + np.flatnonzero(~alive[slots])
+            total, times = _birth_times(spec, t0, t1, free.shape[0])
+            if not total:
+                continue
+            free = free[: times.shape[0]]
+            dropped[spec.index] += total - times.shape[0]
+            born = times
             serials = serial[spec.index] + np.arange(born.shape[0], dtype=np.int64)
-            serial[spec.index] += times.shape[0]
+            serial[spec.index] += total
             _sample(spec, serials, t1 - born, free, x, v, lifetime, size)
             age[free] = t1 - born
             alive[free] = age[free] < lifetime[free]
@@ -163,17 +164,19 @@ def _age_all(
                 v[i, k] = 0.0
 
 
-def _birth_times(spec: EmitterSpec, t0: float, t1: float) -> np.ndarray:
-    """The birth times in ``[t0, t1)``, sorted (bursts before continuous births at a tie)."""
+def _birth_times(spec: EmitterSpec, t0: float, t1: float, room: int) -> tuple[int, np.ndarray]:
+    """How many births the step ``[t0, t1)`` has, and the earliest ``room`` of their times,
+    sorted (bursts before continuous births at a tie). Births beyond the room are only counted:
+    a huge rate or step never makes more arrays than the emitter has slots."""
     first, last = spec.births_before(t0), spec.births_before(t1)
-    continuous = (
-        spec.start + np.arange(first, last, dtype=np.float64) / spec.rate
-        if last > first
-        else np.zeros(0)
-    )
     in_step = (spec.burst_times >= t0) & (spec.burst_times < t1)
-    bursts = np.repeat(spec.burst_times[in_step], spec.burst_counts[in_step])
-    return np.sort(np.concatenate([bursts, continuous]), kind="stable")
+    total = (last - first) + int(spec.burst_counts[in_step].sum())
+    kept = min(room, last - first)
+    continuous = spec.start + np.arange(first, first + kept, dtype=np.float64) / spec.rate
+    counts = np.minimum(spec.burst_counts[in_step], room)
+    bursts = np.repeat(spec.burst_times[in_step], counts)
+    times = np.sort(np.concatenate([bursts, continuous]), kind="stable")[:room]
+    return total, times
 
 
 def _sample(

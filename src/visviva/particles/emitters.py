@@ -40,11 +40,13 @@ def value_range(
 
 
 def unit_vector(name: str, value: Sequence[float]) -> np.ndarray:
+    """``value`` scaled to unit length (any finite non-zero 3-vector, however large or small)."""
     vector = np.asarray(value, dtype=np.float64)
-    length = float(np.linalg.norm(vector))
-    if vector.shape != (3,) or not length > 0.0 or not math.isfinite(length):
-        raise ModelError(f"`{name}` must be a non-zero 3-vector (got {list(value)!r})")
-    return vector / length
+    largest = float(np.abs(vector).max()) if vector.shape == (3,) else 0.0
+    if not (0.0 < largest < math.inf):
+        raise ModelError(f"`{name}` must be a finite non-zero 3-vector (got {list(value)!r})")
+    vector = vector / largest  # first to order one, so the length cannot overflow
+    return vector / float(np.linalg.norm(vector))
 
 
 def ramp_values(stops: np.ndarray, fraction: np.ndarray) -> np.ndarray:
@@ -124,22 +126,29 @@ class EmitterSpec:
         end = min(t, self.stop) - self.start
         return max(0, math.ceil(end * self.rate)) if end > 0.0 else 0
 
-    def most_alive(self, duration: float) -> int:
-        """An upper bound on how many of its particles are alive at once within ``duration``."""
+    def most_alive(self, duration: float) -> float:
+        """An upper bound on how many of its particles are alive at once within ``duration``
+        [s] (a float: it may be too large to allocate, which the caller refuses)."""
         longest = self.lifetime[1]
-        window = min(longest, duration) + 1e-9
-        continuous = 0 if self.rate == 0.0 else math.ceil(window * self.rate) + 1
+        continuous = 0.0
+        if self.rate > 0.0 and self.start < duration:
+            # Births happen within [start, min(stop, duration)); at most a lifetime of them live.
+            window = min(longest, min(self.stop, duration) - self.start) + 1e-9
+            continuous = (
+                math.ceil(window * self.rate) + 1.0 if window * self.rate < 1e300 else math.inf
+            )
         # At each burst, the bursts whose particles may still be alive.
         bursts = max(
             (
-                int(
+                float(
                     self.burst_counts[
                         (self.burst_times <= t) & (self.burst_times > t - longest)
                     ].sum()
                 )
                 for t in self.burst_times
+                if t < duration
             ),
-            default=0,
+            default=0.0,
         )
         return continuous + bursts
 
