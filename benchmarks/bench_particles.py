@@ -955,8 +955,19 @@ def bench_agreement(args: argparse.Namespace, warp: WarpPeer | None, checks: Che
         return
     for _ in range(steps):
         runner_step()
-    difference = np.abs(runner_positions() - plain).max()
-    checks.check(difference < 1e-9, f"plain Numba vs visviva: {difference:.1e}")
+    difference = np.abs(runner_positions() - plain).max(axis=1)
+    # visviva holds a resting particle by static friction where it is; the peers let it slide
+    # by the step's displacement before friction stops it (at most a step's slide, h·|v|).
+    held = plain[:, 1] <= RADIUS * (1 + 1e-12)
+    free = float(difference[~held].max(initial=0.0))
+    resting = float(difference[held].max(initial=0.0))
+    checks.check(free < 1e-9, f"plain Numba vs visviva, particles off the plane: {free:.1e}")
+    slide = STEP * 3.0  # a step at the starting speeds (≤ 3 m/s)
+    checks.check(
+        resting < slide,
+        f"plain Numba vs visviva, particles resting on the plane: {resting:.1e} (visviva's static "
+        f"friction holds them; below one step's slide, {slide:.1e} m)",
+    )
 
 
 # --------------------------------------------------------------------------------------------

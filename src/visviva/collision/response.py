@@ -140,11 +140,12 @@ class ParticleCollisions:
 @njit(cache=True, error_model="numpy", inline="always")
 def _bounce(vx, vy, vz, nx, ny, nz, e, mu, resting):  # pragma: no cover - compiled
     """The velocity after an impulse along ``n`` (restitution ``e``, friction ``mu``), and
-    whether friction held the particle (its tangential velocity stopped)."""
+    whether static friction holds the particle (a resting contact whose sliding stopped)."""
     vn = vx * nx + vy * ny + vz * nz
     if vn >= 0.0:
         return vx, vy, vz, False
-    if -vn < resting:
+    rests = -vn < resting
+    if rests:
         e = 0.0
     tx, ty, tz = vx - vn * nx, vy - vn * ny, vz - vn * nz
     tangential = np.sqrt(tx * tx + ty * ty + tz * tz)
@@ -152,7 +153,7 @@ def _bounce(vx, vy, vz, nx, ny, nz, e, mu, resting):  # pragma: no cover - compi
     keep = 0.0
     if tangential > 0.0:
         keep = max(0.0, 1.0 - mu * (1.0 + e) * (-vn) / tangential)
-    held = keep == 0.0
+    held = rests and keep == 0.0
     return keep * tx - e * vn * nx, keep * ty - e * vn * ny, keep * tz - e * vn * nz, held
 
 

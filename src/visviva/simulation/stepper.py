@@ -47,9 +47,9 @@ class FusedStep(Protocol):
     """A whole step — integrator, stages and the watch's check — in one compiled pass, for
     models whose every piece has a compiled form (:mod:`visviva.particles.fused`)."""
 
-    def step(self, state: State, h: float, t_after: float, limit: float) -> tuple[State, int]:
-        """The state after a step of ``h`` ending at ``t_after``, and the number of entities
-        beyond the divergence ``limit`` (or not finite) in it."""
+    def step(self, state: State, h: float, t_after: float, limit: float) -> tuple[State, bool]:
+        """The state after a step of ``h`` ending at ``t_after``, and whether it may be beyond
+        the divergence ``limit`` (checked then by the watch)."""
         ...
 
 
@@ -93,10 +93,10 @@ class Stepper:
             SimulationError: If the integrator failed (its ``step`` is set to ``index``).
         """
         if self.fused is not None:
-            after, bad = self.fused.step(state, h, t_after, self.watch.limit)
+            after, suspect = self.fused.step(state, h, t_after, self.watch.limit)
             self.system.counters.f_evaluations += 1
             self.system.counters.accepted_steps += 1
-            if bad:
+            if suspect and not self.watch.healthy(after):
                 raise self.watch.diverged(after, index, state)
             return after
         try:
