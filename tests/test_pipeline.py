@@ -223,3 +223,13 @@ def test_peak_memory_of_a_recording_does_not_grow_with_its_frames(tmp_path):
     long = _peak_kib(800, tmp_path / "long")
     assert long - short < 40_000, (short, long)
     assert vv.io.load_recording(tmp_path / "long" / "recording.h5").frames == 801
+
+
+def test_summary_reports_births_and_warns_about_dropped_ones(tmp_path):
+    builder = vv.SceneBuilder(name="crowded")
+    builder.set_integration(dt=0.01, duration=0.5)
+    builder.add_emitter(rate=1000.0, lifetime=1.0, capacity=100, name="jet")
+    summary = vv.run_scene(builder.build(), tmp_path).summary
+    assert summary["emitters"] == {"jet": {"births": 500, "dropped": 400, "capacity": 100}}
+    (warning,) = [w for w in summary["warnings"] if w["kind"] == "dropped_births"]
+    assert "'jet'" in warning["message"] and "capacity" in warning["message"]

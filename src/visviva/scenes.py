@@ -210,6 +210,7 @@ class _Run:
     energy_start: float | None = None
     energy_last: float | None = None
     energy_change: float = 0.0
+    emitters: dict[str, dict[str, int]] = field(default_factory=dict)
 
     def see(self, t: float, energy: Any) -> None:
         self.t_reached = t
@@ -291,6 +292,15 @@ def _simulate_streaming(
             failure = Interrupted(stops.requested or "SIGINT", writer.last_time)
         counters = simulation.system.counters.as_dict()
         run.counters = {"steps": counters["accepted_steps"]} | counters
+        end = simulation.raw_state
+        run.emitters = {
+            spec.name: {
+                "births": int(end["emitter_serial"][spec.index]),
+                "dropped": int(end["emitter_dropped"][spec.index]),
+                "capacity": spec.capacity,
+            }
+            for spec in model.emitters
+        }
         final: dict[str, Any] = run.counters | {
             "wall_time_s": time.perf_counter() - started,
             "complete": failure is None,
@@ -333,6 +343,18 @@ def _summary(
     }
     if isinstance(failure, Interrupted):
         summary["interrupted"] = failure.signal
+    if run.emitters:
+        summary["emitters"] = run.emitters
+    for name, counts in run.emitters.items():
+        if counts["dropped"]:
+            summary["warnings"].append(
+                {
+                    "kind": "dropped_births",
+                    "message": f"emitter {name!r} had no free slot for {counts['dropped']} of its "
+                    f"{counts['births']} births (capacity {counts['capacity']}): raise its "
+                    "`capacity`, or leave it unset to have room for every particle",
+                }
+            )
     if model.conservative and drift is not None and abs(drift) > tolerance:
         summary["warnings"].append(
             {"kind": "energy_drift", "message": _energy_warning(model, drift, tolerance)}
