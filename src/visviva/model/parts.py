@@ -274,7 +274,7 @@ def collision_stage(scene: Scene, groups: Sequence[ParticleGroup], count: int, h
             f"a scene may hold at most {MAX_COLLIDERS} impulse colliders",
         )
     shapes = [_shape(e, f"entities[{i}]") for i, e in chosen]
-    gravity = float(np.linalg.norm(scene.world.gravity))
+    gravity = math.hypot(*scene.world.gravity)  # no overflow for huge components
     masks = np.zeros(count, dtype=np.uint64)
     for bit, (_, e) in enumerate(chosen):
         masks[_targets(e, groups, count).indices] |= np.uint64(1) << np.uint64(bit)
