@@ -348,52 +348,28 @@ def _plane_impact(k, sx, sy, sz, px, py, pz, r, mask, toi, rows):  # pragma: no 
     the end inside, or a thin plane crossed."""
     if not toi[k] or not (mask >> np.uint64(k)) & np.uint64(1):
         return False
-    d1, _, _, _ = plane_distance(
-        px,
-        py,
-        pz,
-        rows[k, 0],
-        rows[k, 1],
-        rows[k, 2],
-        rows[k, 3],
-        rows[k, 4],
-        rows[k, 5],
-        rows[k, 6],
-    )
+    d1 = _plane_gap(k, px, py, pz, rows)
     if d1 >= r and rows[k, 6] == np.inf:
         return False  # ends clear of a half-space, which cannot be jumped over
-    d0, _, _, _ = plane_distance(
-        sx,
-        sy,
-        sz,
-        rows[k, 0],
-        rows[k, 1],
-        rows[k, 2],
-        rows[k, 3],
-        rows[k, 4],
-        rows[k, 5],
-        rows[k, 6],
-    )
-    if d0 - r <= _tolerance(sx, sy, sz, px, py, pz, r):
+    if _plane_gap(k, sx, sy, sz, rows) - r <= _tolerance(sx, sy, sz, px, py, pz, r):
         return False  # touching at the start: a resting contact
     if d1 < r:
         return True
     hit = plane_first_hit(
-        sx,
-        sy,
-        sz,
-        px,
-        py,
-        pz,
-        rows[k, 0],
-        rows[k, 1],
-        rows[k, 2],
-        rows[k, 3],
-        rows[k, 4],
-        rows[k, 5],
-        rows[k, 6],
-    )
+        sx, sy, sz, px, py, pz, rows[k, 0], rows[k, 1], rows[k, 2], rows[k, 3], rows[k, 4],
+        rows[k, 5], rows[k, 6],
+    )  # fmt: skip
     return hit <= 1.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _plane_gap(k, x, y, z, rows):  # pragma: no cover - compiled
+    """The signed distance [m] of a point from plane ``k`` (its row read entry by entry)."""
+    d, _, _, _ = plane_distance(
+        x, y, z, rows[k, 0], rows[k, 1], rows[k, 2], rows[k, 3], rows[k, 4], rows[k, 5],
+        rows[k, 6],
+    )  # fmt: skip
+    return d
 
 
 @njit(cache=True, error_model="numpy", inline="always")
