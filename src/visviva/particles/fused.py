@@ -42,11 +42,6 @@ __all__ = ["FusedParticles"]
 
 #: Codes of the fields the kernel evaluates by their law.
 _QUADRATIC, _ATTRACTOR, _VORTEX, _DRAG, _DAMPING = 0, 1, 2, 3, 4
-#: Floating-point licence of the kernel: reassociation lets the compiler vectorize the loop and
-#: its reduction (the watch's flag); NaN and infinity stay honoured (no nnan/ninf), so a
-#: blown-up particle is still seen. Each particle's arithmetic is deterministic for a given
-#: build, so runs, checkpoints and restores repeat to the bit.
-_VECTOR = {"reassoc", "contract", "nsz", "arcp"}
 #: Most fields evaluated by their law (each particle keeps which apply as bits of a mask).
 MAX_LAW_FIELDS = 64
 
@@ -236,7 +231,7 @@ def _law_acceleration(k, kinds, table, x, y, z, vx, vy, vz, inverse_mass):  # pr
 
 
 # fmt: off
-@njit(cache=True, parallel=True, error_model="numpy", fastmath=_VECTOR)
+@njit(cache=True, parallel=True, error_model="numpy")
 def _fused(
     x0, v0, x1, v1, inverse_mass, h, g, drag, air, damping, kinds, parameters, law_masks,
     alive0, alive1, radius0, radius1,
