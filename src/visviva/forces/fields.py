@@ -106,15 +106,8 @@ class UniformGravity(_Field):
         """Nothing to add: ``∂F/∂x = ∂F/∂v = 0``."""
 
 
-class Drag(_Field):
-    """Linear drag in still or moving air: ``F = −k (v − w)`` (wind when ``w ≠ 0``).
-
-    Args:
-        coefficient: ``k`` [N·s/m], at least 0.
-        mass: Particle masses [kg] (unused by the law; kept for the common interface).
-        targets: The particles it acts on (default: all).
-        air_velocity: The air's velocity ``w`` [m/s].
-    """
+class _AirDrag(_Field):
+    """A drag towards the air's velocity: a coefficient and the air velocity ``w`` [m/s]."""
 
     def __init__(
         self,
@@ -126,6 +119,17 @@ class Drag(_Field):
         super().__init__(mass, targets or Targets(len(mass)))
         self.coefficient = real_number("coefficient", coefficient, nonnegative=True)
         self.air_velocity = vector("velocity", air_velocity, unit="m/s")
+
+
+class Drag(_AirDrag):
+    """Linear drag in still or moving air: ``F = −k (v − w)`` (wind when ``w ≠ 0``).
+
+    Args:
+        coefficient: ``k`` [N·s/m], at least 0.
+        mass: Particle masses [kg] (unused by the law; kept for the common interface).
+        targets: The particles it acts on (default: all).
+        air_velocity: The air's velocity ``w`` [m/s].
+    """
 
     def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         """Add ``−k (v − w)`` [N] to ``out``."""
@@ -170,7 +174,7 @@ class Damping(_Field):
             dfdv[:, axis, axis] -= self._factor[:, 0]
 
 
-class QuadraticDrag(_Field):
+class QuadraticDrag(_AirDrag):
     """Quadratic drag ``F = −c |v − w| (v − w)``, the drag of a fast body in air.
 
     Args:
@@ -179,17 +183,6 @@ class QuadraticDrag(_Field):
         targets: The particles it acts on (default: all).
         air_velocity: The air's velocity ``w`` [m/s].
     """
-
-    def __init__(
-        self,
-        coefficient: float,
-        mass: np.ndarray,
-        targets: Targets | None = None,
-        air_velocity: Sequence[float] = (0.0, 0.0, 0.0),
-    ) -> None:
-        super().__init__(mass, targets or Targets(len(mass)))
-        self.coefficient = real_number("coefficient", coefficient, nonnegative=True)
-        self.air_velocity = vector("velocity", air_velocity, unit="m/s")
 
     def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         """Add the drag [N] to ``out``."""
