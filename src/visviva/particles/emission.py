@@ -90,12 +90,12 @@ class Emission:
         lifetime, size = carried["particle_lifetime"], carried["particle_size"]
         serial, dropped = carried["emitter_serial"], carried["emitter_dropped"]
         for spec in self.emitters:
-            slots = slice(spec.first_slot, spec.first_slot + spec.capacity)
-            free = spec.first_slot + np.flatnonzero(~alive[slots])
-            total, times = _birth_times(spec, t0, t1, free.shape[0])
+            total = _birth_count(spec, t0, t1)
             if not total:
                 continue
-            free = free[: times.shape[0]]
+            end = spec.first_slot + spec.capacity
+            free = _free_slots(alive, spec.first_slot, end, min(total, spec.capacity))
+            times = _birth_times(spec, t0, t1, free.shape[0])
             dropped[spec.index] += total - times.shape[0]
             born = times
             serials = serial[spec.index] + np.arange(born.shape[0], dtype=np.int64)
@@ -135,7 +135,7 @@ def age_one(alive, age, lifetime, size, emitter, size_ramps, h):  # pragma: no c
     return True, age, size * ramp(size_ramps, emitter, age / lifetime)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def ramp(ramps, e, fraction):  # pragma: no cover - compiled
     """Ramp ``e``'s value at ``fraction`` (``ramps[e]``: ``(fraction, value)`` stops): linear
     between stops, constant beyond the first and last (as ``numpy.interp``). Entries are read
@@ -164,19 +164,39 @@ def _age_all(
                 v[i, k] = 0.0
 
 
-def _birth_times(spec: EmitterSpec, t0: float, t1: float, room: int) -> tuple[int, np.ndarray]:
-    """How many births the step ``[t0, t1)`` has, and the earliest ``room`` of their times,
-    sorted (bursts before continuous births at a tie). Births beyond the room are only counted:
-    a huge rate or step never makes more arrays than the emitter has slots."""
-    first, last = spec.births_before(t0), spec.births_before(t1)
+def _birth_count(spec: EmitterSpec, t0: float, t1: float) -> int:
+    """How many births the step ``[t0, t1)`` has (continuous and bursts)."""
     in_step = (spec.burst_times >= t0) & (spec.burst_times < t1)
-    total = (last - first) + int(spec.burst_counts[in_step].sum())
-    kept = min(room, last - first)
+    continuous = spec.births_before(t1) - spec.births_before(t0)
+    return continuous + int(spec.burst_counts[in_step].sum())
+
+
+def _birth_times(spec: EmitterSpec, t0: float, t1: float, room: int) -> np.ndarray:
+    """The earliest ``room`` birth times of the step ``[t0, t1)``, sorted (bursts before
+    continuous births at a tie). Births beyond the room are only counted (:func:`_birth_count`):
+    a huge rate or step never makes more arrays than the emitter has slots."""
+    first = spec.births_before(t0)
+    kept = min(room, spec.births_before(t1) - first)
     continuous = spec.start + np.arange(first, first + kept, dtype=np.float64) / spec.rate
+    in_step = (spec.burst_times >= t0) & (spec.burst_times < t1)
     counts = np.minimum(spec.burst_counts[in_step], room)
     bursts = np.repeat(spec.burst_times[in_step], counts)
-    times = np.sort(np.concatenate([bursts, continuous]), kind="stable")[:room]
-    return total, times
+    return np.sort(np.concatenate([bursts, continuous]), kind="stable")[:room]
+
+
+@njit(cache=True)
+def _free_slots(alive, start, stop, count):  # pragma: no cover - compiled
+    """The lowest ``count`` (at most) free slots in ``[start, stop)``: a scan that stops when it
+    has them, so a full emitter of a million slots costs nothing like a million-entry array."""
+    found = np.empty(count, dtype=np.int64)
+    n = 0
+    for i in range(start, stop):
+        if n == count:
+            break
+        if not alive[i]:
+            found[n] = i
+            n += 1
+    return found[:n]
 
 
 def _sample(

@@ -138,14 +138,16 @@ class FusedParticles:
         if emission is not None:
             emission.give_birth(state.t, t_after, x1, u1, carried)
         after = state.from_parts(t_after, (target["q"], target["v"])).with_carried(**carried)
-        return after, not bad == 0.0
+        return after, bad != 0.0
 
     def _spare(self, state: State) -> dict[str, np.ndarray]:
         """The buffer set the state does not use (two sets, allocated on first use)."""
         if not self._buffers:
+            # Copies of the first state, not empty arrays: the kernel relies on a free slot's
+            # entries in the target (two steps old) being its parked values.
             for _ in range(2):
-                buffer = {"q": np.empty_like(state.parts[0]), "v": np.empty_like(state.parts[1])}
-                buffer |= {name: np.empty_like(value) for name, value in state.carried.items()}
+                buffer = {"q": np.array(state.parts[0]), "v": np.array(state.parts[1])}
+                buffer |= {name: np.array(value) for name, value in state.carried.items()}
                 self._buffers.append(buffer)
         first = self._buffers[0]
         return self._buffers[1] if state.parts[0] is first["q"] else first
@@ -245,6 +247,20 @@ def _fused(
     bad = 0.0
     for i in prange(x0.shape[0]):
         alive = alive0[i]
+        if not alive:
+            # A free slot stays parked at rest at the origin (the generic pipeline moves it for a
+            # step and parks it again: the same zeros), without reading it; if it was free two
+            # steps ago too, the target buffer holds exactly that already.
+            if not alive1[i]:
+                continue
+            for k in range(3):
+                x1[i, k] = 0.0
+                v1[i, k] = 0.0
+            alive1[i] = False
+            radius1[i] = radius0[i]
+            if age0 is not None:
+                age1[i], lifetime1[i], size1[i] = age0[i], lifetime0[i], size0[i]
+            continue
         x, y, z = x0[i, 0], x0[i, 1], x0[i, 2]
         vx, vy, vz = v0[i, 0], v0[i, 1], v0[i, 2]
         w = inverse_mass[i]
