@@ -42,11 +42,10 @@ from numba import njit, prange
 
 import visviva as vv
 from bench_integrators import (
-    CONTENDED,
-    CONTENTION_WARNING,
     PATIENCE,
     Checks,
     cpu_description,
+    finish,
     fmt_time,
     heading,
     load_average,
@@ -334,18 +333,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     bench_direct(args, checks)
     bench_tree_small(args)
     bench_tree_large(args)
-    print()
-    print(
-        f"total: {time.perf_counter() - started:.0f} s; load average at the end: {load_average()}"
-    )
-    if CONTENDED:
-        print(f"WARNING: other processes were busy (> {CONTENTION_WARNING:.0%}) during:")
-        for line in CONTENDED:
-            print(f"  - {line}")
-    if checks.failures:
-        print(f"{len(checks.failures)} sanity check(s) FAILED")
-        return 1
-    return 0
+    return finish(started, checks)
 
 
 if __name__ == "__main__":

@@ -352,6 +352,34 @@ def heading(text: str) -> None:
     print("=" * len(text))
 
 
+def finish(started: float, checks: Checks) -> int:
+    """Print the run's total time, load and contention warnings and failed checks; return the
+    exit status (1 if a sanity check failed). Every benchmark script ends with this."""
+    print()
+    print(
+        f"total benchmark time: {time.perf_counter() - started:.0f} s; load average at the end: "
+        f"{load_average()}"
+    )
+    if CONTENDED:
+        print(
+            f"WARNING: other processes were busy during {len(CONTENDED)} measurement(s); "
+            "those figures understate this machine:"
+        )
+        for line in CONTENDED:
+            print(f"  - {line}")
+    else:
+        print(
+            f"no measurement saw other processes use more than {CONTENTION_WARNING:.0%} of "
+            "the machine"
+        )
+    if checks.failures:
+        print(f"{len(checks.failures)} sanity check(s) FAILED:")
+        for failure in checks.failures:
+            print(f"  - {failure}")
+        return 1
+    return 0
+
+
 class Checks:
     """Sanity checks: printed as they happen, summarised at the end (exit status 1 if any fail)."""
 
@@ -1092,29 +1120,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     bench_batch(args, checks)
     bench_accuracy(args, checks)
     bench_cli(args)
-    print()
-    print(
-        f"total benchmark time: {time.perf_counter() - started:.0f} s; load average at the end: "
-        f"{load_average()}"
-    )
-    if CONTENDED:
-        print(
-            f"WARNING: other processes were busy during {len(CONTENDED)} measurement(s); "
-            "those figures understate this machine:"
-        )
-        for line in CONTENDED:
-            print(f"  - {line}")
-    else:
-        print(
-            f"no measurement saw other processes use more than {CONTENTION_WARNING:.0%} of "
-            "the machine"
-        )
-    if checks.failures:
-        print(f"{len(checks.failures)} sanity check(s) FAILED:")
-        for failure in checks.failures:
-            print(f"  - {failure}")
-        return 1
-    return 0
+    return finish(started, checks)
 
 
 if __name__ == "__main__":

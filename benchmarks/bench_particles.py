@@ -77,12 +77,11 @@ from numba import njit, prange
 
 import visviva as vv
 from bench_integrators import (
-    CONTENDED,
-    CONTENTION_WARNING,
     PATIENCE,
     Checks,
     Timing,
     cpu_description,
+    finish,
     fmt_time,
     heading,
     load_average,
@@ -1137,18 +1136,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     summarise(args, entries)
     bench_agreement(args, warp, checks)
     bench_fountain(args, checks)
-    print()
-    print(
-        f"total: {time.perf_counter() - started:.0f} s; load average at the end: {load_average()}"
-    )
-    if CONTENDED:
-        print(f"WARNING: other processes were busy (> {CONTENTION_WARNING:.0%}) during:")
-        for line in CONTENDED:
-            print(f"  - {line}")
-    if checks.failures:
-        print(f"{len(checks.failures)} sanity check(s) FAILED")
-        return 1
-    return 0
+    return finish(started, checks)
 
 
 if __name__ == "__main__":

@@ -202,12 +202,3 @@ class State:
     def with_carried(self, **arrays: np.ndarray) -> State:
         """The same state with carried arrays replaced or added."""
         return replace(self, carried=MappingProxyType(dict(self.carried) | arrays))
-
-    def copy(self) -> State:
-        """A deep copy (arrays copied, derivative dropped), safe to keep while a run goes on."""
-        return State(
-            self.t,
-            tuple(np.array(part) for part in self.parts),
-            self.layout,
-            MappingProxyType({name: np.array(a) for name, a in self.carried.items()}),
-        )

@@ -90,7 +90,11 @@ class FusedParticles:
             return None
         if not all(isinstance(f, _FIELDS) for f in model.forces):
             return None
-        if not all(isinstance(s, (ParticleCollisions, Emission)) for s in model.stages):
+        # A stage that declares no compiled form keeps the generic pipeline; of those that
+        # do, the fused step knows how to take the collisions' and the emission's place.
+        if not all(
+            s.compiled and isinstance(s, (ParticleCollisions, Emission)) for s in model.stages
+        ):
             return None
         laws = [f for f in model.forces if not (isinstance(f, _FOLDED) and f.targets.everything)]
         if len(laws) > MAX_LAW_FIELDS:

@@ -79,11 +79,6 @@ class Stepper:
         self.stages = tuple(stages)
         self.fused = fused
 
-    @property
-    def compiled_stages(self) -> bool:
-        """True if every stage has a compiled form."""
-        return all(stage.compiled for stage in self.stages)
-
     def step(self, state: State, h: float, t_after: float, index: int) -> State:
         """The state after one step of ``h`` [s] ending at ``t_after`` (from the caller's
         integer counter); ``index`` numbers the step in the run, for messages.
