@@ -58,7 +58,7 @@ def rotate(qw, qx, qy, qz, vx, vy, vz):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def plane_distance(px, py, pz, ox, oy, oz, nx, ny, nz, thickness):  # pragma: no cover
     """Signed distance [m] and outward normal of a plane slab.
 

@@ -4,22 +4,31 @@ A scene of particles under field forces, with colliders and emitters, stepped by
 Euler (the scenes' default), is bound by memory traffic: the generic pipeline reads and writes
 the particle arrays once for each force, for the integrator's kick and drift, for each stage
 and for the divergence watch. This module takes the whole step in one pass over the particles,
-each one in registers from its load to its store (every core, ``prange``):
+in place, on every core (``prange``), a block of :data:`BLOCK` particles at a time:
 
-1. the acceleration from the fields: uniform gravity, linear drag, wind and damping folded into
-   ``g − c_i v + b_i`` (:class:`LinearFields`), and any other field (attractors, vortices,
-   quadratic drag, forces on some particles only) by its law (:mod:`visviva.forces.laws`);
-2. symplectic Euler: ``v += h a``, ``x += h v`` (:class:`~visviva.integrators.SymplecticEuler`);
-3. collisions, by the collision stage's own per-particle function
-   (:func:`visviva.collision.response.resolve`);
-4. ageing and death, by the emission stage's own per-particle function
-   (:func:`visviva.particles.emission.age_one`), and the divergence watch's check;
+1. a pass over the block that the compiler vectorizes, since every particle takes the same
+   path: the acceleration from the fields folded into ``g − c_i v + b_i`` (uniform gravity,
+   linear drag, wind and damping), symplectic Euler ``v += h a``,
+   ``x += h v`` (:class:`~visviva.integrators.SymplecticEuler`), the divergence watch's check,
+   and a cheap test of whether the particle needs more: it touches or crosses a leading plane
+   collider, it may meet another collider, a field acts on it by its law (attractors,
+   vortices, quadratic drag, forces on some particles only), or it ages;
+2. a second pass over the few particles that need more, from their values at the start of the
+   step (kept in the thread's scratch, in cache): the fields by their law
+   (:mod:`visviva.forces.laws`), the collision stage's own per-particle function
+   (:func:`visviva.collision.response.resolve`), the emission stage's ageing and death
+   (:func:`visviva.particles.emission.age_one`);
 
 then the step's births (:meth:`~visviva.particles.emission.Emission.give_birth`). The results
 are those of the generic pipeline to round-off (the order of the force sum differs), which
-``tests/test_fused.py`` checks. The state's arrays alternate between two buffers, so the step
-allocates nothing; a state stays valid until the step after next (copy what you keep:
-:class:`~visviva.simulation.Simulation`'s ``state`` already does).
+``tests/test_fused.py`` checks.
+
+The step updates the state's arrays **in place** (as MuJoCo's ``mj_step`` and Warp do): a
+second buffer set would cost a third of the step in write traffic. The
+:class:`~visviva.simulation.stepper.Stepper` keeps a copy of the state every few steps and
+replays from it when it must give back an earlier state (after a divergence); a caller that
+keeps a state while stepping on copies it (:class:`~visviva.simulation.Simulation`'s ``state``
+already does).
 """
 
 from __future__ import annotations
@@ -29,7 +38,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numba import njit, prange
 
-from ..collision.response import ParticleCollisions, resolve
+from ..collision.colliders import UNROLLED_PLANES
+from ..collision.queries import plane_distance
+from ..collision.response import ParticleCollisions, _contact, _tolerance, resolve
 from ..forces.fields import Attractor, Damping, Drag, QuadraticDrag, UniformGravity, Vortex
 from ..forces.laws import attractor_force, quadratic_drag_force, vortex_air_velocity
 from .emission import Emission, age_one
@@ -79,7 +90,16 @@ class FusedParticles:
             self.law_masks[force.targets.indices] |= np.uint64(1) << np.uint64(k)
         self.collisions = next((s for s in stages if isinstance(s, ParticleCollisions)), None)
         self.emission = next((s for s in stages if isinstance(s, Emission)), None)
-        self._buffers: list[dict[str, np.ndarray]] = []
+        self._collision, contacts = _collision_arguments(self.collisions)
+        # Which particles take the kernel's pass 2 (none can without emitters, fields by law,
+        # and colliders other than a first plane without time of impact).
+        general = contacts or self.emission is not None or len(laws) > 0
+        self._special = np.zeros(count, dtype=np.bool_) if general else None
+        # The working copy: positions and velocities, (3, N) each (one contiguous array per
+        # component, which the compiler vectorizes over), and the state they belong to.
+        self._x = self._v = np.zeros((3, 0))
+        self._current: State | None = None
+        self._settled = True
 
     @classmethod
     def of(cls, model: Any, method: str) -> FusedParticles | None:
@@ -104,57 +124,78 @@ class FusedParticles:
         )
 
     def step(self, state: State, h: float, t_after: float, limit: float) -> tuple[State, bool]:
-        """The state after one step of ``h`` [s] ending at ``t_after``, and whether a particle
-        may be beyond the divergence ``limit`` (or not finite): the caller's watch decides."""
-        target = self._spare(state)
-        q0, v0 = state.parts
-        n = 3 * self.count
-        x0, u0 = q0[:n].reshape(-1, 3), v0[:n].reshape(-1, 3)
-        x1, u1 = target["q"][:n].reshape(-1, 3), target["v"][:n].reshape(-1, 3)
-        carried = {name: target[name] for name in state.carried}
-        for name, value in state.carried.items():
-            if name.startswith("emitter_"):
-                carried[name][:] = value
-        collisions, emission = self.collisions, self.emission
-        laws = self.kinds if self.kinds.shape[0] else None
-        bad = _fused(
-            x0,
-            u0,
-            x1,
-            u1,
+        """Advance ``state`` by one step of ``h`` [s] ending at ``t_after``: the state at
+        ``t_after``, and whether a particle may be beyond the divergence ``limit`` or not
+        finite (the caller's watch decides).
+
+        The step works on its own copy of the particles' positions and velocities, one array
+        per component, and updates the carried arrays in place: ``state`` is spent, and the
+        returned state's positions and velocities are brought up to date by :meth:`settled`.
+        """
+        if state is not self._current:
+            self._load(state)
+        carried = dict(state.carried)
+        emission = self.emission
+        suspects = _fused(
+            *self._x,
+            *self._v,
             self.inverse_mass,
             h,
             self.gravity,
             self.drag,
             self.air,
             self.damping,
-            laws,
+            self.kinds if self.kinds.shape[0] else None,
             self.parameters,
             self.law_masks,
-            state["particle_alive"],
             carried["particle_alive"],
-            state["particle_radius"],
             carried["particle_radius"],
-            *_emission_arguments(state, carried, emission),
-            *_collision_arguments(collisions),
+            *_emission_arguments(carried, emission),
+            *self._collision,
             limit,
+            self._special,
         )
         if emission is not None:
-            emission.give_birth(state.t, t_after, x1, u1, carried)
-        after = state.from_parts(t_after, (target["q"], target["v"])).with_carried(**carried)
-        return after, bad != 0.0
+            emission.give_birth(state.t, t_after, self._x.T, self._v.T, carried)
+        self._current = state.from_parts(t_after, state.parts)
+        self._settled = False
+        return self._current, suspects != 0
 
-    def _spare(self, state: State) -> dict[str, np.ndarray]:
-        """The buffer set the state does not use (two sets, allocated on first use)."""
-        if not self._buffers:
-            # Copies of the first state, not empty arrays: the kernel relies on a free slot's
-            # entries in the target (two steps old) being its parked values.
-            for _ in range(2):
-                buffer = {"q": np.array(state.parts[0]), "v": np.array(state.parts[1])}
-                buffer |= {name: np.array(value) for name, value in state.carried.items()}
-                self._buffers.append(buffer)
-        first = self._buffers[0]
-        return self._buffers[1] if state.parts[0] is first["q"] else first
+    def settled(self, state: State) -> State:
+        """``state`` with its particle positions and velocities up to date (it is, unless it
+        is the latest state this step returned; then they are copied into it)."""
+        if state is self._current and not self._settled:
+            n = 3 * self.count
+            _interleave(self._x, state.parts[0][:n])
+            _interleave(self._v, state.parts[1][:n])
+            self._settled = True
+        return state
+
+    def _load(self, state: State) -> None:
+        """Take the particles of ``state`` as the working copy."""
+        n = 3 * self.count
+        if self._x.shape[1] != self.count:
+            self._x, self._v = np.empty((3, self.count)), np.empty((3, self.count))
+        _deinterleave(state.parts[0][:n], self._x)
+        _deinterleave(state.parts[1][:n], self._v)
+
+
+@njit(cache=True, parallel=True)
+def _interleave(columns, flat):  # pragma: no cover - compiled
+    """``flat`` (3N,) ← ``columns`` (3, N): x0 y0 z0 x1 y1 z1 ..."""
+    for i in prange(columns.shape[1]):
+        flat[3 * i] = columns[0, i]
+        flat[3 * i + 1] = columns[1, i]
+        flat[3 * i + 2] = columns[2, i]
+
+
+@njit(cache=True, parallel=True)
+def _deinterleave(flat, columns):  # pragma: no cover - compiled
+    """``columns`` (3, N) ← ``flat`` (3N,)."""
+    for i in prange(columns.shape[1]):
+        columns[0, i] = flat[3 * i]
+        columns[1, i] = flat[3 * i + 1]
+        columns[2, i] = flat[3 * i + 2]
 
 
 _FOLDED = (UniformGravity, Drag, Damping)
@@ -177,34 +218,60 @@ def _law(force: Force) -> tuple[int, list[float]]:
 
 
 def _emission_arguments(
-    state: State, carried: dict[str, np.ndarray], emission: Emission | None
+    carried: dict[str, np.ndarray], emission: Emission | None
 ) -> tuple[Any, ...]:
     if emission is None:
-        return (None,) * 8
+        return (None,) * 5
     return (
-        state["particle_age"],
         carried["particle_age"],
-        state["particle_lifetime"],
         carried["particle_lifetime"],
-        state["particle_size"],
         carried["particle_size"],
         emission.slot_emitter,
         emission.size_ramps,
     )
 
 
-def _collision_arguments(collisions: ParticleCollisions | None) -> tuple[Any, ...]:
-    """The collision stage's arrays for the kernel (``collider_masks`` ``None``: none)."""
+def _collision_arguments(collisions: ParticleCollisions | None) -> tuple[tuple[Any, ...], bool]:
+    """The collision stage for the kernel, and whether some contacts need pass 2.
+
+    First what pass 1 takes: the particles' collider masks (``None`` if every particle meets
+    the same colliders, then given as that one mask: 8 B a particle less to read); the first
+    collider if it is a plane (point, normal, thickness), its mask bit (0 if it is not a
+    plane) and its restitution, friction and resting speed; the other leading planes and
+    those with time of impact, each as point, normal, thickness and mask bit, one after the
+    other in a flat tuple (``None`` if none): the kernel is compiled for their number (a scene
+    with a floor only does no test for other planes). Then what :func:`resolve` takes, for
+    pass 2.
+    """
+    far = (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, np.inf)
     if collisions is None:
-        return (None, None, None, None, None, 0, None, None, None)
+        no_rows = np.zeros((0, 7))
+        pass_1 = (None, np.uint64(0), far, np.uint64(0), 0.0, 0.0, 0.0, None, None)
+        return (*pass_1, None, None, None, None, 0, no_rows, None, None), False
     r = collisions.response
-    return (
-        collisions.masks,
+    masks = collisions.masks
+    common = bool(masks.shape[0]) and bool((masks == masks[0]).all())
+    rows = collisions.colliders.rows
+    leading = min(collisions.colliders.planes, UNROLLED_PLANES)
+    planes = [(*(float(v) for v in rows[k, :7]), float(k)) for k in range(leading)]
+    near = sum(planes[1:], ()) or None
+    impact = sum((plane for plane in planes if r.time_of_impact[int(plane[7])]), ()) or None
+    general = collisions.kernel_arguments()
+    others = general[3]
+    arguments = (
+        None if common else masks,
+        masks[0] if common else np.uint64(0),
+        planes[0][:7] if leading else far,
+        np.uint64(1 if leading else 0),
+        *((r.restitution[0], r.friction[0], r.resting_speed[0]) if leading else (0.0,) * 3),
+        near,
+        impact,
         r.restitution,
         r.friction,
         r.resting_speed,
-        *collisions.kernel_arguments(),
+        *general,
     )
+    return arguments, near is not None or impact is not None or others is not None
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -236,73 +303,162 @@ def _law_acceleration(k, kinds, table, x, y, z, vx, vy, vz, inverse_mass):  # pr
     return fx * inverse_mass, fy * inverse_mass, fz * inverse_mass
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _plane_at(planes, k):  # pragma: no cover - compiled
+    """The plane of the flat tuple ``planes`` (8 entries a plane) starting at entry ``k``."""
+    return (
+        planes[k],
+        planes[k + 1],
+        planes[k + 2],
+        planes[k + 3],
+        planes[k + 4],
+        planes[k + 5],
+        planes[k + 6],
+        planes[k + 7],
+    )
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _plane_gap(plane, px, py, pz):  # pragma: no cover - compiled
+    """Signed distance [m] and outward normal of a plane slab at a point (as
+    :func:`~visviva.collision.queries.plane_distance`, from the plane as one tuple: point,
+    normal, thickness)."""
+    return plane_distance(
+        px, py, pz, plane[0], plane[1], plane[2], plane[3], plane[4], plane[5], plane[6]
+    )
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _near(plane, bit, px, py, pz, r):  # pragma: no cover - compiled
+    """True if the particle meets the plane (mask ``bit`` set) and its centre ends closer to
+    it than ``r``."""
+    d, _, _, _ = _plane_gap(plane, px, py, pz)
+    return (bit != 0) & (d < r)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _impact_possible(plane, bit, sx, sy, sz, px, py, pz, r):  # pragma: no cover
+    """True if the particle may hit the leading plane within the step, so that the time of
+    impact must be found (the test of the collision stage's ``_plane_impact``, with a thin
+    slab's crossing assumed): the plane has time of impact, the particle meets it (mask
+    ``bit``), was clear of it at the start and ends inside it (or the slab is thin)."""
+    d0, _, _, _ = _plane_gap(plane, sx, sy, sz)
+    d1, _, _, _ = _plane_gap(plane, px, py, pz)
+    clear = d0 - r > _tolerance(sx, sy, sz, px, py, pz, r)
+    return (bit != 0) & clear & ((d1 < r) | (plane[6] != np.inf))
+
+
 # fmt: off
 @njit(cache=True, parallel=True, error_model="numpy")
 def _fused(
-    x0, v0, x1, v1, inverse_mass, h, g, drag, air, damping, kinds, parameters, law_masks,
-    alive0, alive1, radius0, radius1,
-    age0, age1, lifetime0, lifetime1, size0, size1, slot_emitter, size_ramps,
-    collider_masks, restitution, friction, resting, toi, planes, rows, others, everything,
-    limit,
+    x, y, z, vx, vy, vz, inverse_mass, h, g, drag, air, damping, kinds, parameters, law_masks,
+    alive, radius, age, lifetime, size, slot_emitter, size_ramps,
+    collider_masks, common_mask, floor, floor_bit, e, mu, rests, near_planes, impact_planes,
+    restitution, friction, resting, toi, planes, rows, others, everything,
+    limit, special,
 ):  # pragma: no cover - compiled
-    """The step of the module docstring for every particle; returns a positive or non-finite
-    number if a particle may be beyond ``limit`` or not finite (0 otherwise)."""
+    """The step of the module docstring for every particle, in place (positions ``x, y, z``
+    and velocities ``vx, vy, vz``, one array per component; ``special`` is scratch, ``None``
+    if no particle can need pass 2); returns how many particles may be beyond ``limit`` or
+    not finite."""
     # fmt: on
-    bad = 0.0
-    for i in prange(x0.shape[0]):
-        alive = alive0[i]
-        if not alive:
-            # A free slot stays parked at rest at the origin (the generic pipeline moves it for a
-            # step and parks it again: the same zeros), without reading it; if it was free two
-            # steps ago too, the target buffer holds exactly that already.
-            if not alive1[i]:
-                continue
-            for k in range(3):
-                x1[i, k] = 0.0
-                v1[i, k] = 0.0
-            alive1[i] = False
-            radius1[i] = radius0[i]
-            if age0 is not None:
-                age1[i], lifetime1[i], size1[i] = age0[i], lifetime0[i], size0[i]
-            continue
-        x, y, z = x0[i, 0], x0[i, 1], x0[i, 2]
-        vx, vy, vz = v0[i, 0], v0[i, 1], v0[i, 2]
+    beyond = np.uint64(min(planes, UNROLLED_PLANES))  # mask bits from here on: other colliders
+    one = np.uint64(1)
+    # Loop invariants in registers: the compiler cannot tell that the stores miss them.
+    gx, gy, gz, wx, wy, wz = g[0], g[1], g[2], air[0], air[1], air[2]
+    pending = 0
+    suspects = 0
+    # Pass 1, vectorized: every particle takes the same path, with no loop and no call, and
+    # stores by selection (a conditional store would keep the loop scalar).
+    for i in prange(x.shape[0]):
+        sx, sy, sz, svx, svy, svz = x[i], y[i], z[i], vx[i], vy[i], vz[i]
         w = inverse_mass[i]
-        # The acceleration, then symplectic Euler: kick, drift.
         c = drag * w + damping
-        ax = g[0] - c * vx + air[0] * w
-        ay = g[1] - c * vy + air[1] * w
-        az = g[2] - c * vz + air[2] * w
+        ux = svx + h * (gx - c * svx + wx * w)
+        uy = svy + h * (gy - c * svy + wy * w)
+        uz = svz + h * (gz - c * svz + wz * w)
+        px, py, pz = sx + h * ux, sy + h * uy, sz + h * uz
+        r = radius[i]
+        mask = common_mask if collider_masks is None else collider_masks[i]
+        # The first plane's contact (the floor, most often) is taken here; a particle near
+        # another collider is special. (The compiler vectorizes one contact, not four.)
+        d, nx, ny, nz = _plane_gap(floor, px, py, pz)
+        if ((mask & floor_bit) != 0) & (d < r):
+            px, py, pz, ux, uy, uz = _contact(
+                sx, sy, sz, px, py, pz, ux, uy, uz, d, nx, ny, nz, r, e, mu, rests
+            )
+        odd = False
+        if near_planes is not None:
+            for k in range(0, len(near_planes), 8):
+                plane = _plane_at(near_planes, k)
+                odd |= _near(plane, (mask >> np.uint64(plane[7])) & one, px, py, pz, r)
+        if impact_planes is not None:
+            for k in range(0, len(impact_planes), 8):
+                plane = _plane_at(impact_planes, k)
+                bit = (mask >> np.uint64(plane[7])) & one
+                odd |= _impact_possible(plane, bit, sx, sy, sz, px, py, pz, r)
+        if others is not None:
+            odd |= (mask >> beyond) != 0
         if kinds is not None:
-            mask = law_masks[i]
+            odd |= law_masks[i] != 0
+        if age is not None:
+            odd = True
+        # Only emitted particles die: without emitters, every slot is alive.
+        live = True if age is None else alive[i]
+        if special is not None:
+            odd &= live
+            special[i] = odd
+            pending += odd
+        # A free slot stays parked; a special particle keeps its start for pass 2.
+        keep = live & (not odd)
+        x[i] = px if keep else sx
+        y[i] = py if keep else sy
+        z[i] = pz if keep else sz
+        vx[i] = ux if keep else svx
+        vy[i] = uy if keep else svy
+        vz[i] = uz if keep else svz
+        # The watch's check (a particle flagged wrongly costs only the watch's exact check).
+        extent = abs(px) + abs(py) + abs(pz) + abs(ux) + abs(uy) + abs(uz)
+        suspects += 0 if extent <= limit else 1
+    if pending == 0:
+        return suspects
+    # Pass 2: the special particles, each by the general path.
+    for i in prange(x.shape[0]):
+        if not special[i]:
+            continue
+        sx, sy, sz, svx, svy, svz = x[i], y[i], z[i], vx[i], vy[i], vz[i]
+        w = inverse_mass[i]
+        c = drag * w + damping
+        ax = gx - c * svx + wx * w
+        ay = gy - c * svy + wy * w
+        az = gz - c * svz + wz * w
+        if kinds is not None:
+            bits = law_masks[i]
             for k in range(kinds.shape[0]):
-                if (mask >> np.uint64(k)) & np.uint64(1):
-                    bx, by, bz = _law_acceleration(k, kinds, parameters, x, y, z, vx, vy, vz, w)
+                if (bits >> np.uint64(k)) & one:
+                    bx, by, bz = _law_acceleration(
+                        k, kinds, parameters, sx, sy, sz, svx, svy, svz, w
+                    )
                     ax += bx
                     ay += by
                     az += bz
-        ux, uy, uz = vx + h * ax, vy + h * ay, vz + h * az
-        px, py, pz = x + h * ux, y + h * uy, z + h * uz
-        radius = radius0[i]
-        if collider_masks is not None and alive and collider_masks[i] != 0:
+        ux, uy, uz = svx + h * ax, svy + h * ay, svz + h * az
+        px, py, pz = sx + h * ux, sy + h * uy, sz + h * uz
+        r = radius[i]
+        if restitution is not None:  # the scene has colliders
+            mask = common_mask if collider_masks is None else collider_masks[i]
             px, py, pz, ux, uy, uz = resolve(
-                x, y, z, vx, vy, vz, px, py, pz, ux, uy, uz, radius, collider_masks[i], h,
+                sx, sy, sz, svx, svy, svz, px, py, pz, ux, uy, uz, r, mask, h,
                 restitution, friction, resting, toi, planes, rows, others, everything,
             )  # fmt: skip
-        if age0 is not None:
-            lifetime1[i], size1[i] = lifetime0[i], size0[i]
-            alive, age1[i], radius = age_one(
-                alive, age0[i], lifetime0[i], size0[i], slot_emitter[i], size_ramps, h
+        if age is not None:
+            live, age[i], radius[i] = age_one(
+                True, age[i], lifetime[i], size[i], slot_emitter[i], size_ramps, h
             )
-            if not alive:
+            if not live:  # parked at rest at the origin
+                alive[i] = False
                 px = py = pz = ux = uy = uz = 0.0
-        alive1[i] = alive
-        radius1[i] = radius
-        x1[i, 0], x1[i, 1], x1[i, 2] = px, py, pz
-        v1[i, 0], v1[i, 1], v1[i, 2] = ux, uy, uz
-        # The watch's check, cheaply: a sum that is not finite, or beyond the limit, flags the
-        # step (NaN and inf propagate through the sum; a branch per component would cost more
-        # than the step); the caller confirms with the exact check.
-        size = abs(px) + abs(py) + abs(pz) + abs(ux) + abs(uy) + abs(uz)
-        bad += size * 0.0 + (1.0 if size > limit else 0.0)
-    return bad
+        x[i], y[i], z[i], vx[i], vy[i], vz[i] = px, py, pz, ux, uy, uz
+        extent = abs(px) + abs(py) + abs(pz) + abs(ux) + abs(uy) + abs(uz)
+        suspects += 0 if extent <= limit else 1
+    return suspects

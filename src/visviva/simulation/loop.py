@@ -279,19 +279,21 @@ def advance(
 
     A frame is recorded after every ``record_every``-th step counted from the grid's origin,
     after the last step, and when a stop was requested (then :class:`Interrupted` is raised
-    with that frame's time). Returns the final state.
+    with that frame's time). Returns the final state (pass it through
+    :meth:`Stepper.settled` before reading its arrays).
     """
     substeps = schedule.substeps
     done = state
     for step in range(schedule.steps):
         current = done
+        sub = 0
         try:
             for sub in range(substeps):
                 h, t_after = schedule.substep(step, sub)
                 index = (schedule.first + step) * substeps + sub
-                current = stepper.step(current, h, t_after, index)
+                current = stepper.step(current, h, t_after, index, boundary=sub == 0)
         except SimulationError as failure:
-            failure.state, failure.steps_done = done, step
+            failure.state, failure.steps_done = stepper.earlier(done, sub + 1), step
             raise
         done = current
         last = step + 1 == schedule.steps
@@ -299,11 +301,11 @@ def advance(
         if recorder is not None and (
             (schedule.first + step + 1) % record_every == 0 or last or stop
         ):
-            recorder.append(done)
+            recorder.append(stepper.settled(done))
         bar.advance(1)
         if stop is not None and not last:
             interrupted = Interrupted(stop, done.t)
-            interrupted.state, interrupted.steps_done = done, step + 1
+            interrupted.state, interrupted.steps_done = stepper.settled(done), step + 1
             raise interrupted
     return done
 

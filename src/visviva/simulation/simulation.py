@@ -148,7 +148,7 @@ class Simulation:
     @property
     def state(self) -> SimulationState:
         """The current state by part name (live particles only; see :class:`SimulationState`)."""
-        return SimulationState(self._state)
+        return SimulationState(self._current())
 
     @property
     def compiled(self) -> bool:
@@ -159,12 +159,13 @@ class Simulation:
     def raw_state(self) -> State:
         """The whole state: every particle slot, dead ones included, and the carried parts.
 
-        With the fused step its arrays are reused two steps later: copy what you keep."""
-        return self._state
+        The next step changes its arrays in place: copy what you keep."""
+        return self._current()
 
     def energy(self) -> float:
         """Kinetic plus potential energy [J] of the live particles and the systems."""
-        energy = self.system.energy(self._state)
+        state = self._current()
+        energy = self.system.energy(state)
         return math.nan if energy is None else float(energy)
 
     def step(self, count: int = 1) -> None:
@@ -262,13 +263,18 @@ class Simulation:
                 static=self.model.static(),
             )
 
-        keep(self._state, self.system.energy(self._state))
+        state = self._current()
+        keep(state, self.system.energy(state))
         try:
             self.run(until, record_every=every, on_frame=keep, progress=progress)
         except (SimulationError, Interrupted) as stopped:
             stopped.recording = recording()
             raise
         return recording()
+
+    def _current(self) -> State:
+        """The current state, its arrays up to date (the fused step works on a copy)."""
+        return self._stepper.settled(self._state)
 
     def _check_budget(self, steps: int) -> None:
         if steps * self.substeps > MAX_STEPS:
@@ -286,7 +292,7 @@ class Simulation:
     ) -> None:
         recorder = None
         if on_frame is not None:
-            recorder = FrameRecorder(self.system, self._state, False, on_frame, keep=False)
+            recorder = FrameRecorder(self.system, self._current(), False, on_frame, keep=False)
         with Progress(schedule.steps, self.integrator.name, progress) as bar:
             try:
                 self._state = advance(
@@ -308,6 +314,7 @@ class Simulation:
         Restore with :meth:`Simulation.restore` on the same model (checked by a fingerprint of
         the scene).
         """
+        state = self._current()
         header = {
             "format": CHECKPOINT_FORMAT,
             "version": CHECKPOINT_VERSION,
@@ -316,14 +323,14 @@ class Simulation:
             "dt": self.dt,
             "origin": self._origin,
             "steps": self._steps,
-            "t": self._state.t,
-            "derivative": self._state.derivative is not None,
-            "carried": list(self._state.carried),
+            "t": state.t,
+            "derivative": state.derivative is not None,
+            "carried": list(state.carried),
         }
-        arrays = {f"part{i}": part for i, part in enumerate(self._state.parts)}
-        arrays |= {f"carried_{name}": value for name, value in self._state.carried.items()}
-        if self._state.derivative is not None:
-            arrays |= {f"derivative{i}": d for i, d in enumerate(self._state.derivative)}
+        arrays = {f"part{i}": part for i, part in enumerate(state.parts)}
+        arrays |= {f"carried_{name}": value for name, value in state.carried.items()}
+        if state.derivative is not None:
+            arrays |= {f"derivative{i}": d for i, d in enumerate(state.derivative)}
         buffer = io.BytesIO()
         np.savez(buffer, header=np.frombuffer(json.dumps(header).encode(), np.uint8), **arrays)
         return buffer.getvalue()
