@@ -59,6 +59,11 @@ class Emission:
             stops = spec.size_ramp
             self.size_ramps[spec.index, : stops.shape[0]] = stops
             self.size_ramps[spec.index, stops.shape[0] :] = stops[-1]
+        #: Whether slot ``i``'s size changes with age (its emitter's size ramp is not 1).
+        self.slot_ramped = np.zeros(count, dtype=np.bool_)
+        for spec in self.emitters:
+            ramped = bool((spec.size_ramp[:, 1] != 1.0).any())
+            self.slot_ramped[spec.first_slot : spec.first_slot + spec.capacity] = ramped
 
     def apply(self, before: State, after: State, h: float) -> State:
         """Age, kill, give birth and ramp sizes (see the module docstring)."""
@@ -83,12 +88,14 @@ class Emission:
 
     def give_birth(
         self, t0: float, t1: float, x: np.ndarray, v: np.ndarray, carried: dict[str, np.ndarray]
-    ) -> None:
+    ) -> int:
         """The births of the step ``[t0, t1)``, written in place into the particle arrays
-        ``x``, ``v`` and the ``carried`` parts (the fused particle step calls this too)."""
+        ``x``, ``v`` and the ``carried`` parts (the fused particle step calls this too); returns
+        one past the highest slot filled (0 if none)."""
         alive, age = carried["particle_alive"], carried["particle_age"]
         lifetime, size = carried["particle_lifetime"], carried["particle_size"]
         serial, dropped = carried["emitter_serial"], carried["emitter_dropped"]
+        end = 0
         for spec in self.emitters:
             total = _birth_count(spec, t0, t1)
             if not total:
@@ -107,6 +114,9 @@ class Emission:
             carried["particle_radius"][free] = (
                 size[free] * ramp_values(spec.size_ramp, fraction)[:, 0]
             )
+            if free.shape[0]:
+                end = max(end, int(free.max()) + 1)
+        return end
 
 
 #: The carried parts the emission stage updates.

@@ -1,21 +1,23 @@
-"""The fused particle step: one parallel pass per step for scenes made only of particles.
+"""The fused particle step: the whole step in one compiled call for scenes made only of particles.
 
 A scene of particles under field forces, with colliders and emitters, stepped by symplectic
 Euler (the scenes' default), is bound by memory traffic: the generic pipeline reads and writes
 the particle arrays once for each force, for the integrator's kick and drift, for each stage
-and for the divergence watch. This module takes the whole step in one pass over the particles,
-in place, on every core (``prange``), a block of :data:`BLOCK` particles at a time:
+and for the divergence watch. This module takes the whole step in place, on every core
+(``prange``), in two passes:
 
-1. a pass over the block that the compiler vectorizes, since every particle takes the same
-   path: the acceleration from the fields folded into ``g − c_i v + b_i`` (uniform gravity,
-   linear drag, wind and damping), symplectic Euler ``v += h a``,
-   ``x += h v`` (:class:`~visviva.integrators.SymplecticEuler`), the divergence watch's check,
-   and a cheap test of whether the particle needs more: it touches or crosses a leading plane
-   collider, it may meet another collider, a field acts on it by its law (attractors,
-   vortices, quadratic drag, forces on some particles only), or it ages;
-2. a second pass over the few particles that need more, from their values at the start of the
-   step (kept in the thread's scratch, in cache): the fields by their law
-   (:mod:`visviva.forces.laws`), the collision stage's own per-particle function
+1. a pass over every particle that the compiler vectorizes (AVX-512: eight particles at a
+   time), since every particle takes the same path, with no loop, no call and no conditional
+   store: the acceleration from the fields folded into ``g − c_i v + b_i`` (uniform gravity,
+   linear drag, wind and damping), symplectic Euler ``v += h a``, ``x += h v``
+   (:class:`~visviva.integrators.SymplecticEuler`), the first collider's contact if it is a
+   plane (the floor, most often), ageing, the divergence watch's check, and a cheap test of
+   whether the particle needs more: it is near another plane, may meet another collider or
+   hit a plane within the step (time of impact), a field acts on it by its law (attractors,
+   vortices, quadratic drag, forces on some particles only), it dies, or its size follows a
+   ramp. Such a particle keeps its start values;
+2. a pass over those few, each by the general path from its start values: the fields by their
+   law (:mod:`visviva.forces.laws`), the collision stage's own per-particle function
    (:func:`visviva.collision.response.resolve`), the emission stage's ageing and death
    (:func:`visviva.particles.emission.age_one`);
 
@@ -23,12 +25,13 @@ then the step's births (:meth:`~visviva.particles.emission.Emission.give_birth`)
 are those of the generic pipeline to round-off (the order of the force sum differs), which
 ``tests/test_fused.py`` checks.
 
-The step updates the state's arrays **in place** (as MuJoCo's ``mj_step`` and Warp do): a
-second buffer set would cost a third of the step in write traffic. The
-:class:`~visviva.simulation.stepper.Stepper` keeps a copy of the state every few steps and
-replays from it when it must give back an earlier state (after a divergence); a caller that
-keeps a state while stepping on copies it (:class:`~visviva.simulation.Simulation`'s ``state``
-already does).
+The step works on its own copy of the positions and velocities, one contiguous array per
+component (the state's ``(N, 3)`` rows interleave them, which the compiler does not vectorize
+over), and updates it **in place**, as MuJoCo's ``mj_step`` and Warp do: writing a second
+copy would add a third to the step's memory traffic. The state's arrays are brought up to
+date when someone reads them (:meth:`FusedParticles.settled`). Only slots up to the last one
+an emitter has used are visited. The :class:`~visviva.simulation.stepper.Stepper` keeps a
+journal and replays it when it must give back an earlier state (after a divergence).
 """
 
 from __future__ import annotations
@@ -100,6 +103,7 @@ class FusedParticles:
         self._x = self._v = np.zeros((3, 0))
         self._current: State | None = None
         self._settled = True
+        self._end = count  # one past the last slot that may be alive
 
     @classmethod
     def of(cls, model: Any, method: str) -> FusedParticles | None:
@@ -151,12 +155,14 @@ class FusedParticles:
             carried["particle_alive"],
             carried["particle_radius"],
             *_emission_arguments(carried, emission),
+            self._end,
             *self._collision,
             limit,
             self._special,
         )
         if emission is not None:
-            emission.give_birth(state.t, t_after, self._x.T, self._v.T, carried)
+            born = emission.give_birth(state.t, t_after, self._x.T, self._v.T, carried)
+            self._end = max(self._end, born)
         self._current = state.from_parts(t_after, state.parts)
         self._settled = False
         return self._current, suspects != 0
@@ -178,6 +184,12 @@ class FusedParticles:
             self._x, self._v = np.empty((3, self.count)), np.empty((3, self.count))
         _deinterleave(state.parts[0][:n], self._x)
         _deinterleave(state.parts[1][:n], self._v)
+        self._end = self.count
+        if self.emission is not None:
+            # Emitters fill their lowest free slots first: the slots past the last live one
+            # stay free until a birth reaches them, and the kernel need not visit them.
+            live = np.flatnonzero(state["particle_alive"])
+            self._end = int(live[-1]) + 1 if live.shape[0] else 0
 
 
 @njit(cache=True, parallel=True)
@@ -221,13 +233,14 @@ def _emission_arguments(
     carried: dict[str, np.ndarray], emission: Emission | None
 ) -> tuple[Any, ...]:
     if emission is None:
-        return (None,) * 5
+        return (None,) * 6
     return (
         carried["particle_age"],
         carried["particle_lifetime"],
         carried["particle_size"],
         emission.slot_emitter,
         emission.size_ramps,
+        emission.slot_ramped,
     )
 
 
@@ -352,7 +365,7 @@ def _impact_possible(plane, bit, sx, sy, sz, px, py, pz, r):  # pragma: no cover
 @njit(cache=True, parallel=True, error_model="numpy")
 def _fused(
     x, y, z, vx, vy, vz, inverse_mass, h, g, drag, air, damping, kinds, parameters, law_masks,
-    alive, radius, age, lifetime, size, slot_emitter, size_ramps,
+    alive, radius, age, lifetime, size, slot_emitter, size_ramps, slot_ramped, end,
     collider_masks, common_mask, floor, floor_bit, e, mu, rests, near_planes, impact_planes,
     restitution, friction, resting, toi, planes, rows, others, everything,
     limit, special,
@@ -370,7 +383,7 @@ def _fused(
     suspects = 0
     # Pass 1, vectorized: every particle takes the same path, with no loop and no call, and
     # stores by selection (a conditional store would keep the loop scalar).
-    for i in prange(x.shape[0]):
+    for i in prange(end):
         sx, sy, sz, svx, svy, svz = x[i], y[i], z[i], vx[i], vy[i], vz[i]
         w = inverse_mass[i]
         c = drag * w + damping
@@ -401,16 +414,21 @@ def _fused(
             odd |= (mask >> beyond) != 0
         if kinds is not None:
             odd |= law_masks[i] != 0
-        if age is not None:
-            odd = True
         # Only emitted particles die: without emitters, every slot is alive.
-        live = True if age is None else alive[i]
+        live = True
+        if age is not None:
+            live = alive[i]
+            older = age[i] + h
+            # One that dies, or whose size follows a ramp, is special.
+            odd |= (not older < lifetime[i]) | slot_ramped[i]
         if special is not None:
             odd &= live
             special[i] = odd
             pending += odd
         # A free slot stays parked; a special particle keeps its start for pass 2.
         keep = live & (not odd)
+        if age is not None:
+            age[i] = older if keep else age[i]
         x[i] = px if keep else sx
         y[i] = py if keep else sy
         z[i] = pz if keep else sz
@@ -423,7 +441,7 @@ def _fused(
     if pending == 0:
         return suspects
     # Pass 2: the special particles, each by the general path.
-    for i in prange(x.shape[0]):
+    for i in prange(end):
         if not special[i]:
             continue
         sx, sy, sz, svx, svy, svz = x[i], y[i], z[i], vx[i], vy[i], vz[i]

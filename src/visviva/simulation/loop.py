@@ -1,9 +1,10 @@
 """The one fixed-step simulation loop every model runs through.
 
 ``simulate`` advances a problem from ``t0`` to ``t_end`` in steps of ``dt``, each made of
-``substeps`` integrator steps of ``h = dt/substeps``. Time is never accumulated: integrator step
-``k`` ends at ``t0 + (k + 1)·h``, computed from the integer counter, so a million steps land on
-the same times as one would by hand (``t += dt`` drifts by ``~k·ε``). If ``t_end − t0`` is not a
+``substeps`` integrator steps of ``h = dt/substeps``. Time is never accumulated: step ``n``
+ends at ``t0 + (n + 1)·dt`` and its substep ``j`` at ``t0 + n·dt + (j + 1)·h``, computed from
+integer counters, so a million steps land on the same times as one would by hand (``t += dt``
+drifts by ``~n·ε``). If ``t_end − t0`` is not a
 whole number of steps, the last step is shortened to end exactly at ``t_end``.
 
 Every ``record_every``-th step (and the last) becomes a frame of the :class:`Recording`. After
@@ -59,9 +60,10 @@ CHUNK_SYSTEM_STEPS = 200_000
 class Schedule:
     """When each step happens: ``full_steps`` steps of ``dt``, then possibly one shorter step.
 
-    Time is counted on the grid ``t0 + k·h`` (``h = dt/substeps``) from ``t0``, the grid's
-    origin; a run that continues an earlier one on the same grid starts at step ``first``, so
-    its times are exactly those one longer run would have had.
+    Time is counted on the grid ``t0 + n·dt`` (substeps at ``+ j·h`` within a step, ``h =
+    dt/substeps``) from ``t0``, the grid's origin; a run that continues an earlier one on the
+    same grid starts at step ``first``, so its times are exactly those one longer run would
+    have had.
 
     Attributes:
         t0: The grid's origin [s].
@@ -106,9 +108,13 @@ class Schedule:
         """``(h, t_after)`` of substep ``sub`` of this run's step ``step`` (time from integer
         counters)."""
         if step < self.full_steps:
-            k = (self.first + step) * self.substeps + sub + 1
-            last = step + 1 == self.steps and sub + 1 == self.substeps
-            return self.h, self.t_end if last else self.t0 + k * self.h
+            n = self.first + step  # steps of dt before this one, from the grid's origin
+            if sub + 1 < self.substeps:
+                return self.h, self.t0 + n * self.dt + (sub + 1) * self.h
+            # A step ends on the grid of dt whatever its substeps: a run split into pieces
+            # passes through the same times as one long run.
+            last = step + 1 == self.steps
+            return self.h, self.t_end if last else self.t0 + (n + 1) * self.dt
         h_last = self.last_dt / self.substeps
         if sub + 1 == self.substeps:
             return h_last, self.t_end
