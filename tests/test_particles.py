@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 import visviva as vv
 
@@ -320,3 +322,24 @@ def test_emitters_too_large_to_allocate_or_count_are_refused_before_allocation(e
         return
     with pytest.raises(vv.SceneError, match=r"entities\[0\]"):
         builder.build()
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    alive=st.lists(st.booleans(), min_size=1, max_size=80),
+    start=st.integers(0, 80),
+    stop=st.integers(0, 80),
+    count=st.integers(0, 20),
+)
+@example(alive=[True] * 40 + [False, True, False] + [True] * 20, start=3, stop=70, count=3)
+@example(alive=[True] * 16 + [False] * 3, start=0, stop=19, count=2)
+def test_free_slots_are_the_lowest_free_ones(alive, start, stop, count):
+    """The free-slot scan (which skips eight live slots at a time) finds what a plain scan
+    finds: the lowest ``count`` free slots in ``[start, stop)``."""
+    from visviva.particles.emission import _free_slots
+
+    flags = np.array(alive, dtype=np.bool_)
+    start, stop = min(start, flags.shape[0]), min(stop, flags.shape[0])
+    words = flags[: flags.shape[0] // 8 * 8].view(np.uint64)
+    expected = [i for i in range(start, stop) if not flags[i]][:count]
+    assert _free_slots(flags, words, start, stop, count).tolist() == expected
