@@ -89,14 +89,24 @@ def test_fused_state_reads_are_current_and_copies_stay_put():
     and what a caller copied does not change under it."""
     simulation = vv.Simulation(_scene())
     simulation.step(3)
-    kept = simulation.state["particle_position"]
+    view = simulation.state
+    kept = view["particle_position"]
     raw = simulation.raw_state.parts[0].copy()
     simulation.step()
-    np.testing.assert_array_equal(simulation.state["particle_position"].shape[1], 3)
     assert not np.array_equal(simulation.raw_state.parts[0], raw)
+    # The view kept across the step still reads the state of its time.
+    np.testing.assert_array_equal(view["particle_position"], kept)
+    assert view.t == pytest.approx(3 / 240)
     generic = vv.Simulation(_scene(), compiled=False)
     generic.step(3)
     np.testing.assert_allclose(kept, generic.state["particle_position"], rtol=0, atol=1e-12)
+    generic.step()
+    np.testing.assert_allclose(
+        simulation.state["particle_position"],
+        generic.state["particle_position"],
+        rtol=0,
+        atol=1e-12,
+    )
 
 
 @pytest.mark.parametrize("substeps", [1, 3])

@@ -145,10 +145,11 @@ def particle_arrays(
         elif isinstance(entity, ParticleCloud):
             count = entity.count
             rng = np.random.default_rng(entity.seed)
-            x = np.asarray(entity.center) + (rng.random((count, 3)) - 0.5) * np.asarray(entity.size)
-            v = np.asarray(entity.velocity) + entity.velocity_jitter * rng.standard_normal(
-                (count, 3)
-            )
+            with np.errstate(over="ignore"):  # an overflow is refused below, by the entity
+                offsets = (rng.random((count, 3)) - 0.5) * np.asarray(entity.size)
+                x = np.asarray(entity.center) + offsets
+                jitter = entity.velocity_jitter * rng.standard_normal((count, 3))
+                v = np.asarray(entity.velocity) + jitter
             color = entity.color
         elif isinstance(entity, Emitter):
             k = next(emitted)

@@ -25,6 +25,7 @@ import hashlib
 import io
 import json
 import math
+import weakref
 from collections.abc import Iterator, Mapping
 from types import MappingProxyType
 from typing import TYPE_CHECKING
@@ -60,7 +61,9 @@ class SimulationState(Mapping[str, np.ndarray]):
 
     Particle parts (``particle_position``, ``particle_velocity``, ``particle_radius``, ...)
     hold the live particles only, in slot order: ``(n, 3)`` or ``(n,)``. Other parts
-    (``generalized_position``, ...) are whole. Values are copies, safe to keep.
+    (``generalized_position``, ...) are whole. Values are copies, safe to keep, and so is the
+    view: it reads the state of its time ``t`` even after the simulation has gone on (a view
+    kept across a step copies its state before the step).
 
     Attributes:
         t: Time [s].
@@ -87,6 +90,18 @@ class SimulationState(Mapping[str, np.ndarray]):
 
     def __repr__(self) -> str:
         return f"SimulationState(t={self.t!r}, parts: {', '.join(self)})"
+
+    def _keep(self) -> None:
+        """Hold copies of the state's arrays: the simulation is about to change them."""
+        state = self._state
+        self._state = State(
+            state.t,
+            tuple(np.array(part) for part in state.parts),
+            state.layout,
+            {name: np.array(value) for name, value in state.carried.items()},
+        )
+        if self._alive is not None:
+            self._alive = self._state.carried["particle_alive"]
 
 
 class Simulation:
@@ -137,6 +152,7 @@ class Simulation:
             )
         self._stepper = Stepper(self.system, self.integrator, watch, model.stages, fused)
         self._state = state
+        self._views: list[weakref.ref[SimulationState]] = []  # handed out since the last step
         self._origin = state.t
         self._steps = 0  # steps of dt since the origin
 
@@ -148,7 +164,10 @@ class Simulation:
     @property
     def state(self) -> SimulationState:
         """The current state by part name (live particles only; see :class:`SimulationState`)."""
-        return SimulationState(self._current())
+        view = SimulationState(self._current())
+        self._views = [ref for ref in self._views if ref() is not None]
+        self._views.append(weakref.ref(view))
+        return view
 
     @property
     def compiled(self) -> bool:
@@ -290,6 +309,11 @@ class Simulation:
         record_every: int,
         progress: bool | None,
     ) -> None:
+        for ref in self._views:  # the steps change the arrays the views read
+            view = ref()
+            if view is not None:
+                view._keep()
+        self._views = []
         recorder = None
         if on_frame is not None:
             recorder = FrameRecorder(self.system, self._current(), False, on_frame, keep=False)
