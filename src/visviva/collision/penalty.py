@@ -27,11 +27,16 @@ References:
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
 
 from .colliders import ColliderSet, collider_distance
+from .contacts import DEFAULT_GAP, Contacts, find_contacts
+
+if TYPE_CHECKING:
+    from ..ode.state import State
 from .tables import ColliderKind
 
 __all__ = ["PenaltyContact"]
@@ -49,6 +54,9 @@ class PenaltyContact:
         masks: ``(N,)`` uint64: bit ``k`` set where particle ``i`` meets collider ``k``.
         radius: Particle radii [m], ``(N,)`` (the radii at the start: a size ramp does not
             change the contact distance).
+        labels: Each collider's name, for :class:`~visviva.collision.contacts.Contacts`.
+        resting_speed: Normal speeds [m/s] below which :meth:`contacts` calls a contact
+            resting, per collider (default 0).
     """
 
     velocity_dependent = True
@@ -60,14 +68,39 @@ class PenaltyContact:
         damping: Sequence[float],
         masks: np.ndarray,
         radius: np.ndarray,
+        labels: Sequence[str] | None = None,
+        resting_speed: Sequence[float] | None = None,
     ) -> None:
         self.colliders = colliders
         self.stiffness = np.asarray(stiffness, dtype=np.float64)
         self.damping = np.asarray(damping, dtype=np.float64)
         self.masks = np.asarray(masks, dtype=np.uint64)
         self.radius = np.asarray(radius, dtype=np.float64)
+        self.labels = tuple(labels or (f"collider {k}" for k in range(len(colliders))))
+        self.resting_speed = (
+            np.zeros(len(colliders))
+            if resting_speed is None
+            else np.asarray(resting_speed, dtype=np.float64)
+        )
         self.conservative = not np.any(self.damping)
         self._touched = np.flatnonzero(self.masks).astype(np.int64)
+
+    def contacts(self, state: State, gap: float = DEFAULT_GAP) -> Contacts:
+        """The contacts of ``state``'s live particles with these colliders (see
+        :mod:`~visviva.collision.contacts`)."""
+        x = state["particle_position"]
+        alive = state.carried.get("particle_alive")
+        return find_contacts(
+            x,
+            state["particle_velocity"],
+            self.radius,
+            np.ones(x.shape[0], dtype=np.bool_) if alive is None else alive,
+            self.masks,
+            self.colliders,
+            self.resting_speed,
+            self.labels,
+            gap,
+        )
 
     def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         """Add the contact forces [N] to ``out``."""

@@ -36,6 +36,7 @@ import numpy as np
 from numba import njit, prange
 
 from .colliders import UNROLLED_PLANES, ColliderSet, collider_distance, collider_first_hit
+from .contacts import DEFAULT_GAP, Contacts, find_contacts
 from .queries import plane_distance, plane_first_hit
 from .tables import ColliderKind
 
@@ -84,6 +85,8 @@ class ParticleCollisions:
         colliders: The colliders.
         response: Restitution, friction, resting speed and time of impact per collider.
         masks: ``(N,)`` uint64: bit ``k`` set where particle ``i`` meets collider ``k``.
+        labels: Each collider's name, for :class:`~visviva.collision.contacts.Contacts`
+            (default ``collider 0``, ``collider 1``, ...).
 
     The state must carry ``particle_radius`` and ``particle_alive`` and name its particle
     positions and velocities ``particle_position`` / ``particle_velocity``.
@@ -92,11 +95,31 @@ class ParticleCollisions:
     compiled: ClassVar[bool] = True
 
     def __init__(
-        self, colliders: ColliderSet, response: ColliderResponse, masks: np.ndarray
+        self,
+        colliders: ColliderSet,
+        response: ColliderResponse,
+        masks: np.ndarray,
+        labels: Sequence[str] | None = None,
     ) -> None:
         self.colliders = colliders
         self.response = response
         self.masks = np.asarray(masks, dtype=np.uint64)
+        self.labels = tuple(labels or (f"collider {k}" for k in range(len(colliders))))
+
+    def contacts(self, state: State, gap: float = DEFAULT_GAP) -> Contacts:
+        """The contacts of ``state``'s live particles with these colliders (classified with
+        each collider's resting speed; see :mod:`~visviva.collision.contacts`)."""
+        return find_contacts(
+            state["particle_position"],
+            state["particle_velocity"],
+            state["particle_radius"],
+            state["particle_alive"],
+            self.masks,
+            self.colliders,
+            self.response.resting_speed,
+            self.labels,
+            gap,
+        )
 
     def apply(self, before: State, after: State, h: float) -> State:
         """The state with every particle moved out of the colliders and bounced."""

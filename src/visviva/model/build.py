@@ -90,7 +90,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         systems = _systems(scene, names)
         with np.errstate(all="ignore"):  # overflowing values are judged by the start check
             forces = force_objects(scene, groups, arrays["mass"])
-            forces += penalty_forces(scene, groups, arrays["mass"], arrays["radius"])
+            forces += penalty_forces(scene, groups, arrays["mass"], arrays["radius"], h)
         stages = []
         collisions = collision_stage(scene, groups, count, h)
         if collisions is not None:

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..collision.contacts import DEFAULT_GAP, Contacts
 from ..ode.problems import Problem
 from .systems import SYSTEMS
 
@@ -215,6 +216,13 @@ class Model:
         from .scene_system import initial_state
 
         return initial_state(self)
+
+    def contacts(self, state: State, gap: float = DEFAULT_GAP) -> Contacts:
+        """The particle–collider contacts of ``state`` (every collider, impulse and penalty:
+        where, how deep, and colliding, resting or separating; see
+        :mod:`visviva.collision.contacts`)."""
+        sources = [s for s in (*self.stages, *self.forces) if hasattr(s, "contacts")]
+        return Contacts.join([source.contacts(state, gap) for source in sources])
 
     def frame(self, state: State) -> dict[str, np.ndarray]:
         """What a recording keeps of ``state`` (one frame; see :mod:`.frames`)."""

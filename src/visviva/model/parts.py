@@ -275,26 +275,27 @@ def collision_stage(scene: Scene, groups: Sequence[ParticleGroup], count: int, h
             f"a scene may hold at most {MAX_COLLIDERS} impulse colliders",
         )
     shapes = [_shape(e, f"entities[{i}]") for i, e in chosen]
-    gravity = math.hypot(*scene.world.gravity)  # no overflow for huge components
     masks = np.zeros(count, dtype=np.uint64)
     for bit, (_, e) in enumerate(chosen):
         masks[_targets(e, groups, count).indices] |= np.uint64(1) << np.uint64(bit)
     response = ColliderResponse(
         restitution=[e.restitution for _, e in chosen],
         friction=[e.friction for _, e in chosen],
-        # A contact rests below the speed gravity gives in two steps (Mirtich & Canny 1995).
-        resting_speed=[
-            2.0 * gravity * h if e.resting_speed is None else e.resting_speed for _, e in chosen
-        ],
+        resting_speed=_resting_speeds(scene, chosen, h),
         time_of_impact=[e.time_of_impact for _, e in chosen],
     )
-    return ParticleCollisions(ColliderSet(shapes), response, masks)
+    return ParticleCollisions(ColliderSet(shapes), response, masks, _labels(chosen))
 
 
 def penalty_forces(
-    scene: Scene, groups: Sequence[ParticleGroup], mass: np.ndarray, radius: np.ndarray
+    scene: Scene,
+    groups: Sequence[ParticleGroup],
+    mass: np.ndarray,
+    radius: np.ndarray,
+    h: float,
 ) -> list[Force]:
-    """The penalty-contact force of the penalty colliders (empty list if there are none)."""
+    """The penalty-contact force of the penalty colliders (empty list if there are none); ``h``
+    [s] is the integrator step (a contact rests below the speed gravity gives in two)."""
     from ..collision import ColliderSet, PenaltyContact
 
     chosen = _colliders(scene, "penalty")
@@ -312,5 +313,19 @@ def penalty_forces(
             damping=[e.damping or 0.0 for _, e in chosen],
             masks=masks,
             radius=radius,
+            labels=_labels(chosen),
+            resting_speed=_resting_speeds(scene, chosen, h),
         )
     ]
+
+
+def _resting_speeds(scene: Scene, chosen: Sequence[tuple[int, Collider]], h: float) -> list[float]:
+    """Each collider's resting speed [m/s]: by default, the speed gravity gives in two steps
+    of ``h`` (Mirtich & Canny 1995)."""
+    gravity = math.hypot(*scene.world.gravity)  # no overflow for huge components
+    return [2.0 * gravity * h if e.resting_speed is None else e.resting_speed for _, e in chosen]
+
+
+def _labels(chosen: Sequence[tuple[int, Collider]]) -> list[str]:
+    """Each collider's name, or where it is in the scene."""
+    return [e.name or f"entities[{i}]" for i, e in chosen]

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._validation import real_number, whole_number
+from ..collision.contacts import DEFAULT_GAP, Contacts
 from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get
 from ..ode.state import State
@@ -180,6 +181,15 @@ class Simulation:
 
         The next step changes its arrays in place: copy what you keep."""
         return self._current()
+
+    def contacts(self, gap: float = DEFAULT_GAP) -> Contacts:
+        """The particles' contacts with the colliders now: which particle touches which
+        collider (within its radius plus ``gap`` [m]), where, how deep, and whether it is
+        colliding, resting or separating (see :mod:`visviva.collision.contacts`)."""
+        gap = real_number("gap", gap, unit=" m")
+        if gap < 0.0:
+            raise ModelError(f"`gap` must be >= 0 (got {gap!r} m)")
+        return self.model.contacts(self._current(), gap)
 
     def energy(self) -> float:
         """Kinetic plus potential energy [J] of the live particles and the systems."""
