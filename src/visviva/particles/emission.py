@@ -10,7 +10,8 @@ After each integrator step, for each emitter, in order:
    emitter's shape, a direction in the cone, a speed, a lifetime and a radius from the
    counter-based generator of :mod:`visviva.particles.random`, and has already flown for
    ``t1 − τ`` seconds since its birth time ``τ`` (so a stream of particles leaves evenly spaced,
-   not in clumps at each step);
+   not in clumps at each step), in a straight line: the forces act from the next step on, which
+   misplaces a newborn by less than ``½|a|h²``;
 3. the radius of every live particle follows its size ramp.
 
 The carried parts: ``particle_alive``, ``particle_age`` [s], ``particle_lifetime`` [s],
