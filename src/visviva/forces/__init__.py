@@ -5,6 +5,7 @@ from .assembly import ForceSum
 from .base import Force, Targets
 from .fields import Attractor, Damping, Drag, QuadraticDrag, UniformGravity, Vortex
 from .gravitation import Gravitation
+from .springs import Springs
 
 __all__ = [
     "Attractor",
@@ -14,6 +15,7 @@ __all__ = [
     "ForceSum",
     "Gravitation",
     "QuadraticDrag",
+    "Springs",
     "Targets",
     "UniformGravity",
     "Vortex",

@@ -1,0 +1,223 @@
+"""Damped springs between particles: the force of every mass-spring deformable.
+
+A spring joins particles ``i`` and ``j`` with rest length ``L`` [m], stiffness ``k`` [N/m] and
+damping ``c`` [N·s/m] along the spring (seed 002). With ``d = x_j − x_i``, ``l = |d|``,
+``u = d / l`` and ``w = v_j − v_i``,
+
+    f   = (k (l − L) + c (w · u)) u          the force on i; j feels −f       [N]
+    U   = ½ k (l − L)²                                                      [J]
+
+so the forces of a spring sum to zero and conserve momentum, and the damper only resists the
+rate of stretch (a rigid rotation is not damped). The exact Jacobians, with ``P = I − u uᵀ``
+the projection across the spring,
+
+    ∂f/∂x_j = −∂f/∂x_i = K = k u uᵀ + k (1 − L/l) P + (c / l) (u wᵀ P + (w · u) P),
+    ∂f/∂v_j = −∂f/∂v_i = D = c u uᵀ,
+
+fill four 3×3 blocks per spring, ``(i, i) = −K``, ``(i, j) = K``, ``(j, i) = K``,
+``(j, j) = −K`` (and the same for ``D``), on a pattern fixed when the springs are built. A
+compressed spring (``l < L``) makes ``K`` indefinite across the spring: the buckling that
+implicit solvers handle by projecting it (``definite=True`` drops the negative part, Choi & Ko
+2002).
+
+``tests/test_springs.py`` checks every Jacobian against central finite differences of the same
+force (compressed springs included) and ``f = −∇U`` without damping.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+from numba import njit
+
+from ..errors import ModelError
+
+__all__ = ["Springs"]
+
+
+class Springs:
+    """Damped springs between particles (see the module docstring).
+
+    Args:
+        pairs: ``(S, 2)`` particle indices ``(i, j)`` of each spring, ``i ≠ j``.
+        rest_length: ``(S,)`` rest lengths ``L`` [m], > 0.
+        stiffness: ``(S,)`` ``k`` [N/m], ≥ 0.
+        damping: ``(S,)`` ``c`` [N·s/m], ≥ 0.
+        count: Number of particles ``N`` in the scene.
+        definite: Project each spring's stiffness block to be positive semi-definite (the
+            negative part of a compressed spring dropped) in :meth:`add_jacobian`.
+
+    Raises:
+        ModelError: Naming the first bad spring: an index out of range, a spring joining a
+            particle to itself, a rest length not positive, a negative stiffness or damping.
+    """
+
+    conservative: ClassVar[bool] = False
+    velocity_dependent: ClassVar[bool] = True
+
+    def __init__(
+        self,
+        pairs: np.ndarray,
+        rest_length: np.ndarray,
+        stiffness: np.ndarray,
+        damping: np.ndarray,
+        count: int,
+        *,
+        definite: bool = False,
+    ) -> None:
+        pairs = np.asarray(pairs)
+        if pairs.ndim != 2 or pairs.shape[1] != 2 or not np.issubdtype(pairs.dtype, np.integer):
+            raise ModelError(f"`pairs` must be an (S, 2) array of particle indices, not {pairs!r}")
+        self.pairs = np.ascontiguousarray(pairs, dtype=np.int64)
+        springs = self.pairs.shape[0]
+        self.rest_length = _per_spring("rest_length", rest_length, springs)
+        self.stiffness = _per_spring("stiffness", stiffness, springs)
+        self.damping = _per_spring("damping", damping, springs)
+        _check(self.pairs, self.rest_length, self.stiffness, self.damping, count)
+        self.count = count
+        self.definite = definite
+        # An undamped set of springs is conservative (instances may differ from the class).
+        self.conservative = not np.any(self.damping)  # type: ignore[misc]
+        self.velocity_dependent = bool(np.any(self.damping))  # type: ignore[misc]
+
+    def __len__(self) -> int:
+        return int(self.pairs.shape[0])
+
+    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        """Add every spring's force [N] on its two particles to ``out``."""
+        _forces(self.pairs, self.rest_length, self.stiffness, self.damping, x, v, out)
+
+    def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
+        """``Σ ½ k (l − L)²`` [J] over the springs."""
+        return float(_energy(self.pairs, self.rest_length, self.stiffness, x))
+
+    def jacobian_blocks(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per spring, the blocks ``(i, i), (i, j), (j, i), (j, j)``."""
+        i, j = self.pairs[:, 0], self.pairs[:, 1]
+        rows = np.stack([i, i, j, j], axis=1).reshape(-1)
+        cols = np.stack([i, j, i, j], axis=1).reshape(-1)
+        return rows, cols
+
+    def add_jacobian(
+        self, t: float, x: np.ndarray, v: np.ndarray, dfdx: np.ndarray, dfdv: np.ndarray
+    ) -> None:
+        """Add ``∂F/∂x`` [N/m] and ``∂F/∂v`` [N·s/m] into the blocks of
+        :meth:`jacobian_blocks` (``(4S, 3, 3)`` each)."""
+        _jacobian(
+            self.pairs,
+            self.rest_length,
+            self.stiffness,
+            self.damping,
+            x,
+            v,
+            self.definite,
+            dfdx,
+            dfdv,
+        )
+
+
+def _per_spring(name: str, values: object, springs: int) -> np.ndarray:
+    """``values`` as ``(S,)`` float64: one per spring, or one for all."""
+    array = np.asarray(values, dtype=np.float64)
+    if array.ndim == 0:
+        return np.full(springs, float(array))
+    if array.shape != (springs,):
+        raise ModelError(
+            f"`{name}` must be one number or one per spring ({springs}), got shape {array.shape}"
+        )
+    return np.ascontiguousarray(array)
+
+
+def _check(
+    pairs: np.ndarray, rest: np.ndarray, stiffness: np.ndarray, damping: np.ndarray, count: int
+) -> None:
+    """Refuse the first bad spring, naming it, what is wrong and the fix."""
+    checks = [
+        (((pairs < 0) | (pairs >= count)).any(axis=1), "joins a particle that does not exist",
+         f"indices must be in [0, {count})"),
+        (pairs[:, 0] == pairs[:, 1], "joins a particle to itself",
+         "a spring needs two different particles"),
+        (~(np.isfinite(rest) & (rest > 0.0)), "has a rest length that is not positive and finite",
+         "use the distance the spring should keep, > 0 [m]"),
+        (~(np.isfinite(stiffness) & (stiffness >= 0.0)), "has a negative or non-finite stiffness",
+         "use k >= 0 [N/m]"),
+        (~(np.isfinite(damping) & (damping >= 0.0)), "has a negative or non-finite damping",
+         "use c >= 0 [N s/m]"),
+    ]  # fmt: skip
+    for bad, what, fix in checks:
+        if bad.any():
+            s = int(np.argmax(bad))
+            raise ModelError(
+                f"spring {s} {what} (particles {pairs[s].tolist()}, rest length {rest[s]!r} m, "
+                f"stiffness {stiffness[s]!r} N/m, damping {damping[s]!r} N s/m): {fix}"
+            )
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _spring(p, x, v, s):  # pragma: no cover - compiled
+    """Spring ``s``'s ends, unit direction ``u``, length ``l`` and stretch rate ``w · u``."""
+    i, j = p[s, 0], p[s, 1]
+    dx, dy, dz = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
+    length = np.sqrt(dx * dx + dy * dy + dz * dz)
+    ux, uy, uz = dx / length, dy / length, dz / length
+    wx, wy, wz = v[j, 0] - v[i, 0], v[j, 1] - v[i, 1], v[j, 2] - v[i, 2]
+    return i, j, ux, uy, uz, length, wx, wy, wz, wx * ux + wy * uy + wz * uz
+
+
+@njit(cache=True, error_model="numpy")
+def _forces(p, rest, k, c, x, v, out):  # pragma: no cover - compiled
+    for s in range(p.shape[0]):
+        i, j, ux, uy, uz, length, _, _, _, rate = _spring(p, x, v, s)
+        magnitude = k[s] * (length - rest[s]) + c[s] * rate
+        out[i, 0] += magnitude * ux
+        out[i, 1] += magnitude * uy
+        out[i, 2] += magnitude * uz
+        out[j, 0] -= magnitude * ux
+        out[j, 1] -= magnitude * uy
+        out[j, 2] -= magnitude * uz
+
+
+@njit(cache=True, error_model="numpy")
+def _energy(p, rest, k, x):  # pragma: no cover - compiled
+    total = 0.0
+    for s in range(p.shape[0]):
+        i, j = p[s, 0], p[s, 1]
+        dx, dy, dz = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
+        stretch = np.sqrt(dx * dx + dy * dy + dz * dz) - rest[s]
+        total += 0.5 * k[s] * stretch * stretch
+    return total
+
+
+@njit(cache=True, error_model="numpy")
+def _jacobian(p, rest, k, c, x, v, definite, dfdx, dfdv):  # pragma: no cover - compiled
+    u = np.empty(3)
+    w = np.empty(3)
+    block = np.empty((3, 3))
+    for s in range(p.shape[0]):
+        _, _, u[0], u[1], u[2], length, w[0], w[1], w[2], rate = _spring(p, x, v, s)
+        across = k[s] * (1.0 - rest[s] / length)  # the stiffness across the spring
+        if definite and across < 0.0:
+            across = 0.0
+        scale = c[s] / length
+        for a in range(3):
+            # (wᵀ P)_b = w_b − (w · u) u_b
+            for b in range(3):
+                projector = (1.0 if a == b else 0.0) - u[a] * u[b]
+                along = u[a] * u[b]
+                block[a, b] = (
+                    k[s] * along
+                    + across * projector
+                    + scale * (u[a] * (w[b] - rate * u[b]) + rate * projector)
+                )
+        for a in range(3):
+            for b in range(3):
+                damper = c[s] * u[a] * u[b]
+                dfdx[4 * s, a, b] -= block[a, b]
+                dfdx[4 * s + 1, a, b] += block[a, b]
+                dfdx[4 * s + 2, a, b] += block[a, b]
+                dfdx[4 * s + 3, a, b] -= block[a, b]
+                dfdv[4 * s, a, b] -= damper
+                dfdv[4 * s + 1, a, b] += damper
+                dfdv[4 * s + 2, a, b] += damper
+                dfdv[4 * s + 3, a, b] -= damper
