@@ -25,6 +25,7 @@ from .parts import (
     force_objects,
     particle_arrays,
     penalty_forces,
+    spring_forces,
 )
 from .scene import (
     MAX_PARTICLES,
@@ -33,6 +34,7 @@ from .scene import (
     ForceField,
     ParticleCloud,
     Particles,
+    Rope,
     Scene,
     System,
 )
@@ -41,7 +43,7 @@ from .systems import SYSTEMS
 __all__ = ["build_model", "entity_names"]
 
 #: Entities that hold particles (which forces and colliders may target).
-PARTICLE_ENTITIES = (Particles, ParticleCloud, Emitter)
+PARTICLE_ENTITIES = (Particles, ParticleCloud, Rope, Emitter)
 
 
 def entity_names(scene: Scene) -> list[str]:
@@ -69,9 +71,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     except Located as located:
         raise SceneError([located.problem]) from None
     slots = sum(s.capacity for s in specs) + sum(
-        len(e.positions) if isinstance(e, Particles) else e.count
-        for e in scene.entities
-        if isinstance(e, (Particles, ParticleCloud))
+        _count(e) for e in scene.entities if isinstance(e, (Particles, ParticleCloud, Rope))
     )
     if slots > MAX_PARTICLES:
         raise SceneError(
@@ -90,9 +90,10 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         systems = _systems(scene, names)
         with np.errstate(all="ignore"):  # overflowing values are judged by the start check
             forces = force_objects(scene, groups, arrays["mass"])
-            forces += penalty_forces(scene, groups, arrays["mass"], arrays["radius"], h)
+            forces += penalty_forces(scene, groups, arrays, h)
+            forces += spring_forces(scene, groups, count)
         stages = []
-        collisions = collision_stage(scene, groups, count, h)
+        collisions = collision_stage(scene, groups, arrays["pinned"], h)
         if collisions is not None:
             stages.append(collisions)
         if specs:
@@ -119,6 +120,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         particle_radius=frozen_array(arrays["radius"]),
         particle_color=frozen_array(arrays["color"]),
         particle_alive=frozen_array(arrays["alive"], dtype=bool),
+        particle_pinned=frozen_array(arrays["pinned"], dtype=bool),
         particle_groups=tuple(groups),
         systems=tuple(systems),
         forces=tuple(forces),
@@ -251,8 +253,8 @@ def _check(scene: Scene) -> list[SceneProblem]:
                 )
             else:
                 seen[entity.name] = index
-        if isinstance(entity, Particles):
-            total += len(entity.positions)
+        if isinstance(entity, (Particles, Rope)):
+            total += _count(entity)
             problems += _check_lengths(entity, where)
         elif isinstance(entity, ParticleCloud):
             total += entity.count
@@ -344,8 +346,17 @@ def _check_first_order(scene: Scene) -> list[SceneProblem]:
     return []
 
 
-def _check_lengths(entity: Particles, where: str) -> list[SceneProblem]:
-    count = len(entity.positions)
+def _count(entity: Particles | ParticleCloud | Rope) -> int:
+    """How many particles an entity that lists or counts them holds."""
+    if isinstance(entity, Particles):
+        return len(entity.positions)
+    if isinstance(entity, Rope):
+        return len(entity.points)
+    return entity.count
+
+
+def _check_lengths(entity: Particles | Rope, where: str) -> list[SceneProblem]:
+    count = _count(entity)
     problems = []
     for name in ("velocities", "mass", "radius"):
         value = getattr(entity, name)

@@ -26,6 +26,7 @@ from .scene import (
     Output,
     ParticleCloud,
     Particles,
+    Rope,
     Scene,
     System,
     World,
@@ -135,6 +136,27 @@ class SceneBuilder:
         """Add ``count`` particles at random in a box (``center``, edge lengths ``size`` [m]),
         with a mean ``velocity`` and a ``velocity_jitter`` [m/s], ``mass``, ``radius``, ``seed``."""
         return self._add(ParticleCloud, "particle_cloud", _given(locals()))
+
+    def add_rope(
+        self,
+        points: Any,
+        *,
+        stiffness: float,
+        mass: float | Sequence[float] | None = None,
+        damping: float | None = None,
+        bending: float | None = None,
+        pinned: Sequence[int] | None = None,
+        velocities: Any = None,
+        radius: float | None = None,
+        color: Vector | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add a rope: particles at ``points`` [m] ``(n, 3)`` (in this order in the state) of
+        ``mass`` [kg] (one value or one per point), joined in order by springs of
+        ``stiffness`` [N/m] and ``damping`` [N·s/m] at rest at the points' distances;
+        ``bending`` [N/m] > 0 adds springs between points two apart; the points ``pinned``
+        (indices) stay where they are."""
+        return self._add(Rope, "rope", _given(locals()))
 
     def add_system(
         self, system: str, parameters: Mapping[str, float] | None = None, *, name: str | None = None

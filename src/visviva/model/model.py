@@ -138,6 +138,8 @@ class Model:
         particle_radius: Initial radii [m], shape ``(particle_count,)``.
         particle_color: sRGB colours in [0, 1], shape ``(particle_count, 3)``.
         particle_alive: Which slots hold a particle at the start, ``(particle_count,)``.
+        particle_pinned: Which particles are held where they start (no force moves them),
+            ``(particle_count,)``.
         particle_groups: Which entity each range of particle slots came from.
         systems: The named systems, whose coordinates follow the particles' in the state.
         forces: The forces on particles, world gravity first.
@@ -160,6 +162,7 @@ class Model:
     particle_radius: np.ndarray
     particle_color: np.ndarray
     particle_alive: np.ndarray
+    particle_pinned: np.ndarray
     particle_groups: tuple[ParticleGroup, ...] = ()
     systems: tuple[SystemInstance, ...] = ()
     forces: tuple[Force, ...] = field(default=(), repr=False)

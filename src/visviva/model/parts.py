@@ -29,7 +29,16 @@ from ..forces import (
 from ..mechanics.gravity import GRAVITATIONAL_CONSTANT
 from ..particles.emitters import SHAPES, EmitterSpec, unit_vector, value_range
 from .model import ParticleGroup
-from .scene import MAX_PARTICLES, Collider, Emitter, ForceField, ParticleCloud, Particles, Scene
+from .scene import (
+    MAX_PARTICLES,
+    Collider,
+    Emitter,
+    ForceField,
+    ParticleCloud,
+    Particles,
+    Rope,
+    Scene,
+)
 
 __all__ = [
     "Located",
@@ -131,17 +140,21 @@ def particle_arrays(
     """Initial particle state and properties of every particle entity, in entity order; an
     emitter's slots start dead. ``specs`` get their ``first_slot`` (in place in the list)."""
     columns: dict[str, list[np.ndarray]] = {
-        k: [] for k in ("position", "velocity", "mass", "radius", "color", "alive")
+        k: [] for k in ("position", "velocity", "mass", "radius", "color", "alive", "pinned")
     }
     groups: list[ParticleGroup] = []
     start = 0
     emitted = iter(range(len(specs)))
     for index, entity in enumerate(scene.entities):
-        if isinstance(entity, Particles):
-            x = np.array(entity.positions, dtype=np.float64)
+        pinned = np.zeros(0, dtype=np.int64)
+        if isinstance(entity, (Particles, Rope)):
+            x = np.array(entity.points if isinstance(entity, Rope) else entity.positions)
+            x = x.astype(np.float64)
             count = x.shape[0]
             v = np.zeros_like(x) if entity.velocities is None else np.array(entity.velocities)
             color = entity.color
+            if isinstance(entity, Rope):
+                pinned = np.array(entity.pinned, dtype=np.int64)
         elif isinstance(entity, ParticleCloud):
             count = entity.count
             rng = np.random.default_rng(entity.seed)
@@ -167,6 +180,9 @@ def particle_arrays(
         columns["radius"].append(np.broadcast_to(np.asarray(radius, dtype=np.float64), (count,)))
         columns["color"].append(np.broadcast_to(np.asarray(color, dtype=np.float64), (count, 3)))
         columns["alive"].append(np.full(count, not isinstance(entity, Emitter)))
+        held = np.zeros(count, dtype=bool)
+        held[pinned] = True
+        columns["pinned"].append(held)
         groups.append(
             ParticleGroup(names[index], index, start, count, emitted=isinstance(entity, Emitter))
         )
@@ -177,6 +193,7 @@ def particle_arrays(
         for name, parts in columns.items()
     }
     arrays["alive"] = arrays["alive"].astype(bool)
+    arrays["pinned"] = arrays["pinned"].astype(bool)
     return arrays, groups
 
 
@@ -234,6 +251,37 @@ def _force(e: ForceField, targets: Targets, mass: np.ndarray) -> Force:
     )
 
 
+def spring_forces(scene: Scene, groups: Sequence[ParticleGroup], count: int) -> list[Force]:
+    """The springs of each rope: a stretch spring between consecutive points, and a bending
+    spring between points two apart if ``bending`` > 0, each at rest at its initial length."""
+    from ..forces import Springs
+
+    forces: list[Force] = []
+    starts = {g.entity: g.start for g in groups}
+    for index, entity in enumerate(scene.entities):
+        if not isinstance(entity, Rope):
+            continue
+        n, first = len(entity.points), starts[index]
+        points = np.array(entity.points, dtype=np.float64)
+        pairs = [np.stack([np.arange(n - 1), np.arange(1, n)], axis=1)]
+        stiffness = [np.full(n - 1, entity.stiffness)]
+        if entity.bending > 0.0 and n > 2:
+            pairs.append(np.stack([np.arange(n - 2), np.arange(2, n)], axis=1))
+            stiffness.append(np.full(n - 2, entity.bending))
+        local = np.concatenate(pairs)
+        rest = np.linalg.norm(points[local[:, 1]] - points[local[:, 0]], axis=1)
+        if not (rest > 0.0).all():
+            a, b = local[int(np.argmin(rest > 0.0))]
+            raise Located(
+                f"entities[{index}].points",
+                f"points {a} and {b} coincide: the spring between them needs a rest length > 0",
+            )
+        forces.append(
+            Springs(local + first, rest, np.concatenate(stiffness), entity.damping, count)
+        )
+    return forces
+
+
 def _colliders(scene: Scene, response: str) -> list[tuple[int, Collider]]:
     """The colliders of one response, planes first (the kernels' fast path; see
     :class:`~visviva.collision.ColliderSet`)."""
@@ -262,12 +310,15 @@ def _shape(e: Collider, where: str) -> Any:
         raise Located(where, str(error)) from None
 
 
-def collision_stage(scene: Scene, groups: Sequence[ParticleGroup], count: int, h: float) -> Any:
-    """The collision stage of the impulse colliders, or ``None`` if there are none."""
+def collision_stage(
+    scene: Scene, groups: Sequence[ParticleGroup], pinned: np.ndarray, h: float
+) -> Any:
+    """The collision stage of the impulse colliders, or ``None`` if there are none (``pinned``
+    particles meet none: nothing moves them)."""
     from ..collision import MAX_COLLIDERS, ColliderResponse, ColliderSet, ParticleCollisions
 
     chosen = _colliders(scene, "impulse")
-    if not chosen or not count:
+    if not chosen or not pinned.shape[0]:
         return None
     if len(chosen) > MAX_COLLIDERS:
         raise Located(
@@ -275,9 +326,7 @@ def collision_stage(scene: Scene, groups: Sequence[ParticleGroup], count: int, h
             f"a scene may hold at most {MAX_COLLIDERS} impulse colliders",
         )
     shapes = [_shape(e, f"entities[{i}]") for i, e in chosen]
-    masks = np.zeros(count, dtype=np.uint64)
-    for bit, (_, e) in enumerate(chosen):
-        masks[_targets(e, groups, count).indices] |= np.uint64(1) << np.uint64(bit)
+    masks = _masks(chosen, groups, pinned)
     response = ColliderResponse(
         restitution=[e.restitution for _, e in chosen],
         friction=[e.friction for _, e in chosen],
@@ -288,35 +337,42 @@ def collision_stage(scene: Scene, groups: Sequence[ParticleGroup], count: int, h
 
 
 def penalty_forces(
-    scene: Scene,
-    groups: Sequence[ParticleGroup],
-    mass: np.ndarray,
-    radius: np.ndarray,
-    h: float,
+    scene: Scene, groups: Sequence[ParticleGroup], arrays: dict[str, np.ndarray], h: float
 ) -> list[Force]:
-    """The penalty-contact force of the penalty colliders (empty list if there are none); ``h``
-    [s] is the integrator step (a contact rests below the speed gravity gives in two)."""
+    """The penalty-contact force of the penalty colliders (empty list if there are none), on
+    the particles' ``arrays`` (``mass``, ``radius``, ``pinned``); ``h`` [s] is the integrator
+    step (a contact rests below the speed gravity gives in two)."""
     from ..collision import ColliderSet, PenaltyContact
 
     chosen = _colliders(scene, "penalty")
-    count = mass.shape[0]
-    if not chosen or not count:
+    if not chosen or not arrays["mass"].shape[0]:
         return []
     shapes = [_shape(e, f"entities[{i}]") for i, e in chosen]
-    masks = np.zeros(count, dtype=np.uint64)
-    for bit, (_, e) in enumerate(chosen):
-        masks[_targets(e, groups, count).indices] |= np.uint64(1) << np.uint64(bit)
+    masks = _masks(chosen, groups, arrays["pinned"])
     return [
         PenaltyContact(
             ColliderSet(shapes),
             stiffness=[e.stiffness for _, e in chosen],  # type: ignore[misc]
             damping=[e.damping or 0.0 for _, e in chosen],
             masks=masks,
-            radius=radius,
+            radius=arrays["radius"],
             labels=_labels(chosen),
             resting_speed=_resting_speeds(scene, chosen, h),
         )
     ]
+
+
+def _masks(
+    chosen: Sequence[tuple[int, Collider]], groups: Sequence[ParticleGroup], pinned: np.ndarray
+) -> np.ndarray:
+    """Bit ``k`` of ``masks[i]`` set where particle ``i`` meets collider ``k`` (pinned
+    particles meet none)."""
+    count = pinned.shape[0]
+    masks = np.zeros(count, dtype=np.uint64)
+    for bit, (_, e) in enumerate(chosen):
+        masks[_targets(e, groups, count).indices] |= np.uint64(1) << np.uint64(bit)
+    masks[pinned] = 0
+    return masks
 
 
 def _resting_speeds(scene: Scene, chosen: Sequence[tuple[int, Collider]], h: float) -> list[float]:

@@ -41,6 +41,7 @@ __all__ = [
     "Output",
     "ParticleCloud",
     "Particles",
+    "Rope",
     "Scene",
     "SceneInfo",
     "System",
@@ -178,6 +179,48 @@ class ParticleCloud(_Strict):
     radius: Positive = Field(0.02, description="radius of each particle [m]")
     color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
     seed: Annotated[int, Field(strict=True, ge=0, lt=2**63)] = Field(0, description="random seed")
+
+
+class Rope(_Strict):
+    """``type = "rope"``: particles at ``points`` joined in order by damped springs (seed 002).
+
+    Each consecutive pair is a stretch spring of ``stiffness`` k [N/m] and ``damping`` c
+    [N·s/m] along the spring, at rest at the points' distance; ``bending`` > 0 adds springs
+    between particles two apart, which resist bending (and, seed 000 warns, also stretch).
+    Particles listed in ``pinned`` stay where they are.
+    """
+
+    type: Literal["rope"]
+    name: Name | None = None
+    points: Annotated[list[Vector], Field(min_length=2)] = Field(
+        description="positions of the particles along the rope [m], in order"
+    )
+    velocities: list[Vector] | None = Field(None, description="initial velocities [m/s]")
+    mass: Positive | Annotated[list[Positive], Field(min_length=1)] = Field(
+        1.0, description="mass of each particle [kg]: one value or one per point"
+    )
+    stiffness: Positive = Field(description="stiffness k of each stretch spring [N/m]")
+    damping: NonNegative = Field(0.0, description="damping c of each spring [N s/m]")
+    bending: NonNegative = Field(
+        0.0, description="stiffness of the springs between particles two apart [N/m] (0: none)"
+    )
+    pinned: list[Annotated[int, Field(strict=True, ge=0)]] = Field(
+        default_factory=list, description="indices of the points held fixed"
+    )
+    radius: Positive = Field(0.02, description="radius of each particle [m]")
+    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
+
+    @model_validator(mode="after")
+    def _pins_on_the_rope(self) -> Rope:
+        count = len(self.points)
+        outside = [i for i in self.pinned if i >= count]
+        if outside:
+            raise PydanticCustomError(
+                "pin_out_of_range",
+                "pinned index {index} is not a point of this rope (it has {count}: 0 to {last})",
+                {"index": outside[0], "count": count, "last": count - 1},
+            )
+        return self
 
 
 class System(_Strict):
@@ -506,12 +549,13 @@ class Collider(_Strict):
 
 
 Entity = Annotated[
-    Particles | ParticleCloud | Emitter | System | ForceField | Collider,
+    Particles | ParticleCloud | Rope | Emitter | System | ForceField | Collider,
     Field(discriminator="type"),
 ]
 ENTITY_TYPES: dict[str, type[BaseModel]] = {
     "particles": Particles,
     "particle_cloud": ParticleCloud,
+    "rope": Rope,
     "emitter": Emitter,
     "system": System,
     "force": ForceField,

@@ -107,11 +107,24 @@ def scene_system(model: Model) -> System:
         np.zeros(n + model.coordinate_count),
     )
 
+    # Pinned particles feel no net force, so they keep their place (and zero velocity) under
+    # every integrator, explicit or implicit: their rows and columns of the Jacobians are
+    # zero too, which takes them out of Newton's linear systems.
+    held = np.flatnonzero(np.repeat(model.particle_pinned, 3))
+    free = None
+    if held.shape[0]:
+        import scipy.sparse as sp
+
+        keep = np.ones(n, dtype=np.float64)
+        keep[held] = 0.0
+        free = sp.diags(keep)
+
     def force(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         out = np.zeros_like(q)
         if count:
             shape = (count, 3)
             forces.accumulate(t, q[:n].reshape(shape), v[:n].reshape(shape), out[:n].reshape(shape))
+            out[held] = 0.0
         for a, b, piece in pieces:
             out[a:b] = piece.acceleration(t, q[a:b], v[a:b])
         return out
@@ -123,8 +136,11 @@ def scene_system(model: Model) -> System:
         if count:
             shape = (count, 3)
             dfdx, dfdv = forces.jacobian(t, q[:n].reshape(shape), v[:n].reshape(shape))
+            dfdv = dfdv if dfdv is not None else sp.csr_matrix((n, n))
+            if free is not None:
+                dfdx, dfdv = free @ dfdx @ free, free @ dfdv @ free
             stiffness.append(dfdx)
-            damping.append(dfdv if dfdv is not None else sp.csr_matrix((n, n)))
+            damping.append(dfdv)
         for a, b, piece in pieces:
             dq, dv = piece.force_jacobian(t, q[a:b], v[a:b])
             stiffness.append(sp.csr_matrix(dq))

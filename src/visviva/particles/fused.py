@@ -108,9 +108,12 @@ class FusedParticles:
     @classmethod
     def of(cls, model: Any, method: str) -> FusedParticles | None:
         """The fused step of ``model`` for ``method``, or ``None`` if it has none: the method
-        must be symplectic Euler, the scene made only of particles, every force a field
-        (gravitation and penalty contact are not), every stage collisions or emission."""
+        must be symplectic Euler, the scene made only of free particles (none pinned), every
+        force a field (gravitation, springs and penalty contact are not), every stage
+        collisions or emission."""
         if method != "symplectic_euler" or model.systems or not model.particle_count:
+            return None
+        if model.particle_pinned.any():
             return None
         if not all(isinstance(f, _FIELDS) for f in model.forces):
             return None
