@@ -29,6 +29,7 @@ from .parts import (
 )
 from .scene import (
     MAX_PARTICLES,
+    Cloth,
     Collider,
     Emitter,
     ForceField,
@@ -43,7 +44,7 @@ from .systems import SYSTEMS
 __all__ = ["build_model", "entity_names"]
 
 #: Entities that hold particles (which forces and colliders may target).
-PARTICLE_ENTITIES = (Particles, ParticleCloud, Rope, Emitter)
+PARTICLE_ENTITIES = (Particles, ParticleCloud, Rope, Cloth, Emitter)
 
 
 def entity_names(scene: Scene) -> list[str]:
@@ -71,7 +72,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     except Located as located:
         raise SceneError([located.problem]) from None
     slots = sum(s.capacity for s in specs) + sum(
-        _count(e) for e in scene.entities if isinstance(e, (Particles, ParticleCloud, Rope))
+        _count(e) for e in scene.entities if isinstance(e, (Particles, ParticleCloud, Rope, Cloth))
     )
     if slots > MAX_PARTICLES:
         raise SceneError(
@@ -256,8 +257,8 @@ def _check(scene: Scene) -> list[SceneProblem]:
         if isinstance(entity, (Particles, Rope)):
             total += _count(entity)
             problems += _check_lengths(entity, where)
-        elif isinstance(entity, ParticleCloud):
-            total += entity.count
+        elif isinstance(entity, (ParticleCloud, Cloth)):
+            total += _count(entity)
         elif isinstance(entity, System):
             problems += _check_system(entity, where)
     if total > MAX_PARTICLES:
@@ -346,12 +347,14 @@ def _check_first_order(scene: Scene) -> list[SceneProblem]:
     return []
 
 
-def _count(entity: Particles | ParticleCloud | Rope) -> int:
+def _count(entity: Particles | ParticleCloud | Rope | Cloth) -> int:
     """How many particles an entity that lists or counts them holds."""
     if isinstance(entity, Particles):
         return len(entity.positions)
     if isinstance(entity, Rope):
         return len(entity.points)
+    if isinstance(entity, Cloth):
+        return entity.resolution[0] * entity.resolution[1]
     return entity.count
 
 

@@ -19,6 +19,7 @@ from ..errors import SceneError
 from .build import build_model
 from .model import Model
 from .scene import (
+    Cloth,
     Collider,
     Emitter,
     ForceField,
@@ -157,6 +158,33 @@ class SceneBuilder:
         ``bending`` [N/m] > 0 adds springs between points two apart; the points ``pinned``
         (indices) stay where they are."""
         return self._add(Rope, "rope", _given(locals()))
+
+    def add_cloth(
+        self,
+        resolution: Sequence[int],
+        *,
+        stretch: float,
+        origin: Vector | None = None,
+        along: Vector | None = None,
+        across: Vector | None = None,
+        density: float | None = None,
+        shear: float | None = None,
+        bend: float | None = None,
+        damping: float | None = None,
+        pinned: Sequence[int] | None = None,
+        velocity: Vector | None = None,
+        radius: float | None = None,
+        color: Vector | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add a cloth: ``resolution`` = (nu, nv) points on a grid spanning ``origin + s·along
+        + t·across`` [m], of areal ``density`` [kg/m²], with structural springs of ``stretch``
+        [N/m], shear springs of ``shear`` (default ``stretch``) and bend springs of ``bend``
+        (default none), each with ``damping`` [N·s/m]; point (i, j) has index j·nu + i, and
+        the points ``pinned`` stay where they are."""
+        given = _given(locals())
+        given["resolution"] = tuple(given["resolution"])
+        return self._add(Cloth, "cloth", given)
 
     def add_system(
         self, system: str, parameters: Mapping[str, float] | None = None, *, name: str | None = None

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ..deformables import SpringNetwork, cloth_grid, rope
 from ..errors import ModelError, SceneProblem
 from ..forces import (
     Attractor,
@@ -31,6 +32,7 @@ from ..particles.emitters import SHAPES, EmitterSpec, unit_vector, value_range
 from .model import ParticleGroup
 from .scene import (
     MAX_PARTICLES,
+    Cloth,
     Collider,
     Emitter,
     ForceField,
@@ -147,6 +149,7 @@ def particle_arrays(
     emitted = iter(range(len(specs)))
     for index, entity in enumerate(scene.entities):
         pinned = np.zeros(0, dtype=np.int64)
+        mass = None
         if isinstance(entity, (Particles, Rope)):
             x = np.array(entity.points if isinstance(entity, Rope) else entity.positions)
             x = x.astype(np.float64)
@@ -155,6 +158,13 @@ def particle_arrays(
             color = entity.color
             if isinstance(entity, Rope):
                 pinned = np.array(entity.pinned, dtype=np.int64)
+        elif isinstance(entity, Cloth):
+            sheet = spring_network(entity)
+            x, mass = sheet.points, sheet.mass
+            count = x.shape[0]
+            v = np.broadcast_to(np.asarray(entity.velocity, dtype=np.float64), (count, 3))
+            color = entity.color
+            pinned = np.array(entity.pinned, dtype=np.int64)
         elif isinstance(entity, ParticleCloud):
             count = entity.count
             rng = np.random.default_rng(entity.seed)
@@ -174,7 +184,8 @@ def particle_arrays(
             continue
         columns["position"].append(x)
         columns["velocity"].append(np.asarray(v, dtype=np.float64))
-        mass = specs[k].mass if isinstance(entity, Emitter) else entity.mass
+        if mass is None:
+            mass = specs[k].mass if isinstance(entity, Emitter) else entity.mass
         radius = specs[k].particle_radius[0] if isinstance(entity, Emitter) else entity.radius
         columns["mass"].append(np.broadcast_to(np.asarray(mass, dtype=np.float64), (count,)))
         columns["radius"].append(np.broadcast_to(np.asarray(radius, dtype=np.float64), (count,)))
@@ -252,34 +263,43 @@ def _force(e: ForceField, targets: Targets, mass: np.ndarray) -> Force:
 
 
 def spring_forces(scene: Scene, groups: Sequence[ParticleGroup], count: int) -> list[Force]:
-    """The springs of each rope: a stretch spring between consecutive points, and a bending
-    spring between points two apart if ``bending`` > 0, each at rest at its initial length."""
+    """The springs of each rope and cloth (see :mod:`visviva.deformables.topology`), each at
+    rest at its initial length."""
     from ..forces import Springs
 
     forces: list[Force] = []
     starts = {g.entity: g.start for g in groups}
     for index, entity in enumerate(scene.entities):
-        if not isinstance(entity, Rope):
+        if not isinstance(entity, (Rope, Cloth)):
             continue
-        n, first = len(entity.points), starts[index]
-        points = np.array(entity.points, dtype=np.float64)
-        pairs = [np.stack([np.arange(n - 1), np.arange(1, n)], axis=1)]
-        stiffness = [np.full(n - 1, entity.stiffness)]
-        if entity.bending > 0.0 and n > 2:
-            pairs.append(np.stack([np.arange(n - 2), np.arange(2, n)], axis=1))
-            stiffness.append(np.full(n - 2, entity.bending))
-        local = np.concatenate(pairs)
-        rest = np.linalg.norm(points[local[:, 1]] - points[local[:, 0]], axis=1)
-        if not (rest > 0.0).all():
-            a, b = local[int(np.argmin(rest > 0.0))]
-            raise Located(
-                f"entities[{index}].points",
-                f"points {a} and {b} coincide: the spring between them needs a rest length > 0",
-            )
-        forces.append(
-            Springs(local + first, rest, np.concatenate(stiffness), entity.damping, count)
-        )
+        network = spring_network(entity)
+        try:
+            rest = network.rest_length()
+        except ModelError as error:
+            field = "points" if isinstance(entity, Rope) else "resolution"
+            raise Located(f"entities[{index}].{field}", str(error)) from None
+        first = starts[index]
+        pairs = network.pairs + first
+        forces.append(Springs(pairs, rest, network.stiffness, entity.damping, count))
     return forces
+
+
+def spring_network(entity: Rope | Cloth) -> SpringNetwork:
+    """The particles and springs of a rope or cloth entity."""
+    if isinstance(entity, Rope):
+        points = np.array(entity.points, dtype=np.float64)
+        mass = np.broadcast_to(np.asarray(entity.mass, dtype=np.float64), (points.shape[0],))
+        return rope(points, mass, entity.stiffness, entity.bending)
+    return cloth_grid(
+        np.asarray(entity.origin, dtype=np.float64),
+        np.asarray(entity.along, dtype=np.float64),
+        np.asarray(entity.across, dtype=np.float64),
+        entity.resolution,
+        entity.density,
+        entity.stretch,
+        entity.stretch if entity.shear is None else entity.shear,
+        entity.bend,
+    )
 
 
 def _colliders(scene: Scene, response: str) -> list[tuple[int, Collider]]:

@@ -33,6 +33,7 @@ __all__ = [
     "MAX_PARTICLES",
     "OUTPUT_FORMATS",
     "Burst",
+    "Cloth",
     "Collider",
     "Emitter",
     "Entity",
@@ -218,6 +219,57 @@ class Rope(_Strict):
             raise PydanticCustomError(
                 "pin_out_of_range",
                 "pinned index {index} is not a point of this rope (it has {count}: 0 to {last})",
+                {"index": outside[0], "count": count, "last": count - 1},
+            )
+        return self
+
+
+class Cloth(_Strict):
+    """``type = "cloth"``: a sheet of ``resolution`` = [nu, nv] particles on a grid spanning
+    ``origin + s·along + t·across`` (s, t in [0, 1]), joined by structural (``stretch``), shear
+    (cell diagonals) and bend (two apart) springs (Choi & Ko 2002). Point (i, j) has index
+    j·nu + i. Each point weighs ``density`` times its share of the cells around it."""
+
+    type: Literal["cloth"]
+    name: Name | None = None
+    origin: Vector = Field((0.0, 1.0, 0.0), description="position of point (0, 0) [m]")
+    along: Vector = Field((1.0, 0.0, 0.0), description="edge from point (0, 0) to (nu − 1, 0) [m]")
+    across: Vector = Field((0.0, 0.0, 1.0), description="edge from point (0, 0) to (0, nv − 1) [m]")
+    resolution: tuple[
+        Annotated[int, Field(strict=True, ge=2, le=4096)],
+        Annotated[int, Field(strict=True, ge=2, le=4096)],
+    ] = Field(description="points along and across [nu, nv]")
+    density: Positive = Field(0.2, description="mass per area [kg/m²]")
+    stretch: Positive = Field(description="stiffness of the structural springs [N/m]")
+    shear: NonNegative | None = Field(
+        None, description="stiffness of the shear springs [N/m] (default: stretch; 0: none)"
+    )
+    bend: NonNegative = Field(0.0, description="stiffness of the bend springs [N/m] (0: none)")
+    damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
+    pinned: list[Annotated[int, Field(strict=True, ge=0)]] = Field(
+        default_factory=list, description="indices (j·nu + i) of the points held fixed"
+    )
+    velocity: Vector = Field((0.0, 0.0, 0.0), description="initial velocity [m/s]")
+    radius: Positive = Field(0.01, description="radius of each particle [m]")
+    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
+
+    @model_validator(mode="after")
+    def _a_sheet(self) -> Cloth:
+        a, b = self.along, self.across
+        normal = (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+        if not any(normal):
+            raise PydanticCustomError(
+                "no_area",
+                "`along` {along} and `across` {across} are parallel or zero: the sheet has no "
+                "area; give two edges at an angle",
+                {"along": list(a), "across": list(b)},
+            )
+        count = self.resolution[0] * self.resolution[1]
+        outside = [i for i in self.pinned if i >= count]
+        if outside:
+            raise PydanticCustomError(
+                "pin_out_of_range",
+                "pinned index {index} is not a point of this cloth (it has {count}: 0 to {last})",
                 {"index": outside[0], "count": count, "last": count - 1},
             )
         return self
@@ -549,13 +601,14 @@ class Collider(_Strict):
 
 
 Entity = Annotated[
-    Particles | ParticleCloud | Rope | Emitter | System | ForceField | Collider,
+    Particles | ParticleCloud | Rope | Cloth | Emitter | System | ForceField | Collider,
     Field(discriminator="type"),
 ]
 ENTITY_TYPES: dict[str, type[BaseModel]] = {
     "particles": Particles,
     "particle_cloud": ParticleCloud,
     "rope": Rope,
+    "cloth": Cloth,
     "emitter": Emitter,
     "system": System,
     "force": ForceField,

@@ -1,0 +1,86 @@
+"""Cloth grids (Choi & Ko 2002): the spring families and masses of the topology, and the stiff
+cloth of the issue: implicit Euler's energy never increases and the strain stays within 1 %,
+while symplectic Euler at the same step blows up within 10 steps."""
+
+import numpy as np
+import pytest
+
+import visviva as vv
+from visviva.deformables import cloth_grid
+from visviva.deformables.topology import BEND, SHEAR, STRETCH
+from visviva.forces import Springs
+
+
+def test_a_grid_has_its_three_spring_families_and_weighs_density_times_area():
+    sheet = cloth_grid(
+        np.zeros(3), np.array([2.0, 0, 0]), np.array([0, 0, 1.0]), (10, 6), 0.3, 100, 50, 5
+    )
+    counts = {f: int((sheet.family == f).sum()) for f in (STRETCH, SHEAR, BEND)}
+    # Structural: 9·6 along + 10·5 across; shear: two per cell; bend: 8·6 + 10·4.
+    assert counts == {STRETCH: 9 * 6 + 10 * 5, SHEAR: 2 * 9 * 5, BEND: 8 * 6 + 10 * 4}
+    assert sheet.mass.sum() == pytest.approx(0.3 * 2.0 * 1.0)
+    cell = 0.3 * (2.0 / 9) * (1.0 / 5)
+    assert sheet.mass[0] == pytest.approx(cell / 4)  # a corner: a quarter cell
+    assert sheet.mass[1] == pytest.approx(cell / 2)  # an edge: half of two cells
+    assert sheet.mass[11] == pytest.approx(cell)  # inside: a quarter of four cells
+    np.testing.assert_allclose(sheet.points[10 * 5 + 9], [2.0, 0.0, 1.0])  # index j·nu + i
+    lengths = sheet.rest_length()
+    np.testing.assert_allclose(lengths[sheet.family == BEND][:8], 2 * 2.0 / 9)
+
+
+def _stiff_cloth(method: str) -> vv.Simulation:
+    builder = vv.SceneBuilder(name="stiff cloth")
+    builder.set_integration(method=method, dt=1 / 60, duration=2.0)
+    builder.add_cloth(
+        (10, 10), stretch=1e3, bend=10.0, density=0.2, pinned=[0, 9], name="sheet"
+    )  # 1 m × 1 m, horizontal, held at two corners
+    return vv.Simulation(builder.build())
+
+
+def test_stiff_cloth_implicit_euler_loses_energy_and_barely_stretches():
+    simulation = _stiff_cloth("backward_euler")
+    (springs,) = [f for f in simulation.model.forces if isinstance(f, Springs)]
+    energy = [simulation.energy()]
+    strain = 0.0
+    for _ in range(120):
+        simulation.step()
+        energy.append(simulation.energy())
+        x = simulation.raw_state["particle_position"]
+        length = np.linalg.norm(x[springs.pairs[:, 1]] - x[springs.pairs[:, 0]], axis=1)
+        strain = max(strain, float(np.abs(length / springs.rest_length - 1.0).max()))
+    # Backward Euler dissipates: the energy (kinetic + springs + gravity) never increases.
+    assert np.diff(energy).max() <= 1e-9 * abs(energy[0])
+    assert strain <= 0.01
+    assert simulation.raw_state["particle_position"][45, 1] < 0.5  # it has fallen and hangs
+
+
+def test_stiff_cloth_symplectic_euler_blows_up_within_ten_steps():
+    # ω = √(k/m) ≈ √(1e3 / 2e-3) ≈ 700/s for an inside point: h ω ≈ 12 ≫ 2.
+    simulation = _stiff_cloth("symplectic_euler")
+    with pytest.raises(vv.SimulationDiverged) as blow_up:
+        simulation.step(10)
+    assert blow_up.value.step < 10
+
+
+def test_pinned_corners_stay_bit_identical():
+    simulation = _stiff_cloth("backward_euler")
+    start = simulation.state["particle_position"][[0, 9]]
+    simulation.step(30)
+    np.testing.assert_array_equal(simulation.state["particle_position"][[0, 9]], start)
+
+
+@pytest.mark.parametrize(
+    ("cloth", "message"),
+    [
+        ({"along": (1.0, 0.0, 0.0), "across": (2.0, 0.0, 0.0)}, "the sheet has no area"),
+        ({"pinned": [100]}, "pinned index 100 is not a point of this cloth"),
+        ({"resolution": (1, 5)}, "resolution"),
+        ({"stretch": -1.0}, "stretch"),
+    ],
+)
+def test_bad_cloth_is_refused_naming_the_field(cloth, message):
+    arguments = {"resolution": (10, 10), "stretch": 100.0} | cloth
+    builder = vv.SceneBuilder(name="bad")
+    with pytest.raises(vv.ModelError, match=message):
+        builder.add_cloth(**arguments)
+        builder.build()
