@@ -186,3 +186,33 @@ def test_stiff_decay_is_handled_by_backward_euler_not_explicit():
     implicit = vv.solve(problem, "backward_euler", dt=0.01, t_end=10.0)
     # After the transient, y follows cos t to O(1/|λ|) plus the O(h) method error.
     np.testing.assert_allclose(implicit.y[50:, 0], np.cos(implicit.t[50:]), atol=2e-3)
+
+
+def test_line_search_rescues_newton_where_full_steps_diverge(monkeypatch):
+    """A block braking under smoothed Coulomb friction, F = −(2/π) μ m g atan(v/ε): with a
+    large step, full Newton steps on backward Euler's equation v − v_n + h μ g (2/π) atan(v/ε)
+    = 0 overshoot like Newton on atan and diverge; backtracking on the residual's norm
+    converges to the root, which the test checks against bisection."""
+    mu_g, eps, h, v0 = 300.0, 0.01, 0.5, 3.0  # h μ g (2/π) ≈ 95: the root is near 3e-4 m/s
+
+    def force(t, q, v):
+        return -mu_g * (2 / np.pi) * np.arctan(v / eps)
+
+    def jacobian(t, q, v):
+        return np.zeros((1, 1)), np.array([[-mu_g * (2 / np.pi) / (eps * (1 + (v[0] / eps) ** 2))]])
+
+    problem = vv.ode.SecondOrderProblem(force, [0.0], [v0], jacobian=jacobian)
+    solution = vv.solve(problem, "backward_euler", dt=h, t_end=h)
+    assert solution.success and solution.recording.attrs["line_search_steps"] > 0
+
+    def residual(v):
+        return v - v0 - h * force(0.0, 0.0, v)
+
+    low, high = -v0, v0
+    for _ in range(200):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if residual(middle) < 0 else (low, middle)
+    np.testing.assert_allclose(solution.v[-1, 0], 0.5 * (low + high), rtol=1e-9)
+    # Without it, the full steps fly off and the step fails (with a clear error).
+    monkeypatch.setattr("visviva.integrators.newton.LINE_SEARCH_HALVINGS", 0)
+    assert not vv.solve(problem, "backward_euler", dt=h, t_end=h).success

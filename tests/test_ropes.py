@@ -115,3 +115,16 @@ def test_bad_ropes_are_refused_naming_the_field(rope, message):
     with pytest.raises(vv.ModelError, match=message):
         builder.add_rope(**arguments)
         builder.build()
+
+
+def test_recordings_draw_the_stretch_springs_as_edges(tmp_path):
+    builder = vv.SceneBuilder(name="drawn")
+    builder.set_integration(method="backward_euler", dt=0.01, duration=0.05)
+    builder.add_particles([[5.0, 0.0, 0.0]], name="loose")
+    builder.add_rope([[0, 0, 0], [0, -1, 0], [0, -2, 0], [0, -3, 0]], stiffness=50.0,
+                     bending=5.0, color=(0.9, 0.2, 0.1))  # fmt: skip
+    vv.run_scene(builder.build(), tmp_path)
+    recording = vv.io.load_recording(tmp_path / "recording.h5")
+    # The rope's points follow the loose particle (slots 1–4); bend springs are not drawn.
+    np.testing.assert_array_equal(recording.static["edges"], [[1, 2], [2, 3], [3, 4]])
+    np.testing.assert_allclose(recording.static["color"][1:], [[0.9, 0.2, 0.1]] * 4)

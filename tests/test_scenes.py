@@ -102,7 +102,7 @@ def test_example_scenes_validate_and_run_shortened(tmp_path):
         assert summary["success"] is True
         assert summary["steps"] == round(duration / model.integration.dt)
         assert {p.name for p in written} >= {"recording.h5", "summary.json"}
-    assert kinds >= {"Particles", "ParticleCloud", "System"}
+    assert kinds >= {"Particles", "ParticleCloud", "System", "Cloth"}
 
 
 def test_free_fall_matches_the_parabola(tmp_path):
@@ -204,6 +204,8 @@ def test_cli_validate_schema_dry_run_and_plot(tmp_path):
     assert set(discriminator["mapping"]) == {
         "particles",
         "particle_cloud",
+        "rope",
+        "cloth",
         "emitter",
         "system",
         "force",

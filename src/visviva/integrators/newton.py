@@ -51,6 +51,10 @@ KRYLOV_THRESHOLD = 1000
 #: Relative residual GMRES reaches in each Newton iteration: small enough that the Newton
 #: update, and so the stopping rule, is the one a direct solve would give.
 KRYLOV_RTOL = 1e-9
+#: Armijo's fraction: a step must shrink the residual's norm by at least this share of the step.
+ARMIJO = 1e-4
+#: Halvings a backtracking line search may take (the last step is 1/64 of Newton's).
+LINE_SEARCH_HALVINGS = 6
 #: GMRES restart length and restarts allowed per linear solve.
 KRYLOV_RESTART = 40
 KRYLOV_MAX_RESTARTS = 10
@@ -140,13 +144,16 @@ def _solve_second_order(
     mass = system.mass
     v = v_base.copy()
     matrix_free = _matrix_free(system, v)
+    # The last step, to back along if it made the residual grow: (V before it, the update,
+    # the residual's norm before it).
+    last: tuple[np.ndarray, np.ndarray, float] | None = None
     iteration, norm = 0, np.inf
     while iteration < options.max_iterations:
         iteration += 1
-        q = q_base + theta_h * v
-        force = system.force(t, q, v)
-        momentum_change = v - v_base if mass is None else mass.apply(v - v_base)
-        residual = momentum_change - theta_h * force
+        q, force, residual = _stage_residual(system, t, q_base, v_base, v, theta_h)
+        if last is not None and v.ndim == 1:
+            full = (q, force, residual)
+            v, q, force, residual = _backtrack(system, t, q_base, v_base, theta_h, full, last)
         if matrix_free:
             product = _mass_minus_product(system, t, q, v.copy(), force, theta_h)
             update = _krylov_solve(system, product, -residual, mass)
@@ -154,7 +161,8 @@ def _solve_second_order(
             stiffness, damping = system.force_jacobian(t, q, v, force)
             matrix = _mass_minus(mass, damping, stiffness, theta_h, v.shape)
             update = _linear_solve(system, matrix, -residual)
-        v += update
+        last = (v.copy(), update, float(np.linalg.norm(residual)))
+        v = v + update
         system.counters.newton_iterations += 1
         norm = _update_norm(update, v, options)
         if norm <= 1.0:
@@ -162,6 +170,54 @@ def _solve_second_order(
         if not np.isfinite(norm):
             break
     raise _failure(t, iteration, norm)
+
+
+def _stage_residual(
+    system: SecondOrderSystem,
+    t: float,
+    q_base: np.ndarray,
+    v_base: np.ndarray,
+    v: np.ndarray,
+    theta_h: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``Q``, ``F(t, Q, V)`` and the residual ``M (V − v_b) − θh F`` at the velocity ``V``."""
+    q = q_base + theta_h * v
+    force = system.force(t, q, v)
+    momentum_change = v - v_base if system.mass is None else system.mass.apply(v - v_base)
+    return q, force, momentum_change - theta_h * force
+
+
+def _backtrack(
+    system: SecondOrderSystem,
+    t: float,
+    q_base: np.ndarray,
+    v_base: np.ndarray,
+    theta_h: float,
+    full: tuple[np.ndarray, np.ndarray, np.ndarray],
+    last: tuple[np.ndarray, np.ndarray, float],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The iterate after the last Newton step (``full``: its ``Q``, force and residual),
+    shortened — halved up to :data:`LINE_SEARCH_HALVINGS` times — until the residual's norm
+    has decreased by Armijo's fraction. A full step that decreases it, the rule near a
+    solution, costs nothing extra.
+
+    Far from a solution a full step can overshoot: a cloth buckling against a collider makes
+    its springs' stiffness indefinite and Newton's linear model wrong. The residual is the
+    merit function rather than an energy because damping and fields without a potential have
+    none.
+    """
+    v_before, update, norm_before = last
+    q, force, residual = full
+    v = v_before + update
+    step = 1.0
+    for _ in range(LINE_SEARCH_HALVINGS):
+        if np.linalg.norm(residual) <= (1.0 - ARMIJO * step) * norm_before:
+            break
+        step *= 0.5
+        system.counters.line_search_steps += 1
+        v = v_before + step * update
+        q, force, residual = _stage_residual(system, t, q_base, v_base, v, theta_h)
+    return v, q, force, residual
 
 
 def _matrix_free(system: System, state: np.ndarray) -> bool:

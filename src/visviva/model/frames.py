@@ -14,7 +14,8 @@ Per frame (:func:`frame_fields`), following the recording convention of
     color                 (P, 3)       with colour ramps: sRGB colours in [0, 1]
 
 Once (:func:`static_fields`): the radii and colours that do not change, particle masses, and
-the systems' edges (point indices, shifted past the particles).
+the edges to draw between points: the stretch springs of ropes and cloth, then the systems'
+links (point indices, shifted past the particles).
 """
 
 from __future__ import annotations
@@ -96,6 +97,8 @@ def frame_fields(model: Model, state: State) -> dict[str, np.ndarray]:
 def _colors(model: Model, state: State) -> np.ndarray:
     """Particle colours: each emitter's ramp at its particles' age fractions."""
     colors = np.array(model.particle_color)
+    if not model.emitters:
+        return colors
     age, lifetime = state["particle_age"], state["particle_lifetime"]
     for spec in model.emitters:
         slots = slice(spec.first_slot, spec.first_slot + spec.capacity)
@@ -124,7 +127,7 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
             )
         if not _varying_color(model) and (model.emitters or np.any(model.particle_color != 1.0)):
             static["color"] = np.concatenate([_colors(model, start), np.ones((extra, 3))])
-    edges, first = [], count
+    edges, first = _spring_edges(model), count
     for system, points in zip(
         [s for s in model.systems if SYSTEMS[s.system].draw is not None],
         _system_points(model, start),
@@ -137,3 +140,18 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
     if edges:
         static["edges"] = np.concatenate(edges)
     return static
+
+
+def _spring_edges(model: Model) -> list[np.ndarray]:
+    """The stretch springs of each rope and cloth, as pairs of point indices (the shear and
+    bend springs are not drawn: they cross the fabric)."""
+    from ..deformables.topology import STRETCH
+    from .parts import spring_network
+
+    starts = {g.entity: g.start for g in model.particle_groups}
+    edges = []
+    for index, entity in enumerate(model.scene.entities):
+        if entity.type in ("rope", "cloth"):
+            network = spring_network(entity)  # type: ignore[arg-type]
+            edges.append(network.pairs[network.family == STRETCH] + starts[index])
+    return edges

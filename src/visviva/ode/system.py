@@ -44,6 +44,8 @@ class WorkCounters:
         newton_iterations: Newton iterations of implicit methods.
         krylov_iterations: Inner GMRES iterations of matrix-free (Newton–Krylov) linear solves;
             each costs one evaluation of ``f``, counted in ``f_evaluations`` too.
+        line_search_steps: Newton steps shortened by the line search of implicit methods (each
+            costs one evaluation of the force, counted in ``f_evaluations`` too).
         accepted_steps: Steps taken (for adaptive methods, the accepted ones).
         rejected_steps: Steps rejected by error control (adaptive methods only).
     """
@@ -53,6 +55,7 @@ class WorkCounters:
     linear_solves: int = 0
     newton_iterations: int = 0
     krylov_iterations: int = 0
+    line_search_steps: int = 0
     accepted_steps: int = 0
     rejected_steps: int = 0
 
