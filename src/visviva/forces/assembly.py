@@ -67,9 +67,12 @@ class ForceSum:
         """The forces' potential energy [J] (over the particles ``alive``, if given)."""
         return sum((f.potential(t, x, alive) for f in self.forces), 0.0)
 
-    def jacobian(self, t: float, x: np.ndarray, v: np.ndarray) -> tuple[Any, Any]:
+    def jacobian(
+        self, t: float, x: np.ndarray, v: np.ndarray, definite: bool = False
+    ) -> tuple[Any, Any]:
         """``(∂F/∂x, ∂F/∂v)`` as ``3N × 3N`` block-sparse matrices (``∂F/∂v`` is ``None`` if no
-        force depends on velocity).
+        force depends on velocity); ``definite``: each force's ``add_definite_jacobian`` where
+        it has one (see :class:`~visviva.forces.Springs`), for linearized implicit steps.
 
         Raises:
             ValueError: If a force has no analytic Jacobian (check :attr:`has_jacobian`).
@@ -83,7 +86,8 @@ class ForceSum:
         for force, slots in zip(self.forces, self._slots, strict=True):
             local_x = np.zeros((slots.shape[0], 3, 3))
             local_v = np.zeros((slots.shape[0], 3, 3))
-            force.add_jacobian(t, x, v, local_x, local_v)
+            add = getattr(force, "add_definite_jacobian", None) if definite else None
+            (add or force.add_jacobian)(t, x, v, local_x, local_v)
             np.add.at(stiffness, slots, local_x)
             np.add.at(damping, slots, local_v)
         shape = (3 * self.count, 3 * self.count)

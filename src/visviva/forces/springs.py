@@ -17,8 +17,8 @@ the projection across the spring,
 fill four 3×3 blocks per spring, ``(i, i) = −K``, ``(i, j) = K``, ``(j, i) = K``,
 ``(j, j) = −K`` (and the same for ``D``), on a pattern fixed when the springs are built. A
 compressed spring (``l < L``) makes ``K`` indefinite across the spring: the buckling that
-implicit solvers handle by projecting it (``definite=True`` drops the negative part, Choi & Ko
-2002).
+linearized implicit steps handle by projecting it (:meth:`Springs.add_definite_jacobian`
+drops the negative part, Choi & Ko 2002).
 
 ``tests/test_springs.py`` checks every Jacobian against central finite differences of the same
 force (compressed springs included) and ``f = −∇U`` without damping.
@@ -45,8 +45,6 @@ class Springs:
         stiffness: ``(S,)`` ``k`` [N/m], ≥ 0.
         damping: ``(S,)`` ``c`` [N·s/m], ≥ 0.
         count: Number of particles ``N`` in the scene.
-        definite: Project each spring's stiffness block to be positive semi-definite (the
-            negative part of a compressed spring dropped) in :meth:`add_jacobian`.
 
     Raises:
         ModelError: Naming the first bad spring: an index out of range, a spring joining a
@@ -63,8 +61,6 @@ class Springs:
         stiffness: np.ndarray,
         damping: np.ndarray,
         count: int,
-        *,
-        definite: bool = False,
     ) -> None:
         pairs = np.asarray(pairs)
         if pairs.ndim != 2 or pairs.shape[1] != 2 or not np.issubdtype(pairs.dtype, np.integer):
@@ -76,7 +72,6 @@ class Springs:
         self.damping = _per_spring("damping", damping, springs)
         _check(self.pairs, self.rest_length, self.stiffness, self.damping, count)
         self.count = count
-        self.definite = definite
         # An undamped set of springs is conservative (instances may differ from the class).
         self.conservative = not np.any(self.damping)  # type: ignore[misc]
         self.velocity_dependent = bool(np.any(self.damping))  # type: ignore[misc]
@@ -104,6 +99,20 @@ class Springs:
     ) -> None:
         """Add ``∂F/∂x`` [N/m] and ``∂F/∂v`` [N·s/m] into the blocks of
         :meth:`jacobian_blocks` (``(4S, 3, 3)`` each)."""
+        self._add_jacobian(x, v, dfdx, dfdv, False)
+
+    def add_definite_jacobian(
+        self, t: float, x: np.ndarray, v: np.ndarray, dfdx: np.ndarray, dfdv: np.ndarray
+    ) -> None:
+        """:meth:`add_jacobian` with each spring's stiffness made positive semi-definite: a
+        compressed spring's negative stiffness across it dropped, and the damper's
+        non-symmetric part with it (for linearized implicit steps, which need ``M − h D −
+        h² K`` positive definite)."""
+        self._add_jacobian(x, v, dfdx, dfdv, True)
+
+    def _add_jacobian(
+        self, x: np.ndarray, v: np.ndarray, dfdx: np.ndarray, dfdv: np.ndarray, definite: bool
+    ) -> None:
         _jacobian(
             self.pairs,
             self.rest_length,
@@ -111,7 +120,7 @@ class Springs:
             self.damping,
             x,
             v,
-            self.definite,
+            definite,
             dfdx,
             dfdv,
         )
@@ -197,9 +206,10 @@ def _jacobian(p, rest, k, c, x, v, definite, dfdx, dfdv):  # pragma: no cover - 
     for s in range(p.shape[0]):
         _, _, u[0], u[1], u[2], length, w[0], w[1], w[2], rate = _spring(p, x, v, s)
         across = k[s] * (1.0 - rest[s] / length)  # the stiffness across the spring
-        if definite and across < 0.0:
-            across = 0.0
         scale = c[s] / length
+        if definite:
+            across = max(across, 0.0)
+            scale = 0.0
         for a in range(3):
             # (wᵀ P)_b = w_b − (w · u) u_b
             for b in range(3):

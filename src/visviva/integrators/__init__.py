@@ -20,7 +20,13 @@ from .._registry import Registry
 from ..errors import ModelError
 from .base import CompiledStep, Integrator
 from .dopri5 import DormandPrince5
-from .implicit import BackwardEuler, ImplicitMidpoint, ImplicitOneStage, Trapezoidal
+from .implicit import (
+    BackwardEuler,
+    ImplicitMidpoint,
+    ImplicitOneStage,
+    LinearlyImplicitEuler,
+    Trapezoidal,
+)
 from .newton import NewtonOptions
 from .runge_kutta import (
     ButcherTableau,
@@ -45,6 +51,7 @@ __all__ = [
     "ImplicitOneStage",
     "Integrator",
     "Leapfrog",
+    "LinearlyImplicitEuler",
     "Midpoint",
     "NewtonOptions",
     "RungeKutta4",
@@ -124,6 +131,7 @@ for _method in (
     BackwardEuler,
     Trapezoidal,
     ImplicitMidpoint,
+    LinearlyImplicitEuler,
 ):
     register(_method)
 del _method

@@ -42,7 +42,14 @@ if TYPE_CHECKING:
     from ..ode.mass import Mass
     from ..ode.system import FirstOrderSystem, SecondOrderSystem, System
 
-__all__ = ["KRYLOV_THRESHOLD", "NewtonOptions", "solve_stage"]
+__all__ = [
+    "KRYLOV_THRESHOLD",
+    "NewtonOptions",
+    "identity_minus",
+    "linear_solve",
+    "mass_minus",
+    "solve_stage",
+]
 
 #: Unknowns above which a problem without an analytic Jacobian is solved matrix-free: a
 #: finite-difference Jacobian costs n evaluations of f and n² memory per Newton iteration
@@ -122,7 +129,7 @@ def _solve_first_order(
             update = _krylov_solve(system, product, -residual, None)
         else:
             jacobian = system.jacobian(t, y, rate)
-            update = _linear_solve(system, _identity_minus(jacobian, theta_h, y.shape), -residual)
+            update = linear_solve(system, identity_minus(jacobian, theta_h, y.shape), -residual)
         y += update
         system.counters.newton_iterations += 1
         norm = _update_norm(update, y, options)
@@ -159,8 +166,8 @@ def _solve_second_order(
             update = _krylov_solve(system, product, -residual, mass)
         else:
             stiffness, damping = system.force_jacobian(t, q, v, force)
-            matrix = _mass_minus(mass, damping, stiffness, theta_h, v.shape)
-            update = _linear_solve(system, matrix, -residual)
+            matrix = mass_minus(mass, damping, stiffness, theta_h, v.shape)
+            update = linear_solve(system, matrix, -residual)
         last = (v.copy(), update, float(np.linalg.norm(residual)))
         v = v + update
         system.counters.newton_iterations += 1
@@ -311,7 +318,7 @@ def _failure(t: float, iterations: int, norm: float) -> NewtonConvergenceError:
     )
 
 
-def _identity_minus(jacobian: Any, theta_h: float, shape: tuple[int, ...]) -> Any:
+def identity_minus(jacobian: Any, theta_h: float, shape: tuple[int, ...]) -> Any:
     """``I − θh J`` in the storage of ``J`` (dense, batched dense or sparse)."""
     import scipy.sparse as sp
 
@@ -320,7 +327,7 @@ def _identity_minus(jacobian: Any, theta_h: float, shape: tuple[int, ...]) -> An
     return np.eye(shape[-1]) - theta_h * np.asarray(jacobian)
 
 
-def _mass_minus(
+def mass_minus(
     mass: Mass | None, damping: Any, stiffness: Any, theta_h: float, shape: tuple[int, ...]
 ) -> Any:
     """``M − θh ∂F/∂v − (θh)² ∂F/∂q``, sparse if any term is sparse and M allows it."""
@@ -352,7 +359,7 @@ def _dense(matrix: Any) -> np.ndarray:
     return matrix.toarray() if sp.issparse(matrix) else np.asarray(matrix)
 
 
-def _linear_solve(system: System, matrix: Any, rhs: np.ndarray) -> np.ndarray:
+def linear_solve(system: System, matrix: Any, rhs: np.ndarray) -> np.ndarray:
     """Solve ``matrix · x = rhs`` (batched dense or sparse) and count it."""
     import scipy.sparse as sp
 

@@ -129,13 +129,14 @@ def scene_system(model: Model) -> System:
             out[a:b] = piece.acceleration(t, q[a:b], v[a:b])
         return out
 
-    def jacobian(t: float, q: np.ndarray, v: np.ndarray) -> tuple[Any, Any]:
+    def jacobian(t: float, q: np.ndarray, v: np.ndarray, definite: bool = False) -> tuple[Any, Any]:
         import scipy.sparse as sp
 
         stiffness, damping = [], []
         if count:
             shape = (count, 3)
-            dfdx, dfdv = forces.jacobian(t, q[:n].reshape(shape), v[:n].reshape(shape))
+            x, u = q[:n].reshape(shape), v[:n].reshape(shape)
+            dfdx, dfdv = forces.jacobian(t, x, u, definite)
             dfdv = dfdv if dfdv is not None else sp.csr_matrix((n, n))
             if free is not None:
                 dfdx, dfdv = free @ dfdx @ free, free @ dfdv @ free
@@ -175,7 +176,22 @@ def scene_system(model: Model) -> System:
 
 class SceneSystem(SecondOrderSystem):
     """A scene's second-order system; its energy counts only live particles (it reads the
-    state's carried ``particle_alive``)."""
+    state's carried ``particle_alive``), and it gives the forces' definite Jacobian (springs
+    without their negative stiffness) to linearized implicit steps."""
+
+    def force_jacobian(
+        self,
+        t: float,
+        q: np.ndarray,
+        v: np.ndarray,
+        force: np.ndarray | None = None,
+        *,
+        definite: bool = False,
+    ) -> tuple[Any, Any]:
+        if not definite or self._jacobian is None:
+            return super().force_jacobian(t, q, v, force, definite=definite)
+        self.counters.jacobian_evaluations += 1
+        return self._jacobian(t, q, v, True)  # type: ignore[call-arg]
 
     def energy(self, state: State) -> np.ndarray | None:
         """Kinetic plus potential energy [J] of ``state``: live particles and systems."""

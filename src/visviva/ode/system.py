@@ -303,13 +303,21 @@ class SecondOrderSystem:
         return (v, self.acceleration(t, q, v))
 
     def force_jacobian(
-        self, t: float, q: np.ndarray, v: np.ndarray, force: np.ndarray | None = None
+        self,
+        t: float,
+        q: np.ndarray,
+        v: np.ndarray,
+        force: np.ndarray | None = None,
+        *,
+        definite: bool = False,
     ) -> tuple[Any, Any]:
         """``(∂F/∂q, ∂F/∂v)`` at ``(t, q, v)``; the second is ``None`` for position-only forces.
 
         Each is ``(n, n)``, ``(batch, n, n)`` or sparse ``(n, n)``. Uses the problem's Jacobian
         when given, else forward finite differences of ``F`` (``force`` = ``F(t, q, v)`` saves
-        one evaluation).
+        one evaluation). ``definite`` asks for the Jacobian with each element's negative
+        stiffness dropped where the system knows it (a scene's springs); a plain problem gives
+        its exact one.
         """
         self.counters.jacobian_evaluations += 1
         if self._jacobian is not None:
