@@ -206,6 +206,7 @@ def test_cli_validate_schema_dry_run_and_plot(tmp_path):
         "particle_cloud",
         "rope",
         "cloth",
+        "soft_lattice",
         "emitter",
         "system",
         "force",

@@ -8,6 +8,10 @@ springs join.
   two apart along the grid with *bend* springs; each family has its own stiffness. A point's
   mass is the areal density times its share of the cells around it (a quarter of each), so
   the sheet weighs density × area.
+* A **soft lattice** (seed 004's volumetric soft body) of ``nx × ny × nz`` points joins lattice
+  neighbours with structural springs, the diagonals of each cell's faces with shear springs and
+  the diagonals through each cell with *diagonal* springs, which keep a cube from collapsing
+  flat; a point weighs the density times an eighth of each cell around it.
 
 Every spring rests at the distance of its points as built: a network starts unstressed.
 
@@ -23,10 +27,19 @@ import numpy as np
 
 from ..errors import ModelError
 
-__all__ = ["BEND", "SHEAR", "STRETCH", "SpringNetwork", "cloth_grid", "rope"]
+__all__ = [
+    "BEND",
+    "DIAGONAL",
+    "SHEAR",
+    "STRETCH",
+    "SpringNetwork",
+    "cloth_grid",
+    "rope",
+    "soft_lattice",
+]
 
 #: Spring families (the codes of :attr:`SpringNetwork.family`).
-STRETCH, SHEAR, BEND = 0, 1, 2
+STRETCH, SHEAR, BEND, DIAGONAL = 0, 1, 2, 3
 
 
 @dataclass(frozen=True)
@@ -38,7 +51,7 @@ class SpringNetwork:
         mass: ``(n,)`` masses [kg].
         pairs: ``(S, 2)`` indices of each spring's particles.
         stiffness: ``(S,)`` k [N/m].
-        family: ``(S,)`` :data:`STRETCH`, :data:`SHEAR` or :data:`BEND`.
+        family: ``(S,)`` :data:`STRETCH`, :data:`SHEAR`, :data:`BEND` or :data:`DIAGONAL`.
     """
 
     points: np.ndarray
@@ -113,6 +126,59 @@ def cloth_grid(
         families.append(_springs(index[:, :-2], index[:, 2:], bend, BEND))
         families.append(_springs(index[:-2, :], index[2:, :], bend, BEND))
     return _network(points, mass, families)
+
+
+def soft_lattice(
+    origin: np.ndarray,
+    size: np.ndarray,
+    resolution: tuple[int, int, int],
+    density: float,
+    stretch: float,
+    shear: float,
+    diagonal: float,
+) -> SpringNetwork:
+    """A box of ``nx × ny × nz`` points (``resolution``) from the corner ``origin`` with edge
+    lengths ``size`` [m]; point ``(i, j, k)`` has index ``(k·ny + j)·nx + i``. ``density``
+    [kg/m³]; ``stretch``, ``shear`` and ``diagonal`` stiffness [N/m] of the structural,
+    face-diagonal and body-diagonal springs (a family of stiffness 0 is left out)."""
+    nx, ny, nz = resolution
+    axes = [np.arange(n) / (n - 1) for n in (nx, ny, nz)]
+    k, j, i = np.meshgrid(axes[2], axes[1], axes[0], indexing="ij")
+    points = origin + np.stack([i, j, k], axis=-1).reshape(-1, 3) * size
+    index = np.arange(nx * ny * nz).reshape(nz, ny, nx)
+    cell = float(np.prod(size)) / ((nx - 1) * (ny - 1) * (nz - 1))
+    share = np.zeros((nz, ny, nx))
+    for dk in (0, 1):
+        for dj in (0, 1):
+            for di in (0, 1):
+                share[dk : nz - 1 + dk, dj : ny - 1 + dj, di : nx - 1 + di] += 0.125
+    families = []
+    for stiffness, family, offsets in (
+        (stretch, STRETCH, [(1, 0, 0), (0, 1, 0), (0, 0, 1)]),
+        (shear, SHEAR, [(1, 1, 0), (1, -1, 0), (1, 0, 1), (1, 0, -1), (0, 1, 1), (0, 1, -1)]),
+        (diagonal, DIAGONAL, [(1, 1, 1), (1, 1, -1), (1, -1, 1), (-1, 1, 1)]),
+    ):
+        if stiffness > 0.0:
+            families += [_offset_springs(index, o, stiffness, family) for o in offsets]
+    return _network(points, density * cell * share.reshape(-1), families)
+
+
+def _offset_springs(
+    index: np.ndarray, offset: tuple[int, int, int], stiffness: float, family: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Springs from every lattice point ``(i, j, k)`` to ``(i, j, k) + offset`` inside it."""
+    di, dj, dk = offset
+    nz, ny, nx = index.shape
+
+    def span(step: int, n: int) -> tuple[slice, slice]:
+        return (
+            (slice(0, n - step), slice(step, n))
+            if step >= 0
+            else (slice(-step, n), slice(0, n + step))
+        )
+
+    (ai, bi), (aj, bj), (ak, bk) = span(di, nx), span(dj, ny), span(dk, nz)
+    return _springs(index[ak, aj, ai], index[bk, bj, bi], stiffness, family)
 
 
 def _springs(

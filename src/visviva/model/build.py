@@ -37,6 +37,7 @@ from .scene import (
     Particles,
     Rope,
     Scene,
+    SoftLattice,
     System,
 )
 from .systems import SYSTEMS
@@ -44,7 +45,7 @@ from .systems import SYSTEMS
 __all__ = ["build_model", "entity_names"]
 
 #: Entities that hold particles (which forces and colliders may target).
-PARTICLE_ENTITIES = (Particles, ParticleCloud, Rope, Cloth, Emitter)
+PARTICLE_ENTITIES = (Particles, ParticleCloud, Rope, Cloth, SoftLattice, Emitter)
 
 
 def entity_names(scene: Scene) -> list[str]:
@@ -72,7 +73,9 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     except Located as located:
         raise SceneError([located.problem]) from None
     slots = sum(s.capacity for s in specs) + sum(
-        _count(e) for e in scene.entities if isinstance(e, (Particles, ParticleCloud, Rope, Cloth))
+        _count(e)
+        for e in scene.entities
+        if isinstance(e, (Particles, ParticleCloud, Rope, Cloth, SoftLattice))
     )
     if slots > MAX_PARTICLES:
         raise SceneError(
@@ -257,7 +260,7 @@ def _check(scene: Scene) -> list[SceneProblem]:
         if isinstance(entity, (Particles, Rope)):
             total += _count(entity)
             problems += _check_lengths(entity, where)
-        elif isinstance(entity, (ParticleCloud, Cloth)):
+        elif isinstance(entity, (ParticleCloud, Cloth, SoftLattice)):
             total += _count(entity)
         elif isinstance(entity, System):
             problems += _check_system(entity, where)
@@ -347,14 +350,14 @@ def _check_first_order(scene: Scene) -> list[SceneProblem]:
     return []
 
 
-def _count(entity: Particles | ParticleCloud | Rope | Cloth) -> int:
+def _count(entity: Particles | ParticleCloud | Rope | Cloth | SoftLattice) -> int:
     """How many particles an entity that lists or counts them holds."""
     if isinstance(entity, Particles):
         return len(entity.positions)
     if isinstance(entity, Rope):
         return len(entity.points)
-    if isinstance(entity, Cloth):
-        return entity.resolution[0] * entity.resolution[1]
+    if isinstance(entity, (Cloth, SoftLattice)):
+        return int(np.prod(entity.resolution))
     return entity.count
 
 

@@ -29,6 +29,7 @@ from .scene import (
     Particles,
     Rope,
     Scene,
+    SoftLattice,
     System,
     World,
 )
@@ -185,6 +186,32 @@ class SceneBuilder:
         given = _given(locals())
         given["resolution"] = tuple(given["resolution"])
         return self._add(Cloth, "cloth", given)
+
+    def add_soft_lattice(
+        self,
+        resolution: Sequence[int],
+        *,
+        stretch: float,
+        origin: Vector | None = None,
+        size: Vector | None = None,
+        density: float | None = None,
+        shear: float | None = None,
+        diagonal: float | None = None,
+        damping: float | None = None,
+        pinned: Sequence[int] | None = None,
+        velocity: Vector | None = None,
+        radius: float | None = None,
+        color: Vector | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add a soft body: ``resolution`` = (nx, ny, nz) points on a lattice filling the box
+        from the corner ``origin`` with edge lengths ``size`` [m], of ``density`` [kg/m³],
+        with structural springs of ``stretch`` [N/m] and face- and body-diagonal springs of
+        ``shear`` and ``diagonal`` (default ``stretch``), each with ``damping`` [N·s/m];
+        point (i, j, k) has index (k·ny + j)·nx + i."""
+        given = _given(locals())
+        given["resolution"] = tuple(given["resolution"])
+        return self._add(SoftLattice, "soft_lattice", given)
 
     def add_system(
         self, system: str, parameters: Mapping[str, float] | None = None, *, name: str | None = None

@@ -143,15 +143,15 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
 
 
 def _spring_edges(model: Model) -> list[np.ndarray]:
-    """The stretch springs of each rope and cloth, as pairs of point indices (the shear and
-    bend springs are not drawn: they cross the fabric)."""
+    """The stretch springs of each rope, cloth and soft lattice, as pairs of point indices (the
+    other families are not drawn: they cross the fabric or the body)."""
     from ..deformables.topology import STRETCH
     from .parts import spring_network
 
     starts = {g.entity: g.start for g in model.particle_groups}
     edges = []
     for index, entity in enumerate(model.scene.entities):
-        if entity.type in ("rope", "cloth"):
+        if entity.type in ("rope", "cloth", "soft_lattice"):
             network = spring_network(entity)  # type: ignore[arg-type]
             edges.append(network.pairs[network.family == STRETCH] + starts[index])
     return edges

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ..deformables import SpringNetwork, cloth_grid, rope
+from ..deformables import SpringNetwork, cloth_grid, rope, soft_lattice
 from ..errors import ModelError, SceneProblem
 from ..forces import (
     Attractor,
@@ -40,6 +40,7 @@ from .scene import (
     Particles,
     Rope,
     Scene,
+    SoftLattice,
 )
 
 __all__ = [
@@ -158,7 +159,7 @@ def particle_arrays(
             color = entity.color
             if isinstance(entity, Rope):
                 pinned = np.array(entity.pinned, dtype=np.int64)
-        elif isinstance(entity, Cloth):
+        elif isinstance(entity, (Cloth, SoftLattice)):
             sheet = spring_network(entity)
             x, mass = sheet.points, sheet.mass
             count = x.shape[0]
@@ -263,14 +264,14 @@ def _force(e: ForceField, targets: Targets, mass: np.ndarray) -> Force:
 
 
 def spring_forces(scene: Scene, groups: Sequence[ParticleGroup], count: int) -> list[Force]:
-    """The springs of each rope and cloth (see :mod:`visviva.deformables.topology`), each at
-    rest at its initial length."""
+    """The springs of each rope, cloth and soft lattice (see
+    :mod:`visviva.deformables.topology`), each at rest at its initial length."""
     from ..forces import Springs
 
     forces: list[Force] = []
     starts = {g.entity: g.start for g in groups}
     for index, entity in enumerate(scene.entities):
-        if not isinstance(entity, (Rope, Cloth)):
+        if not isinstance(entity, (Rope, Cloth, SoftLattice)):
             continue
         network = spring_network(entity)
         try:
@@ -284,12 +285,22 @@ def spring_forces(scene: Scene, groups: Sequence[ParticleGroup], count: int) -> 
     return forces
 
 
-def spring_network(entity: Rope | Cloth) -> SpringNetwork:
-    """The particles and springs of a rope or cloth entity."""
+def spring_network(entity: Rope | Cloth | SoftLattice) -> SpringNetwork:
+    """The particles and springs of a rope, cloth or soft lattice entity."""
     if isinstance(entity, Rope):
         points = np.array(entity.points, dtype=np.float64)
         mass = np.broadcast_to(np.asarray(entity.mass, dtype=np.float64), (points.shape[0],))
         return rope(points, mass, entity.stiffness, entity.bending)
+    if isinstance(entity, SoftLattice):
+        return soft_lattice(
+            np.asarray(entity.origin, dtype=np.float64),
+            np.asarray(entity.size, dtype=np.float64),
+            entity.resolution,
+            entity.density,
+            entity.stretch,
+            entity.stretch if entity.shear is None else entity.shear,
+            entity.stretch if entity.diagonal is None else entity.diagonal,
+        )
     return cloth_grid(
         np.asarray(entity.origin, dtype=np.float64),
         np.asarray(entity.along, dtype=np.float64),

@@ -45,6 +45,7 @@ __all__ = [
     "Rope",
     "Scene",
     "SceneInfo",
+    "SoftLattice",
     "System",
     "World",
 ]
@@ -270,6 +271,53 @@ class Cloth(_Strict):
             raise PydanticCustomError(
                 "pin_out_of_range",
                 "pinned index {index} is not a point of this cloth (it has {count}: 0 to {last})",
+                {"index": outside[0], "count": count, "last": count - 1},
+            )
+        return self
+
+
+class SoftLattice(_Strict):
+    """``type = "soft_lattice"``: a volumetric soft body (seed 004): ``resolution`` = [nx, ny,
+    nz] particles on a lattice filling the box from ``origin`` with edge lengths ``size``,
+    joined by structural (``stretch``), face-diagonal (``shear``) and body-diagonal
+    (``diagonal``) springs. Point (i, j, k) has index (k·ny + j)·nx + i; each weighs
+    ``density`` times an eighth of each cell around it."""
+
+    type: Literal["soft_lattice"]
+    name: Name | None = None
+    origin: Vector = Field((0.0, 0.5, 0.0), description="the box's lowest corner [m]")
+    size: tuple[Positive, Positive, Positive] = Field(
+        (0.5, 0.5, 0.5), description="edge lengths of the box [m]"
+    )
+    resolution: tuple[
+        Annotated[int, Field(strict=True, ge=2, le=512)],
+        Annotated[int, Field(strict=True, ge=2, le=512)],
+        Annotated[int, Field(strict=True, ge=2, le=512)],
+    ] = Field(description="points along x, y and z [nx, ny, nz]")
+    density: Positive = Field(1000.0, description="mass per volume [kg/m³]")
+    stretch: Positive = Field(description="stiffness of the structural springs [N/m]")
+    shear: NonNegative | None = Field(
+        None, description="stiffness of the face-diagonal springs [N/m] (default: stretch)"
+    )
+    diagonal: NonNegative | None = Field(
+        None, description="stiffness of the body-diagonal springs [N/m] (default: stretch)"
+    )
+    damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
+    pinned: list[Annotated[int, Field(strict=True, ge=0)]] = Field(
+        default_factory=list, description="indices of the points held fixed"
+    )
+    velocity: Vector = Field((0.0, 0.0, 0.0), description="initial velocity [m/s]")
+    radius: Positive = Field(0.01, description="radius of each particle [m]")
+    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
+
+    @model_validator(mode="after")
+    def _pins_in_the_lattice(self) -> SoftLattice:
+        count = self.resolution[0] * self.resolution[1] * self.resolution[2]
+        outside = [i for i in self.pinned if i >= count]
+        if outside:
+            raise PydanticCustomError(
+                "pin_out_of_range",
+                "pinned index {index} is not a point of this lattice (it has {count}: 0 to {last})",
                 {"index": outside[0], "count": count, "last": count - 1},
             )
         return self
@@ -601,7 +649,15 @@ class Collider(_Strict):
 
 
 Entity = Annotated[
-    Particles | ParticleCloud | Rope | Cloth | Emitter | System | ForceField | Collider,
+    Particles
+    | ParticleCloud
+    | Rope
+    | Cloth
+    | SoftLattice
+    | Emitter
+    | System
+    | ForceField
+    | Collider,
     Field(discriminator="type"),
 ]
 ENTITY_TYPES: dict[str, type[BaseModel]] = {
@@ -609,6 +665,7 @@ ENTITY_TYPES: dict[str, type[BaseModel]] = {
     "particle_cloud": ParticleCloud,
     "rope": Rope,
     "cloth": Cloth,
+    "soft_lattice": SoftLattice,
     "emitter": Emitter,
     "system": System,
     "force": ForceField,
