@@ -101,6 +101,7 @@ def test_pinned_corners_stay_bit_identical():
         ({"pinned": [100]}, "pinned index 100 is not a point of this cloth"),
         ({"resolution": (1, 5)}, "resolution"),
         ({"stretch": -1.0}, "stretch"),
+        ({"along": (1e200, 0.0, 0.0), "across": (0.0, 0.0, 1e200)}, "beyond what a float holds"),
     ],
 )
 def test_bad_cloth_is_refused_naming_the_field(cloth, message):

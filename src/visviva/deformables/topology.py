@@ -64,15 +64,25 @@ class SpringNetwork:
         """``(S,)`` each spring's length as built [m], all > 0.
 
         Raises:
-            ModelError: Naming the first two points a spring joins that coincide.
+            ModelError: Naming the first two points a spring joins that coincide (or are too
+                far apart for a float).
         """
-        length = np.linalg.norm(
-            self.points[self.pairs[:, 1]] - self.points[self.pairs[:, 0]], axis=1
-        )
-        if not (length > 0.0).all():
-            a, b = self.pairs[int(np.argmin(length > 0.0))]
+        with np.errstate(over="ignore", invalid="ignore"):
+            length = np.linalg.norm(
+                self.points[self.pairs[:, 1]] - self.points[self.pairs[:, 0]], axis=1
+            )
+        good = np.isfinite(length) & (length > 0.0)
+        if not good.all():
+            s = int(np.argmin(good))
+            a, b = self.pairs[s]
+            if length[s] == 0.0:
+                raise ModelError(
+                    f"points {a} and {b} coincide: the spring between them needs a rest "
+                    "length > 0"
+                )
             raise ModelError(
-                f"points {a} and {b} coincide: the spring between them needs a rest length > 0"
+                f"the spring between points {a} and {b} would be {length[s]!r} m long, "
+                "beyond what a float holds: make the body smaller"
             )
         return length
 
@@ -102,6 +112,20 @@ def cloth_grid(
     s·along + t·across``, ``s, t ∈ [0, 1]`` [m]; point ``(i, j)`` (``i`` along, ``j`` across)
     has index ``j·nu + i``. Areal ``density`` [kg/m²]; ``stretch``, ``shear`` and ``bend``
     stiffness [N/m] of each family (a family of stiffness 0 is left out)."""
+    with np.errstate(over="ignore", invalid="ignore"):  # judged by _network
+        return _cloth_grid(origin, along, across, resolution, density, stretch, shear, bend)
+
+
+def _cloth_grid(
+    origin: np.ndarray,
+    along: np.ndarray,
+    across: np.ndarray,
+    resolution: tuple[int, int],
+    density: float,
+    stretch: float,
+    shear: float,
+    bend: float,
+) -> SpringNetwork:
     nu, nv = resolution
     s = np.arange(nu) / (nu - 1)
     t = np.arange(nv) / (nv - 1)
@@ -141,6 +165,19 @@ def soft_lattice(
     lengths ``size`` [m]; point ``(i, j, k)`` has index ``(k·ny + j)·nx + i``. ``density``
     [kg/m³]; ``stretch``, ``shear`` and ``diagonal`` stiffness [N/m] of the structural,
     face-diagonal and body-diagonal springs (a family of stiffness 0 is left out)."""
+    with np.errstate(over="ignore", invalid="ignore"):  # judged by _network
+        return _soft_lattice(origin, size, resolution, density, stretch, shear, diagonal)
+
+
+def _soft_lattice(
+    origin: np.ndarray,
+    size: np.ndarray,
+    resolution: tuple[int, int, int],
+    density: float,
+    stretch: float,
+    shear: float,
+    diagonal: float,
+) -> SpringNetwork:
     nx, ny, nz = resolution
     axes = [np.arange(n) / (n - 1) for n in (nx, ny, nz)]
     k, j, i = np.meshgrid(axes[2], axes[1], axes[0], indexing="ij")
@@ -192,6 +229,11 @@ def _springs(
 def _network(
     points: np.ndarray, mass: np.ndarray, families: list[tuple[np.ndarray, ...]]
 ) -> SpringNetwork:
+    if not (np.isfinite(points).all() and np.isfinite(mass).all() and (mass > 0.0).all()):
+        raise ModelError(
+            "the body's points or masses are beyond what a float holds (or its masses are "
+            "zero): give it a size, density and resolution of physical magnitude"
+        )
     return SpringNetwork(
         np.asarray(points, dtype=np.float64),
         np.asarray(mass, dtype=np.float64),

@@ -87,7 +87,10 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
                 )
             ]
         )
-    arrays, groups = particle_arrays(scene, names, specs)
+    try:
+        arrays, groups = particle_arrays(scene, names, specs)
+    except Located as located:
+        raise SceneError([located.problem]) from None
     count = arrays["position"].shape[0]
     h = settings.dt / settings.substeps
     try:

@@ -160,7 +160,10 @@ def particle_arrays(
             if isinstance(entity, Rope):
                 pinned = np.array(entity.pinned, dtype=np.int64)
         elif isinstance(entity, (Cloth, SoftLattice)):
-            sheet = spring_network(entity)
+            try:
+                sheet = spring_network(entity)
+            except ModelError as error:
+                raise Located(f"entities[{index}]", str(error)) from None
             x, mass = sheet.points, sheet.mass
             count = x.shape[0]
             v = np.broadcast_to(np.asarray(entity.velocity, dtype=np.float64), (count, 3))
