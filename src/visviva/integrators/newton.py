@@ -15,6 +15,8 @@ SuperLU for ``scipy.sparse`` ones. A problem without an analytic Jacobian and wi
 :data:`KRYLOV_THRESHOLD` unknowns is solved matrix-free instead (Jacobian-free Newton–Krylov):
 GMRES on products of the Newton matrix with vectors, each one forward difference of ``f``
 along the vector, preconditioned by the mass matrix's diagonal, so memory stays ``O(n)``.
+For one second-order system, a step that makes the residual's norm grow is halved until it
+shrinks (Armijo backtracking, which costs nothing when full steps work).
 Iteration stops when every component's update is below ``atol + rtol·|value|``; if that does
 not happen within ``max_iterations`` the step raises
 :class:`~visviva.errors.NewtonConvergenceError` — never a silently wrong answer.

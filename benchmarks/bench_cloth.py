@@ -1,0 +1,737 @@
+#!/usr/bin/env python
+"""Cloth benchmark: an explicit mass-spring cloth step (symplectic Euler), against peers.
+
+Run ``python benchmarks/bench_cloth.py`` (a few minutes on 2 cores) or add ``--quick`` for a
+smoke run whose figures mean nothing. The Warp-CPU peer is optional and never a visviva
+dependency; install it into a directory of its own and name that directory, as for
+``bench_particles.py``::
+
+    pip install --no-deps --target /tmp/peers-warp warp-lang
+    python benchmarks/bench_cloth.py --peers /tmp/peers-warp
+
+The scene, the same for every runner (float64 throughout):
+
+* an N × N grid of points (N = 64, 128, 256; ``--quick``: 16, 32) spaced 1/(N − 1) m in the
+  x–z plane at height y = 1 m; point (i, j) (i along x, j along z) has index j·N + i;
+* areal density 0.1 kg/m²: each point weighs the density times a quarter of each cell it
+  touches (corners ¼ cell, edges ½, inside 1 cell);
+* springs, resting at their initial lengths, each with damping c = 0.01 N·s/m along it:
+  structural (grid neighbours along x and z, k = 1000 N/m), shear (both diagonals of each cell,
+  k = 100 N/m) and bend (points two apart along x and z, k = 1 N/m); with d = x_j − x_i,
+  l = |d|, u = d/l, w = v_j − v_i, spring (i, j) pulls i by f = (k (l − L) + c (w·u)) u and j
+  by −f;
+* the two corners of the first row (points 0 and N − 1) pinned: no force moves them;
+* gravity (0, −9.81, 0) m/s²; one symplectic Euler step v ← v + h F/m, x ← x + h v.
+
+The step h is 1e-4 s where that is stable (N ≤ 32, which includes the agreement check). Above,
+it is not: the cloth's stiffest mode (structural springs on points of mass ∝ 1/(N − 1)², plus
+the damping along them) caps a stable symplectic Euler step at about 9.8e-5 s at N = 64,
+4.2e-5 s at N = 128 and 1.5e-5 s at N = 256 (the linearisation at rest: the largest h with
+λ_max(M⁻¹(h² K + 2h C)) ≤ 4); h = 1e-4 s makes visviva's divergence watch stop the run at
+N = 128 within 20 steps. So N = 64, 128, 256 use h = 5e-5, 2.5e-5, 1e-5 s (``STEP_BY_SIZE``).
+A step does the same work whatever h is.
+
+Runners (one step per call; time per step is the median of repeats after a first call that
+compiles; repeated calls keep advancing the same cloth):
+
+* plain Numba, written by hand to be as fast as we can make it (2 threads; see the comment
+  above ``spring_forces`` for the variants measured);
+* Warp-CPU: what a Warp user writes, a spring kernel scattering with ``wp.atomic_add`` into a
+  force array and an integration kernel, ``vec3d`` arrays, one launch pair per step;
+* visviva through its public API (``visviva_runner``).
+
+Figures per N: time per step, springs/s (springs × steps / s), GB/s, the fraction of a STREAM
+triad's bandwidth over arrays of the cloth state's total size, measured in the same run, and
+the ratios visviva ÷ Warp and visviva ÷ plain Numba. GB/s counts what a spring-list step must
+move at least, 104 B per point (reads x, v and 1/m: 7 float64; writes x, v: 6 float64) plus
+32 B per spring (reads its two ends as int32, L, k and c as float64); a runner that moves more
+(the plain Numba one writes and re-reads a force per spring) still gets only this count.
+Finally the runners' positions after 100 steps at N = 32 from the same start are compared
+(they sum forces in different orders, so they agree to round-off, not bit for bit). This is
+not a test: it prints figures and exits 1 only if a sanity check fails.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import importlib
+import math
+import os
+import platform
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+from numba import njit, prange
+
+import visviva as vv
+from bench_integrators import (
+    PATIENCE,
+    Checks,
+    Timing,
+    cpu_description,
+    finish,
+    fmt_time,
+    heading,
+    load_average,
+    measure,
+    print_table,
+    sci,
+    source_state,
+)
+from bench_particles import TRIAD_BYTES, TRIAD_BYTES_STREAM, Runner, cpu_share, on_path, triad
+
+# --------------------------------------------------------------------------------------------
+# The scene
+# --------------------------------------------------------------------------------------------
+
+GRAVITY = (0.0, -9.81, 0.0)  # m/s²
+DENSITY = 0.1  # kg/m²
+STRETCH = 1000.0  # N/m, structural springs
+SHEAR = 100.0  # N/m, diagonal springs
+BEND = 1.0  # N/m, springs between points two apart
+DAMPING = 0.01  # N·s/m, along every spring
+HEIGHT = 1.0  # m
+
+#: Symplectic Euler step by grid size: 1e-4 s where it is stable (see the module docstring).
+STEP_BY_SIZE = {16: 1e-4, 32: 1e-4, 64: 5e-5, 128: 2.5e-5, 256: 1e-5}
+
+#: The agreement check: grid size, steps, largest allowed position difference [m].
+CHECK_N = 32
+CHECK_STEPS = 100
+CHECK_TOLERANCE = 1e-9
+
+#: Bytes a step must move at least (see the module docstring for what they are).
+BYTES_PER_POINT = (7 + 6) * 8
+BYTES_PER_SPRING = 2 * 4 + 3 * 8
+#: Bytes of the state a step reads: the triad runs over arrays of this total size.
+STATE_BYTES_PER_POINT = 7 * 8
+
+#: The targets for visviva, printed next to the figures.
+TARGET_VS_WARP = 2.0  # × Warp-CPU's springs/s
+TARGET_FRACTION = 1.0 / 3.0  # of the triad's bandwidth
+
+
+@dataclass(frozen=True)
+class Cloth:
+    """The scene at one grid size: points, masses and the spring list.
+
+    ``pairs`` is sorted by first end (each point's springs to higher indices together): the
+    plain Numba spring pass then walks the points nearly in order (about 5% faster than the
+    springs grouped by family, measured at N = 256).
+    """
+
+    n: int
+    positions: np.ndarray  # (N², 3) m
+    mass: np.ndarray  # (N²,) kg
+    pinned: np.ndarray  # indices
+    pairs: np.ndarray  # (S, 2) int32
+    rest: np.ndarray  # (S,) m
+    stiffness: np.ndarray  # (S,) N/m
+    damping: np.ndarray  # (S,) N·s/m
+
+    @property
+    def springs(self) -> int:
+        return self.pairs.shape[0]
+
+    @property
+    def inverse_mass(self) -> np.ndarray:
+        """1/m, and 0 at the pinned points: every runner multiplies forces by it."""
+        inverse = 1.0 / self.mass
+        inverse[self.pinned] = 0.0
+        return inverse
+
+
+def spring_count(n: int) -> int:
+    """Structural 2 N (N − 1), shear 2 (N − 1)², bend 2 N (N − 2)."""
+    return 2 * n * (n - 1) + 2 * (n - 1) ** 2 + 2 * n * (n - 2)
+
+
+def cloth_scene(n: int) -> Cloth:
+    """The scene on an n × n grid, built directly (not through visviva)."""
+    spacing = 1.0 / (n - 1)
+    j, i = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")  # (row j, column i)
+    positions = np.stack([i * spacing, np.full(i.shape, HEIGHT), j * spacing], axis=-1)
+    # A point's share of the cells around it is the product of its shares along x and z.
+    edge = np.ones(n)
+    edge[[0, -1]] = 0.5
+    mass = DENSITY * spacing**2 * np.outer(edge, edge)
+    index = j * n + i
+    pairs, stiffness = [], []
+    # (Δi, Δj) from the first end to the second, and the family's stiffness.
+    families = [
+        (1, 0, STRETCH),
+        (0, 1, STRETCH),
+        (1, 1, SHEAR),
+        (-1, 1, SHEAR),
+        (2, 0, BEND),
+        (0, 2, BEND),
+    ]
+    for di, dj, k in families:
+        inside = (i + di >= 0) & (i + di < n) & (j + dj < n)
+        first = index[inside]
+        second = (j[inside] + dj) * n + i[inside] + di
+        pairs.append(np.stack([first, second], axis=1))
+        stiffness.append(np.full(first.size, k))
+    pairs = np.concatenate(pairs)
+    order = np.lexsort((pairs[:, 1], pairs[:, 0]))
+    pairs = pairs[order].astype(np.int32)
+    positions = positions.reshape(-1, 3)
+    rest = np.linalg.norm(positions[pairs[:, 1]] - positions[pairs[:, 0]], axis=1)
+    return Cloth(
+        n,
+        positions,
+        mass.reshape(-1),
+        np.array([0, n - 1]),
+        pairs,
+        rest,
+        np.concatenate(stiffness)[order],
+        np.full(len(pairs), DAMPING),
+    )
+
+
+def numpy_reference(cloth: Cloth, h: float, steps: int) -> np.ndarray:
+    """The step written plainly with NumPy (``np.add.at`` scatters): positions after ``steps``."""
+    x = cloth.positions.copy()
+    v = np.zeros_like(x)
+    inverse_mass = cloth.inverse_mass[:, None]
+    gravity = np.where(inverse_mass > 0.0, np.array(GRAVITY), 0.0)
+    i, j = cloth.pairs[:, 0], cloth.pairs[:, 1]
+    for _ in range(steps):
+        d = x[j] - x[i]
+        length = np.linalg.norm(d, axis=1)
+        u = d / length[:, None]
+        rate = np.einsum("sk,sk->s", v[j] - v[i], u)
+        f = (cloth.stiffness * (length - cloth.rest) + cloth.damping * rate)[:, None] * u
+        force = np.zeros_like(x)
+        np.add.at(force, i, f)
+        np.add.at(force, j, -f)
+        v += h * (force * inverse_mass + gravity)
+        x += h * v
+    return x
+
+
+# --------------------------------------------------------------------------------------------
+# Plain Numba peer
+# --------------------------------------------------------------------------------------------
+# Race-free parallel force kernels measured here (N = 256, 2 threads, per step, force and
+# integration together):
+#   per-point gather over a CSR list of incident springs, each spring evaluated by both ends,
+#     fused with the integration (new x, v into a second buffer)                     1.9 ms
+#   12 graph-coloured spring sets (no two springs of a set share a point), each a
+#     prange over its springs scattering into a force array, then the integration   2.7 ms
+#   two passes: a prange over springs writing each spring's force (no scatter, so LLVM
+#     vectorises it: AVX-512 gathers, vsqrtpd), then a prange over points summing their
+#     springs' forces through CSR lists and integrating                             1.2 ms
+# The last is the fastest and is the one below. Each spring's force is computed once, as in
+# the peers (the gather variant computes it twice and is compute bound on sqrt and division).
+# Two CSR lists per point (springs where it is the first end, where it is the second) instead
+# of one list with a ±1 per entry: no sign to read, about 5% faster.
+
+
+@njit(parallel=True, cache=True, error_model="numpy")
+def spring_forces(x, y, z, vx, vy, vz, first, second, rest, k, c, fx, fy, fz):
+    """Each spring's force on its first end (its second end gets the opposite)."""
+    for s in prange(first.shape[0]):
+        i, j = first[s], second[s]
+        dx, dy, dz = x[j] - x[i], y[j] - y[i], z[j] - z[i]
+        length = math.sqrt(dx * dx + dy * dy + dz * dz)
+        inverse = 1.0 / length  # one division, three multiplications
+        ux, uy, uz = dx * inverse, dy * inverse, dz * inverse
+        rate = (vx[j] - vx[i]) * ux + (vy[j] - vy[i]) * uy + (vz[j] - vz[i]) * uz
+        magnitude = k[s] * (length - rest[s]) + c[s] * rate
+        fx[s], fy[s], fz[s] = magnitude * ux, magnitude * uy, magnitude * uz
+
+
+@njit(parallel=True, cache=True, error_model="numpy")
+def gather_and_advance(
+    x, y, z, vx, vy, vz, fx, fy, fz, as_first, first_of, as_second, second_of, inverse_mass, h, g
+):
+    """Sum each point's spring forces, then one symplectic Euler step of it, in place.
+
+    ``first_of[as_first[i]:as_first[i + 1]]`` are the springs whose first end is point i (they
+    pull it by +f), ``second_of[...]`` likewise for the second end (−f). ``g``: gravity.
+    """
+    gx, gy, gz = g
+    for i in prange(x.shape[0]):
+        sx = sy = sz = 0.0
+        for e in range(as_first[i], as_first[i + 1]):
+            s = first_of[e]
+            sx, sy, sz = sx + fx[s], sy + fy[s], sz + fz[s]
+        for e in range(as_second[i], as_second[i + 1]):
+            s = second_of[e]
+            sx, sy, sz = sx - fx[s], sy - fy[s], sz - fz[s]
+        a = inverse_mass[i]
+        free = 1.0 if a > 0.0 else 0.0  # pinned points have 1/m = 0: no force moves them
+        px = vx[i] + h * (sx * a + free * gx)
+        py = vy[i] + h * (sy * a + free * gy)
+        pz = vz[i] + h * (sz * a + free * gz)
+        vx[i], vy[i], vz[i] = px, py, pz
+        x[i] += h * px
+        y[i] += h * py
+        z[i] += h * pz
+
+
+def incidence(points: int, ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """CSR lists: the springs having point i at ``ends`` are ``springs[start[i]:start[i + 1]]``."""
+    start = np.zeros(points + 1, dtype=np.int64)
+    np.cumsum(np.bincount(ends, minlength=points), out=start[1:])
+    return start, np.argsort(ends, kind="stable").astype(np.int32)
+
+
+def numba_runner(n: int) -> Runner:
+    """Plain Numba from the scene's start: one step per call, and a positions getter."""
+    cloth = cloth_scene(n)
+    h = STEP_BY_SIZE[n]
+    state = [np.ascontiguousarray(cloth.positions[:, k]) for k in range(3)]
+    state += [np.zeros(n * n) for _ in range(3)]
+    first, second = (np.ascontiguousarray(cloth.pairs[:, e]) for e in range(2))
+    springs = (first, second, cloth.rest, cloth.stiffness, cloth.damping)
+    forces = [np.empty(cloth.springs) for _ in range(3)]
+    lists = (*incidence(n * n, first), *incidence(n * n, second))
+    inverse_mass = cloth.inverse_mass
+
+    def step() -> None:
+        spring_forces(*state, *springs, *forces)
+        gather_and_advance(*state, *forces, *lists, inverse_mass, h, GRAVITY)
+
+    return step, lambda: np.stack(state[:3], axis=1)
+
+
+# --------------------------------------------------------------------------------------------
+# Warp-CPU peer (optional; never a visviva dependency)
+# --------------------------------------------------------------------------------------------
+
+#: The ``warp`` module once loaded: a module global because Warp evaluates the kernels'
+#: annotations (strings, with ``from __future__ import annotations``) in this module.
+wp = None
+
+
+class WarpCloth:
+    """Warp kernels for the same step, float64, launched on ``device="cpu"``."""
+
+    def __init__(self, peers: str | None) -> None:
+        global wp
+        with on_path(peers):
+            wp = importlib.import_module("warp")
+        self.wp = wp
+        wp.config.log_level = wp.LOG_WARNING  # no start-up banner
+        wp.init()
+
+        @wp.kernel
+        def spring_forces(
+            x: wp.array(dtype=wp.vec3d),
+            v: wp.array(dtype=wp.vec3d),
+            first: wp.array(dtype=wp.int32),
+            second: wp.array(dtype=wp.int32),
+            rest: wp.array(dtype=wp.float64),
+            k: wp.array(dtype=wp.float64),
+            c: wp.array(dtype=wp.float64),
+            force: wp.array(dtype=wp.vec3d),
+        ):
+            s = wp.tid()
+            i = first[s]
+            j = second[s]
+            d = x[j] - x[i]
+            length = wp.length(d)
+            u = d / length
+            rate = wp.dot(v[j] - v[i], u)
+            f = (k[s] * (length - rest[s]) + c[s] * rate) * u
+            wp.atomic_add(force, i, f)
+            wp.atomic_sub(force, j, f)
+
+        @wp.kernel
+        def advance(
+            x: wp.array(dtype=wp.vec3d),
+            v: wp.array(dtype=wp.vec3d),
+            force: wp.array(dtype=wp.vec3d),
+            inverse_mass: wp.array(dtype=wp.float64),
+            gravity: wp.vec3d,
+            h: wp.float64,
+        ):
+            i = wp.tid()
+            a = inverse_mass[i]
+            if a > wp.float64(0.0):  # pinned points (1/m = 0) stay
+                q = v[i] + h * (force[i] * a + gravity)
+                v[i] = q
+                x[i] = x[i] + h * q
+            # Cleared here for the next step's atomics (saves a separate force.zero_() pass).
+            force[i] = wp.vec3d(wp.float64(0.0), wp.float64(0.0), wp.float64(0.0))
+
+        self.spring_forces = spring_forces
+        self.advance = advance
+        wp.load_module(device="cpu")
+
+    @property
+    def version(self) -> str:
+        return self.wp.__version__
+
+    def runner(self, n: int) -> Runner:
+        """Warp from the scene's start; a step is two launches and ``wp.synchronize``."""
+        wp = self.wp
+        cloth = cloth_scene(n)
+        points, springs = n * n, cloth.springs
+
+        def array(values: np.ndarray, dtype: object) -> object:
+            return wp.array(np.ascontiguousarray(values), dtype=dtype, device="cpu")
+
+        x = array(cloth.positions, wp.vec3d)
+        v = wp.zeros(points, dtype=wp.vec3d, device="cpu")
+        force = wp.zeros(points, dtype=wp.vec3d, device="cpu")
+        spring_inputs = [
+            x,
+            v,
+            array(cloth.pairs[:, 0], wp.int32),
+            array(cloth.pairs[:, 1], wp.int32),
+            array(cloth.rest, wp.float64),
+            array(cloth.stiffness, wp.float64),
+            array(cloth.damping, wp.float64),
+            force,
+        ]
+        advance_inputs = [
+            x,
+            v,
+            force,
+            array(cloth.inverse_mass, wp.float64),
+            wp.vec3d(*GRAVITY),
+            wp.float64(STEP_BY_SIZE[n]),
+        ]
+
+        def step() -> None:
+            wp.launch(self.spring_forces, dim=springs, inputs=spring_inputs, device="cpu")
+            wp.launch(self.advance, dim=points, inputs=advance_inputs, device="cpu")
+            wp.synchronize()
+
+        return step, lambda: x.numpy().copy()
+
+
+def load_warp(peers: str | None) -> tuple[WarpCloth | None, str]:
+    """The Warp peer, or None and the reason it is unavailable."""
+    try:
+        return WarpCloth(peers), ""
+    except ImportError as error:
+        return None, f"not installed ({error})"
+    except Exception as error:  # a broken install or an unsupported feature: skip, say why
+        return None, f"unusable ({type(error).__name__}: {error})"
+
+
+# --------------------------------------------------------------------------------------------
+# visviva
+# --------------------------------------------------------------------------------------------
+
+
+def visviva_runner(n: int) -> Runner:
+    """visviva's cloth through the public API: one ``sim.step()`` per call.
+
+    ``positions()`` returns the (n², 3) positions; point (i, j) has index j·n + i, as here.
+    """
+    builder = vv.SceneBuilder(name=f"benchmark cloth {n}x{n}")
+    builder.set_world(gravity=GRAVITY)
+    builder.set_integration(method="symplectic_euler", dt=STEP_BY_SIZE[n], duration=1.0)
+    builder.add_cloth(
+        (n, n),
+        stretch=STRETCH,
+        shear=SHEAR,
+        bend=BEND,
+        damping=DAMPING,
+        density=DENSITY,
+        origin=(0.0, HEIGHT, 0.0),
+        along=(1.0, 0.0, 0.0),
+        across=(0.0, 0.0, 1.0),
+        pinned=[0, n - 1],
+    )
+    simulation = vv.Simulation(builder.build())
+
+    def step() -> None:
+        simulation.step()
+
+    def positions() -> np.ndarray:
+        return np.array(simulation.state["particle_position"])
+
+    return step, positions
+
+
+# --------------------------------------------------------------------------------------------
+# (a) Memory bandwidth
+# --------------------------------------------------------------------------------------------
+
+
+def state_bytes(n: int) -> int:
+    """Bytes of the state a step reads (the triad's arrays total this)."""
+    return STATE_BYTES_PER_POINT * n * n + BYTES_PER_SPRING * spring_count(n)
+
+
+def step_bytes(n: int) -> int:
+    """Bytes a step must move at least (GB/s below counts these)."""
+    return BYTES_PER_POINT * n * n + BYTES_PER_SPRING * spring_count(n)
+
+
+def bench_bandwidth(args: argparse.Namespace) -> dict[int, float]:
+    """The triad's real bytes per second (2 threads) by N, over arrays of the state's size.
+
+    ``bench_particles.bench_bandwidth`` sizes its arrays by particle count (8 float64 each);
+    the cloth's state also holds its springs, so the triad kernel is reused, not that table.
+    """
+    heading("(a) Memory bandwidth: STREAM triad a = b + s·c over the cloth state's total size")
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    bandwidth = {}
+    rows = []
+    for n in args.sizes:
+        length = state_bytes(n) // (3 * 8)  # three float64 arrays totalling the state
+        rng = np.random.default_rng(1)
+        a, b, c = np.zeros(length), rng.random(length), rng.random(length)
+        timing = measure(lambda a=a, b=b, c=c: triad(a, b, c, 3.0), args.repeats, f"triad N={n}")
+        bandwidth[n] = TRIAD_BYTES * length / timing.median
+        rows.append(
+            [
+                f"{n}",
+                f"{3 * 8 * length / 2**20:.1f} MiB",
+                fmt_time(timing.median),
+                f"{TRIAD_BYTES_STREAM * length / timing.median / 1e9:.1f}",
+                f"{bandwidth[n] / 1e9:.1f}",
+                timing.busy,
+            ]
+        )
+    print()
+    print_table(
+        ["N", "arrays", "median", "GB/s (STREAM)", "GB/s (real)", "others' CPU"],
+        rows,
+    )
+    print(
+        f"  {numba.get_num_threads()} threads; arrays total {STATE_BYTES_PER_POINT} B per point"
+        f" + {BYTES_PER_SPRING} B per spring; 'real' counts 32 B per element (with the"
+        " write-allocate read of a), STREAM 24 B"
+    )
+    return bandwidth
+
+
+# --------------------------------------------------------------------------------------------
+# (b) The cloth step
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass
+class Figure:
+    label: str
+    n: int
+    timing: Timing
+
+    @property
+    def springs_per_second(self) -> float:
+        return spring_count(self.n) / self.timing.median
+
+
+def runners(warp: WarpCloth | None) -> list[tuple[str, Callable[[int], Runner]]]:
+    plan = [(f"plain Numba ({numba.config.NUMBA_NUM_THREADS} threads)", numba_runner)]
+    if warp is not None:
+        plan.append(("Warp-CPU", warp.runner))
+    plan.append(("visviva", visviva_runner))
+    return plan
+
+
+def bench_step(
+    args: argparse.Namespace,
+    warp: WarpCloth | None,
+    bandwidth: dict[int, float],
+    checks: Checks,
+) -> list[Figure]:
+    heading("(b) Cloth step, one step per call: N = " + ", ".join(map(str, args.sizes)))
+    figures = []
+    rows = []
+    lowest: dict[int, dict[str, float]] = {}  # the lowest point after the timed steps, by N
+    for n in args.sizes:
+        lowest[n] = {}
+        for label, factory in runners(warp):
+            step, positions = factory(n)
+            try:
+                timing = measure(step, args.repeats, f"(b) {label}, N={n}")
+            except vv.SimulationError as error:  # the divergence watch: report, go on
+                checks.check(False, f"{label}, N={n}: {error}")
+                continue
+            final = positions()
+            lowest[n][label] = float(final[:, 1].min()) if np.isfinite(final).all() else math.nan
+            figure = Figure(label, n, timing)
+            figures.append(figure)
+            moved = step_bytes(n) / timing.median
+            rows.append(
+                [
+                    label,
+                    str(n),
+                    f"{spring_count(n):,}",
+                    fmt_time(timing.median),
+                    sci(figure.springs_per_second),
+                    f"{moved / 1e9:.1f}",
+                    f"{100 * moved / bandwidth[n]:.0f}%",
+                    fmt_time(timing.first),
+                    timing.busy,
+                ]
+            )
+    print()
+    print_table(
+        ["runner", "N", "springs", "per step", "springs/s", "GB/s", "of triad", "first call"]
+        + ["others' CPU"],
+        rows,
+    )
+    print(
+        f"  GB/s = ({BYTES_PER_POINT} B × points + {BYTES_PER_SPRING} B × springs) / time per"
+        " step, as a share of (a)'s real triad GB/s at the same N"
+    )
+    print("  h by N: " + ", ".join(f"{n}: {STEP_BY_SIZE[n]:g} s" for n in args.sizes))
+    n = args.sizes[-1]
+    for label, factory in runners(warp)[1:]:
+        share = cpu_share(factory(n)[0])
+        print(f"  {label} threads: process CPU time / wall time while stepping = {share:.2f}")
+    for n, heights in lowest.items():
+        checks.check(
+            all(HEIGHT - 1.0 < y < HEIGHT for y in heights.values()),
+            f"N={n}: every cloth finite and below its start after its timed steps (lowest point: "
+            + ", ".join(f"{label} {y:.4f} m" for label, y in heights.items())
+            + ")",
+        )
+    return figures
+
+
+def summarise(args: argparse.Namespace, figures: list[Figure], bandwidth: dict[int, float]) -> None:
+    heading("Comparisons (springs/s)")
+    rate = {(f.label.split(" (")[0], f.n): f.springs_per_second for f in figures}
+    rows = []
+    for n in args.sizes:
+
+        def ratio(a: str, b: str, n: int = n) -> str:
+            if (a, n) not in rate or (b, n) not in rate:
+                return "n/a"
+            return f"{rate[(a, n)] / rate[(b, n)]:.2f}×"
+
+        versus_warp = ratio("visviva", "Warp-CPU")
+        fraction = (
+            rate[("visviva", n)] * step_bytes(n) / spring_count(n) / bandwidth[n]
+            if ("visviva", n) in rate
+            else math.nan
+        )
+        rows.append(
+            [
+                str(n),
+                versus_warp,
+                verdict(versus_warp, TARGET_VS_WARP),
+                ratio("visviva", "plain Numba"),
+                ratio("plain Numba", "Warp-CPU"),
+                f"{fraction:.0%}",
+                "yes" if fraction >= TARGET_FRACTION else "no",
+            ]
+        )
+    print()
+    print_table(
+        [
+            "N",
+            "visviva ÷ Warp",
+            f"≥ {TARGET_VS_WARP:g}×",
+            "visviva ÷ plain Numba",
+            "plain Numba ÷ Warp",
+            "visviva of triad",
+            f"≥ {TARGET_FRACTION:.0%}",
+        ],
+        rows,
+    )
+    print(
+        f"  targets for visviva: ≥ {TARGET_VS_WARP:g}× Warp-CPU's springs/s, ≥"
+        f" {TARGET_FRACTION:.0%} of the triad's bandwidth (GB/s as counted in (b))"
+    )
+
+
+def verdict(ratio: str, target: float) -> str:
+    return "n/a" if ratio == "n/a" else ("yes" if float(ratio.rstrip("×")) >= target else "no")
+
+
+# --------------------------------------------------------------------------------------------
+# (c) Agreement
+# --------------------------------------------------------------------------------------------
+
+
+def bench_agreement(warp: WarpCloth | None, checks: Checks) -> None:
+    n, steps = CHECK_N, CHECK_STEPS
+    heading(f"(c) Agreement after {steps} steps of {STEP_BY_SIZE[n]:g} s, N = {n} (max |Δx|)")
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    results = {}
+    for label, factory in runners(warp):
+        step, positions = factory(n)
+        for _ in range(steps):
+            step()
+        results[label.split(" (")[0]] = positions()
+    plain = results.pop("plain Numba")
+    sag = HEIGHT - plain[:, 1].min()
+    print(f"  the cloth's lowest point fell {sag * 1e3:.3f} mm (plain Numba)")
+    reference = numpy_reference(cloth_scene(n), STEP_BY_SIZE[n], steps)
+    results = {"NumPy reference": reference, **results}
+    for label, positions in results.items():
+        difference = float(np.abs(positions - plain).max())
+        checks.check(
+            difference <= CHECK_TOLERANCE,
+            f"plain Numba vs {label}: {difference:.1e} m (≤ {CHECK_TOLERANCE:g} m)",
+        )
+
+
+# --------------------------------------------------------------------------------------------
+
+
+def print_header(args: argparse.Namespace, warp: WarpCloth | None, why: str) -> None:
+    print("visviva cloth benchmark" + ("  [--quick: smoke run]" if args.quick else ""))
+    print(
+        f"date:              {datetime.datetime.now().astimezone().isoformat(timespec='seconds')}"
+    )
+    print(f"CPU:               {cpu_description()}")
+    print(f"cores:             {os.cpu_count()} logical")
+    print(f"Python:            {platform.python_version()}")
+    print(f"numpy / numba:     {np.__version__} / {numba.__version__}")
+    print(f"visviva:           {vv.__version__} ({source_state()})")
+    if warp is None:
+        print(f"Warp:              {why}; see the module docstring")
+    else:
+        print(f"Warp:              {warp.version} (device cpu, float64)")
+    print(f"Numba threads:     {numba.config.NUMBA_NUM_THREADS}, layer {numba.threading_layer()}")
+    print(f"load average:      {load_average()} at start")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="small sizes; figures mean nothing")
+    parser.add_argument("--repeats", type=int, default=None, help="timed runs per figure")
+    parser.add_argument("--retries", type=int, default=None, help="re-measurements when contended")
+    parser.add_argument(
+        "--quiet-wait",
+        type=float,
+        default=10.0,
+        help="before a retry, wait up to this many seconds for the machine to be idle (default 10)",
+    )
+    parser.add_argument(
+        "--peers",
+        default=os.environ.get("VISVIVA_PEERS"),
+        help="directory holding warp (pip install --no-deps --target DIR warp-lang)",
+    )
+    args = parser.parse_args(argv)
+    args.repeats = args.repeats or (3 if args.quick else 7)
+    if args.retries is None:
+        args.retries = 0 if args.quick else 2
+    args.sizes = (16, 32) if args.quick else (64, 128, 256)
+    PATIENCE["retries"] = max(0, args.retries)
+    PATIENCE["quiet_wait"] = max(0.0, args.quiet_wait)
+    warp, why = load_warp(args.peers)
+    # Compile (or load from the cache) the Numba kernels before the header and the timings.
+    numba_runner(min(STEP_BY_SIZE))[0]()
+    tiny = np.zeros(3)
+    triad(tiny, tiny, tiny, 1.0)
+    started = time.perf_counter()
+    print_header(args, warp, why)
+    checks = Checks()
+    bandwidth = bench_bandwidth(args)
+    figures = bench_step(args, warp, bandwidth, checks)
+    summarise(args, figures, bandwidth)
+    bench_agreement(warp, checks)
+    return finish(started, checks)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
