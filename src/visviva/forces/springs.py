@@ -29,7 +29,7 @@ from __future__ import annotations
 from typing import ClassVar
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from ..errors import ModelError
 
@@ -72,6 +72,21 @@ class Springs:
         self.damping = _per_spring("damping", damping, springs)
         _check(self.pairs, self.rest_length, self.stiffness, self.damping, count)
         self.count = count
+        # Each particle's springs, for the force's gather: those it is the first end of, and
+        # those it is the second end of (pulled by +f and −f), as CSR lists.
+        self._as_first = _incidence(self.pairs[:, 0], count)
+        self._as_second = _incidence(self.pairs[:, 1], count)
+        # 32-bit ends: the force pass gathers by them, and AVX-512 gathers 8 at a time with
+        # 32-bit indices.
+        self._first = np.ascontiguousarray(self.pairs[:, 0], dtype=np.int32)
+        self._second = np.ascontiguousarray(self.pairs[:, 1], dtype=np.int32)
+        # Each spring's force on its first particle, one array per component (the compiler
+        # vectorizes the force pass over springs only for contiguous components).
+        self._spring_force = np.empty((3, springs))
+        self._touched = np.flatnonzero(
+            np.diff(self._as_first[0]) + np.diff(self._as_second[0])
+        ).astype(np.int64)
+        self._columns = np.empty((6, count))  # x, y, z, vx, vy, vz of every particle
         # An undamped set of springs is conservative (instances may differ from the class).
         self.conservative = not np.any(self.damping)  # type: ignore[misc]
         self.velocity_dependent = bool(np.any(self.damping))  # type: ignore[misc]
@@ -80,8 +95,18 @@ class Springs:
         return int(self.pairs.shape[0])
 
     def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        """Add every spring's force [N] on its two particles to ``out``."""
-        _forces(self.pairs, self.rest_length, self.stiffness, self.damping, x, v, out)
+        """Add every spring's force [N] on its two particles to ``out``: each spring's force
+        in one parallel pass, then each particle's sum in another (no two threads write the
+        same particle, and the sums run in a fixed order: the result does not depend on the
+        thread count)."""
+        fx, fy, fz = self._spring_force
+        columns = self._columns
+        _columns(x, v, columns)
+        _spring_forces(
+            self._first, self._second, self.rest_length, self.stiffness, self.damping,
+            *columns, fx, fy, fz,
+        )  # fmt: skip
+        _gather(self._touched, *self._as_first, *self._as_second, fx, fy, fz, out)
 
     def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
         """``Σ ½ k (l − L)²`` [J] over the springs."""
@@ -124,6 +149,14 @@ class Springs:
             dfdx,
             dfdv,
         )
+
+
+def _incidence(ends: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """CSR lists of the springs at each particle: the springs with particle ``p`` at ``ends``
+    are ``springs[start[p]:start[p + 1]]`` (32-bit, in spring order)."""
+    start = np.zeros(count + 1, dtype=np.int64)
+    np.cumsum(np.bincount(ends, minlength=count), out=start[1:])
+    return start, np.argsort(ends, kind="stable").astype(np.int32)
 
 
 def _per_spring(name: str, values: object, springs: int) -> np.ndarray:
@@ -174,17 +207,54 @@ def _spring(p, x, v, s):  # pragma: no cover - compiled
     return i, j, ux, uy, uz, length, wx, wy, wz, wx * ux + wy * uy + wz * uz
 
 
-@njit(cache=True, error_model="numpy")
-def _forces(p, rest, k, c, x, v, out):  # pragma: no cover - compiled
-    for s in range(p.shape[0]):
-        i, j, ux, uy, uz, length, _, _, _, rate = _spring(p, x, v, s)
+@njit(cache=True, parallel=True)
+def _columns(x, v, columns):  # pragma: no cover - compiled
+    """``columns`` ← the components of ``x`` and ``v`` ``(N, 3)``, one row each."""
+    for i in prange(x.shape[0]):
+        for a in range(3):
+            columns[a, i] = x[i, a]
+            columns[3 + a, i] = v[i, a]
+
+
+# fmt: off
+@njit(cache=True, parallel=True, error_model="numpy")
+def _spring_forces(
+    first, second, rest, k, c, x, y, z, vx, vy, vz, fx, fy, fz,
+):  # pragma: no cover - compiled
+    """``(fx, fy, fz)[s]``: the force of spring ``s`` on its first particle [N] (positions and
+    velocities one array per component: gathers from them vectorize)."""
+    # fmt: on
+    for s in prange(first.shape[0]):
+        i, j = first[s], second[s]
+        dx, dy, dz = x[j] - x[i], y[j] - y[i], z[j] - z[i]
+        length = np.sqrt(dx * dx + dy * dy + dz * dz)
+        inverse = 1.0 / length  # one division
+        ux, uy, uz = dx * inverse, dy * inverse, dz * inverse
+        rate = (vx[j] - vx[i]) * ux + (vy[j] - vy[i]) * uy + (vz[j] - vz[i]) * uz
         magnitude = k[s] * (length - rest[s]) + c[s] * rate
-        out[i, 0] += magnitude * ux
-        out[i, 1] += magnitude * uy
-        out[i, 2] += magnitude * uz
-        out[j, 0] -= magnitude * ux
-        out[j, 1] -= magnitude * uy
-        out[j, 2] -= magnitude * uz
+        fx[s] = magnitude * ux
+        fy[s] = magnitude * uy
+        fz[s] = magnitude * uz
+
+
+@njit(cache=True, parallel=True)
+def _gather(
+    touched, first_start, as_first, second_start, as_second, fx, fy, fz, out
+):  # pragma: no cover - compiled
+    """``out[p] += Σ f[s]`` over the springs whose first end is ``p``, ``− Σ f[s]`` over
+    those whose second end it is, for each particle ``p`` in ``touched``."""
+    for a in prange(touched.shape[0]):
+        p = touched[a]
+        sx = sy = sz = 0.0
+        for b in range(first_start[p], first_start[p + 1]):
+            s = as_first[b]
+            sx, sy, sz = sx + fx[s], sy + fy[s], sz + fz[s]
+        for b in range(second_start[p], second_start[p + 1]):
+            s = as_second[b]
+            sx, sy, sz = sx - fx[s], sy - fy[s], sz - fz[s]
+        out[p, 0] += sx
+        out[p, 1] += sy
+        out[p, 2] += sz
 
 
 @njit(cache=True, error_model="numpy")
