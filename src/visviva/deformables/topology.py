@@ -77,8 +77,7 @@ class SpringNetwork:
             a, b = self.pairs[s]
             if length[s] == 0.0:
                 raise ModelError(
-                    f"points {a} and {b} coincide: the spring between them needs a rest "
-                    "length > 0"
+                    f"points {a} and {b} coincide: the spring between them needs a rest length > 0"
                 )
             raise ModelError(
                 f"the spring between points {a} and {b} would be {length[s]!r} m long, "
