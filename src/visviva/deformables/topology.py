@@ -21,7 +21,10 @@ References:
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -86,6 +89,18 @@ class SpringNetwork:
         return length
 
 
+def _overflow_judged_later(build: Callable[..., SpringNetwork]) -> Callable[..., SpringNetwork]:
+    """Build without NumPy's overflow warnings: a body too large for a float is refused, with
+    its entity named, by :func:`_network` and :meth:`SpringNetwork.rest_length`."""
+
+    @functools.wraps(build)
+    def quietly(*args: Any) -> SpringNetwork:
+        with np.errstate(over="ignore", invalid="ignore"):
+            return build(*args)
+
+    return quietly
+
+
 def rope(points: np.ndarray, mass: np.ndarray, stiffness: float, bending: float) -> SpringNetwork:
     """A rope through ``points`` ``(n, 3)`` [m] with masses ``mass`` ``(n,)`` [kg]: stretch
     springs of ``stiffness`` [N/m] between consecutive points, bending springs of ``bending``
@@ -97,6 +112,7 @@ def rope(points: np.ndarray, mass: np.ndarray, stiffness: float, bending: float)
     return _network(points, mass, families)
 
 
+@_overflow_judged_later
 def cloth_grid(
     origin: np.ndarray,
     along: np.ndarray,
@@ -111,20 +127,6 @@ def cloth_grid(
     s·along + t·across``, ``s, t ∈ [0, 1]`` [m]; point ``(i, j)`` (``i`` along, ``j`` across)
     has index ``j·nu + i``. Areal ``density`` [kg/m²]; ``stretch``, ``shear`` and ``bend``
     stiffness [N/m] of each family (a family of stiffness 0 is left out)."""
-    with np.errstate(over="ignore", invalid="ignore"):  # judged by _network
-        return _cloth_grid(origin, along, across, resolution, density, stretch, shear, bend)
-
-
-def _cloth_grid(
-    origin: np.ndarray,
-    along: np.ndarray,
-    across: np.ndarray,
-    resolution: tuple[int, int],
-    density: float,
-    stretch: float,
-    shear: float,
-    bend: float,
-) -> SpringNetwork:
     nu, nv = resolution
     s = np.arange(nu) / (nu - 1)
     t = np.arange(nv) / (nv - 1)
@@ -151,6 +153,7 @@ def _cloth_grid(
     return _network(points, mass, families)
 
 
+@_overflow_judged_later
 def soft_lattice(
     origin: np.ndarray,
     size: np.ndarray,
@@ -164,19 +167,6 @@ def soft_lattice(
     lengths ``size`` [m]; point ``(i, j, k)`` has index ``(k·ny + j)·nx + i``. ``density``
     [kg/m³]; ``stretch``, ``shear`` and ``diagonal`` stiffness [N/m] of the structural,
     face-diagonal and body-diagonal springs (a family of stiffness 0 is left out)."""
-    with np.errstate(over="ignore", invalid="ignore"):  # judged by _network
-        return _soft_lattice(origin, size, resolution, density, stretch, shear, diagonal)
-
-
-def _soft_lattice(
-    origin: np.ndarray,
-    size: np.ndarray,
-    resolution: tuple[int, int, int],
-    density: float,
-    stretch: float,
-    shear: float,
-    diagonal: float,
-) -> SpringNetwork:
     nx, ny, nz = resolution
     axes = [np.arange(n) / (n - 1) for n in (nx, ny, nz)]
     k, j, i = np.meshgrid(axes[2], axes[1], axes[0], indexing="ij")

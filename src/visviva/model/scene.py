@@ -183,6 +183,17 @@ class ParticleCloud(_Strict):
     seed: Annotated[int, Field(strict=True, ge=0, lt=2**63)] = Field(0, description="random seed")
 
 
+def _check_pins(pinned: list[int], count: int, body: str) -> None:
+    """Refuse a pinned index past the body's ``count`` points."""
+    outside = [i for i in pinned if i >= count]
+    if outside:
+        raise PydanticCustomError(
+            "pin_out_of_range",
+            "pinned index {index} is not a point of this {body} (it has {count}: 0 to {last})",
+            {"index": outside[0], "body": body, "count": count, "last": count - 1},
+        )
+
+
 class Rope(_Strict):
     """``type = "rope"``: particles at ``points`` joined in order by damped springs (seed 002).
 
@@ -214,14 +225,7 @@ class Rope(_Strict):
 
     @model_validator(mode="after")
     def _pins_on_the_rope(self) -> Rope:
-        count = len(self.points)
-        outside = [i for i in self.pinned if i >= count]
-        if outside:
-            raise PydanticCustomError(
-                "pin_out_of_range",
-                "pinned index {index} is not a point of this rope (it has {count}: 0 to {last})",
-                {"index": outside[0], "count": count, "last": count - 1},
-            )
+        _check_pins(self.pinned, len(self.points), "rope")
         return self
 
 
@@ -265,14 +269,7 @@ class Cloth(_Strict):
                 "area; give two edges at an angle",
                 {"along": list(a), "across": list(b)},
             )
-        count = self.resolution[0] * self.resolution[1]
-        outside = [i for i in self.pinned if i >= count]
-        if outside:
-            raise PydanticCustomError(
-                "pin_out_of_range",
-                "pinned index {index} is not a point of this cloth (it has {count}: 0 to {last})",
-                {"index": outside[0], "count": count, "last": count - 1},
-            )
+        _check_pins(self.pinned, self.resolution[0] * self.resolution[1], "cloth")
         return self
 
 
@@ -312,14 +309,9 @@ class SoftLattice(_Strict):
 
     @model_validator(mode="after")
     def _pins_in_the_lattice(self) -> SoftLattice:
-        count = self.resolution[0] * self.resolution[1] * self.resolution[2]
-        outside = [i for i in self.pinned if i >= count]
-        if outside:
-            raise PydanticCustomError(
-                "pin_out_of_range",
-                "pinned index {index} is not a point of this lattice (it has {count}: 0 to {last})",
-                {"index": outside[0], "count": count, "last": count - 1},
-            )
+        _check_pins(
+            self.pinned, self.resolution[0] * self.resolution[1] * self.resolution[2], "lattice"
+        )
         return self
 
 
