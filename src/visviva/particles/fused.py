@@ -356,7 +356,7 @@ def _near(plane, bit, px, py, pz, r):  # pragma: no cover - compiled
 def _impact_possible(plane, bit, sx, sy, sz, px, py, pz, r):  # pragma: no cover
     """True if the particle may hit the leading plane within the step, so that the time of
     impact must be found (the test of the collision stage's ``_plane_impact``, with a thin
-    slab's crossing assumed): the plane has time of impact, the particle meets it (mask
+    slab's crossing assumed; called for planes with time of impact): the particle meets it (mask
     ``bit``), was clear of it at the start and ends inside it (or the slab is thin)."""
     d0, _, _, _ = _plane_gap(plane, sx, sy, sz)
     d1, _, _, _ = _plane_gap(plane, px, py, pz)
