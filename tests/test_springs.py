@@ -109,7 +109,7 @@ def test_definite_projection_drops_only_the_compressed_springs_negative_part():
     x = rng.normal(size=(N, 3))
     v = np.zeros((N, 3))
     total = ForceSum([_springs(np.random.default_rng(8))], N)
-    exact, projected = (total.jacobian(0.0, x, v, definite=d)[0] for d in (False, True))
+    exact, projected = (total.jacobian(0.0, x, v, form)[0] for form in ("exact", "definite"))
     # −∂F/∂x is the stiffness matrix: positive semi-definite once projected, not before.
     assert np.linalg.eigvalsh(-projected.toarray()).min() > -1e-9
     assert np.linalg.eigvalsh(-exact.toarray()).min() < -1e-6

@@ -10,11 +10,11 @@ built — once per topology — so each Newton iteration only refills the block 
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from numba import njit, prange
 
 from .base import Force
 
@@ -32,8 +32,14 @@ class ForceSum:
         forces: The forces, in order.
         velocity_dependent: True if any force depends on the velocities.
         conservative: True if every force is ``−∇U`` of the energy it reports.
+        gradient_form: True if the sum is ``F(x, v) = −∇U(x) + D(x) v`` with ``D = ∂F/∂v``
+            symmetric: every force conservative, or damped linearly in the velocities (a force
+            says so with ``linear_damping``). Backward Euler's step then minimizes an energy.
         has_jacobian: True if every force gives its Jacobian blocks.
-        blocks: Number of distinct 3×3 blocks in the Jacobians' pattern.
+        blocks: Number of distinct 3×3 blocks in the Jacobians' pattern, which holds every
+            diagonal block ``(i, i)`` (a Newton matrix adds the masses there).
+        indptr, indices: The pattern in BSR form (block rows ``N``).
+        diagonal: ``(N,)`` the index of block ``(i, i)`` among the blocks.
     """
 
     def __init__(self, forces: Sequence[Force], count: int) -> None:
@@ -41,6 +47,10 @@ class ForceSum:
         self.count = count
         self.velocity_dependent = any(f.velocity_dependent for f in self.forces)
         self.conservative = all(f.conservative for f in self.forces)
+        self.gradient_form = all(
+            (f.conservative and not f.velocity_dependent) or getattr(f, "linear_damping", False)
+            for f in self.forces
+        )
         patterns = [f.jacobian_blocks() for f in self.forces]
         self.has_jacobian = all(p is not None for p in patterns)
         self.blocks = 0
@@ -48,14 +58,21 @@ class ForceSum:
             self._build_pattern([p for p in patterns if p is not None])
 
     def _build_pattern(self, patterns: list[tuple[np.ndarray, np.ndarray]]) -> None:
-        rows = np.concatenate([p[0] for p in patterns] or [np.zeros(0, np.int64)])
-        cols = np.concatenate([p[1] for p in patterns] or [np.zeros(0, np.int64)])
+        every = np.arange(self.count, dtype=np.int64)
+        rows = np.concatenate([p[0] for p in patterns] + [every])
+        cols = np.concatenate([p[1] for p in patterns] + [every])
         keys, slots = np.unique(rows * self.count + cols, return_inverse=True)
-        block_rows, self._indices = np.divmod(keys, self.count)
-        self._indptr = np.searchsorted(block_rows, np.arange(self.count + 1)).astype(np.int64)
-        bounds = np.cumsum([0] + [p[0].shape[0] for p in patterns])
-        # Where each force's blocks land among the distinct ones.
-        self._slots = [slots[a:b] for a, b in itertools.pairwise(bounds)]
+        block_rows, self.indices = np.divmod(keys, self.count)
+        self.indices = self.indices.astype(np.int32)
+        self.indptr = np.searchsorted(block_rows, np.arange(self.count + 1)).astype(np.int32)
+        self.diagonal = slots[-self.count :] if self.count else np.zeros(0, np.int64)
+        # The forces fill their blocks side by side in one array (``_local``); each distinct
+        # block is the sum of its entries there, listed in CSR form for a parallel gather.
+        filled = slots[: slots.shape[0] - self.count]
+        self._bounds = np.cumsum([0] + [p[0].shape[0] for p in patterns])
+        self._order = np.argsort(filled, kind="stable").astype(np.int64)
+        self._start = np.searchsorted(filled[self._order], np.arange(keys.shape[0] + 1))
+        self._local = np.empty((2, filled.shape[0], 3, 3))
         self.blocks = int(keys.shape[0])
 
     def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
@@ -68,11 +85,14 @@ class ForceSum:
         return sum((f.potential(t, x, alive) for f in self.forces), 0.0)
 
     def jacobian(
-        self, t: float, x: np.ndarray, v: np.ndarray, definite: bool = False
+        self, t: float, x: np.ndarray, v: np.ndarray, form: str = "exact"
     ) -> tuple[Any, Any]:
-        """``(∂F/∂x, ∂F/∂v)`` as ``3N × 3N`` block-sparse matrices (``∂F/∂v`` is ``None`` if no
-        force depends on velocity); ``definite``: each force's ``add_definite_jacobian`` where
-        it has one (see :class:`~visviva.forces.Springs`), for linearized implicit steps.
+        """``(∂F/∂x, ∂F/∂v)`` as ``3N × 3N`` block-sparse matrices (BSR, 3×3 blocks, on the
+        pattern :attr:`indptr`, :attr:`indices`; ``∂F/∂v`` is ``None`` if no force depends
+        on velocity). ``form``: ``"exact"``; ``"symmetric"``, each force's
+        ``add_symmetric_jacobian`` where it has one (the damped springs' ``∂F/∂x`` without
+        the damper's non-symmetric part: ``−∇²U``); or ``"definite"``, the same made
+        positive semi-definite (see :class:`~visviva.forces.Springs`) for implicit steps.
 
         Raises:
             ValueError: If a force has no analytic Jacobian (check :attr:`has_jacobian`).
@@ -81,17 +101,33 @@ class ForceSum:
 
         if not self.has_jacobian:
             raise ValueError("a force of this scene has no analytic Jacobian")
-        stiffness = np.zeros((self.blocks, 3, 3))
-        damping = np.zeros((self.blocks, 3, 3))
-        for force, slots in zip(self.forces, self._slots, strict=True):
-            local_x = np.zeros((slots.shape[0], 3, 3))
-            local_v = np.zeros((slots.shape[0], 3, 3))
-            add = getattr(force, "add_definite_jacobian", None) if definite else None
-            (add or force.add_jacobian)(t, x, v, local_x, local_v)
-            np.add.at(stiffness, slots, local_x)
-            np.add.at(damping, slots, local_v)
+        local_x, local_v = self._local
+        local_x.fill(0.0)
+        local_v.fill(0.0)
+        for force, a, b in zip(self.forces, self._bounds[:-1], self._bounds[1:], strict=True):
+            symmetric = getattr(force, "add_symmetric_jacobian", None)
+            if form == "exact" or symmetric is None:
+                force.add_jacobian(t, x, v, local_x[a:b], local_v[a:b])
+            else:
+                symmetric(t, x, v, local_x[a:b], local_v[a:b], form == "definite")
         shape = (3 * self.count, 3 * self.count)
-        dfdx = sp.bsr_matrix((stiffness, self._indices, self._indptr), shape=shape)
-        if not self.velocity_dependent:
-            return dfdx, None
-        return dfdx, sp.bsr_matrix((damping, self._indices, self._indptr), shape=shape)
+        matrices = []
+        for local in self._local[: 2 if self.velocity_dependent else 1]:
+            blocks = np.empty((self.blocks, 3, 3))
+            _sum_blocks(self._start, self._order, local, blocks)
+            matrices.append(sp.bsr_matrix((blocks, self.indices, self.indptr), shape=shape))
+        return matrices[0], (matrices[1] if self.velocity_dependent else None)
+
+
+@njit(cache=True, parallel=True)
+def _sum_blocks(start, order, local, out):  # pragma: no cover - compiled
+    """``out[k] ← Σ local[order[j]]`` for ``j`` in ``start[k] : start[k + 1]``."""
+    for k in prange(out.shape[0]):
+        for a in range(3):
+            for b in range(3):
+                out[k, a, b] = 0.0
+        for j in range(start[k], start[k + 1]):
+            e = order[j]
+            for a in range(3):
+                for b in range(3):
+                    out[k, a, b] += local[e, a, b]

@@ -131,6 +131,11 @@ class Drag(_AirDrag):
         air_velocity: The air's velocity ``w`` [m/s].
     """
 
+    @property
+    def linear_damping(self) -> bool:
+        """In still air the drag is ``D v`` with ``D = −k I`` (see visviva.forces.ForceSum)."""
+        return not np.any(self.air_velocity)
+
     def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         """Add ``−k (v − w)`` [N] to ``out``."""
         k, w = self.coefficient, self.air_velocity
@@ -154,6 +159,8 @@ class Damping(_Field):
         mass: Particle masses [kg], shape ``(N,)``.
         targets: The particles it acts on (default: all).
     """
+
+    linear_damping = True  # F = D v with D = −γ m I (see visviva.forces.ForceSum)
 
     def __init__(self, rate: float, mass: np.ndarray, targets: Targets | None = None) -> None:
         super().__init__(mass, targets or Targets(len(mass)))

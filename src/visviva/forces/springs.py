@@ -17,8 +17,8 @@ the projection across the spring,
 fill four 3×3 blocks per spring, ``(i, i) = −K``, ``(i, j) = K``, ``(j, i) = K``,
 ``(j, j) = −K`` (and the same for ``D``), on a pattern fixed when the springs are built. A
 compressed spring (``l < L``) makes ``K`` indefinite across the spring: the buckling that
-linearized implicit steps handle by projecting it (:meth:`Springs.add_definite_jacobian`
-drops the negative part, Choi & Ko 2002).
+implicit steps handle by projecting it (:meth:`Springs.add_symmetric_jacobian` drops the
+negative part, Choi & Ko 2002).
 
 ``tests/test_springs.py`` checks every Jacobian against central finite differences of the same
 force (compressed springs included) and ``f = −∇U`` without damping.
@@ -53,6 +53,9 @@ class Springs:
 
     conservative: ClassVar[bool] = False
     velocity_dependent: ClassVar[bool] = True
+    #: The force is ``−∇U + D v`` with ``D = ∂F/∂v`` symmetric: the damper is linear in the
+    #: velocities (see :class:`~visviva.forces.ForceSum`).
+    linear_damping: ClassVar[bool] = True
 
     def __init__(
         self,
@@ -124,19 +127,32 @@ class Springs:
     ) -> None:
         """Add ``∂F/∂x`` [N/m] and ``∂F/∂v`` [N·s/m] into the blocks of
         :meth:`jacobian_blocks` (``(4S, 3, 3)`` each)."""
-        self._add_jacobian(x, v, dfdx, dfdv, False)
+        self._add_jacobian(x, v, dfdx, dfdv)
 
-    def add_definite_jacobian(
-        self, t: float, x: np.ndarray, v: np.ndarray, dfdx: np.ndarray, dfdv: np.ndarray
+    def add_symmetric_jacobian(
+        self,
+        t: float,
+        x: np.ndarray,
+        v: np.ndarray,
+        dfdx: np.ndarray,
+        dfdv: np.ndarray,
+        definite: bool,
     ) -> None:
-        """:meth:`add_jacobian` with each spring's stiffness made positive semi-definite: a
-        compressed spring's negative stiffness across it dropped, and the damper's
-        non-symmetric part with it (for linearized implicit steps, which need ``M − h D −
-        h² K`` positive definite)."""
-        self._add_jacobian(x, v, dfdx, dfdv, True)
+        """:meth:`add_jacobian` without the damper's non-symmetric part (the change of its
+        direction with the positions): ``∂F/∂x`` is then ``−∇²U``, the Hessian backward
+        Euler's incremental potential needs. ``definite``: each spring's stiffness made
+        positive semi-definite too, a compressed spring's negative stiffness across it dropped
+        (Choi & Ko 2002), so that ``M − h D − h² K`` is positive definite."""
+        self._add_jacobian(x, v, dfdx, dfdv, True, definite)
 
     def _add_jacobian(
-        self, x: np.ndarray, v: np.ndarray, dfdx: np.ndarray, dfdv: np.ndarray, definite: bool
+        self,
+        x: np.ndarray,
+        v: np.ndarray,
+        dfdx: np.ndarray,
+        dfdv: np.ndarray,
+        symmetric: bool = False,
+        definite: bool = False,
     ) -> None:
         _jacobian(
             self.pairs,
@@ -145,6 +161,7 @@ class Springs:
             self.damping,
             x,
             v,
+            symmetric,
             definite,
             dfdx,
             dfdv,
@@ -268,35 +285,30 @@ def _energy(p, rest, k, x):  # pragma: no cover - compiled
     return total
 
 
-@njit(cache=True, error_model="numpy")
-def _jacobian(p, rest, k, c, x, v, definite, dfdx, dfdv):  # pragma: no cover - compiled
-    u = np.empty(3)
-    w = np.empty(3)
-    block = np.empty((3, 3))
-    for s in range(p.shape[0]):
-        _, _, u[0], u[1], u[2], length, w[0], w[1], w[2], rate = _spring(p, x, v, s)
+@njit(cache=True, parallel=True, error_model="numpy")
+def _jacobian(p, rest, k, c, x, v, symmetric, definite, dfdx, dfdv):  # pragma: no cover
+    for s in prange(p.shape[0]):
+        _, _, ux, uy, uz, length, wx, wy, wz, rate = _spring(p, x, v, s)
+        u, w = (ux, uy, uz), (wx, wy, wz)
         across = k[s] * (1.0 - rest[s] / length)  # the stiffness across the spring
-        scale = c[s] / length
+        scale = 0.0 if symmetric else c[s] / length
         if definite:
             across = max(across, 0.0)
-            scale = 0.0
         for a in range(3):
-            # (wᵀ P)_b = w_b − (w · u) u_b
             for b in range(3):
-                projector = (1.0 if a == b else 0.0) - u[a] * u[b]
                 along = u[a] * u[b]
-                block[a, b] = (
+                projector = (1.0 if a == b else 0.0) - along
+                # (wᵀ P)_b = w_b − (w · u) u_b
+                block = (
                     k[s] * along
                     + across * projector
                     + scale * (u[a] * (w[b] - rate * u[b]) + rate * projector)
                 )
-        for a in range(3):
-            for b in range(3):
-                damper = c[s] * u[a] * u[b]
-                dfdx[4 * s, a, b] -= block[a, b]
-                dfdx[4 * s + 1, a, b] += block[a, b]
-                dfdx[4 * s + 2, a, b] += block[a, b]
-                dfdx[4 * s + 3, a, b] -= block[a, b]
+                damper = c[s] * along
+                dfdx[4 * s, a, b] -= block
+                dfdx[4 * s + 1, a, b] += block
+                dfdx[4 * s + 2, a, b] += block
+                dfdx[4 * s + 3, a, b] -= block
                 dfdv[4 * s, a, b] -= damper
                 dfdv[4 * s + 1, a, b] += damper
                 dfdv[4 * s + 2, a, b] += damper

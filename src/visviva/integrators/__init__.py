@@ -28,6 +28,7 @@ from .implicit import (
     Trapezoidal,
 )
 from .newton import NewtonOptions
+from .projected_newton import ProjectedNewton
 from .runge_kutta import (
     ButcherTableau,
     ExplicitEuler,
@@ -54,6 +55,7 @@ __all__ = [
     "LinearlyImplicitEuler",
     "Midpoint",
     "NewtonOptions",
+    "ProjectedNewton",
     "RungeKutta4",
     "SymplecticEuler",
     "SymplecticEulerPositionFirst",
@@ -132,6 +134,7 @@ for _method in (
     Trapezoidal,
     ImplicitMidpoint,
     LinearlyImplicitEuler,
+    ProjectedNewton,
 ):
     register(_method)
 del _method

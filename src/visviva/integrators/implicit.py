@@ -189,7 +189,7 @@ class LinearlyImplicitEuler(Integrator):
         force = system.force(t, q, v)
         # Definite: a buckling spring's negative stiffness would make the matrix indefinite
         # and the linearized step blow up (Baraff & Witkin; Choi & Ko 2002).
-        stiffness, damping = system.force_jacobian(t, q, v, force, definite=True)
+        stiffness, damping = system.force_jacobian(t, q, v, force, form="definite")
         matrix = mass_minus(system.mass, damping, stiffness, dt, v.shape)
         rhs = dt * (force + dt * _product(stiffness, v))
         v_new = v + linear_solve(system, matrix, rhs)

@@ -19,6 +19,7 @@ made of a first-order system alone (Dahlquist's test equation) is that system, p
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
@@ -111,13 +112,11 @@ def scene_system(model: Model) -> System:
     # every integrator, explicit or implicit: their rows and columns of the Jacobians are
     # zero too, which takes them out of Newton's linear systems.
     held = np.flatnonzero(np.repeat(model.particle_pinned, 3))
-    free = None
-    if held.shape[0]:
-        import scipy.sparse as sp
-
-        keep = np.ones(n, dtype=np.float64)
-        keep[held] = 0.0
-        free = sp.diags(keep)
+    held_blocks = None
+    if held.shape[0] and forces.has_jacobian:
+        pinned = model.particle_pinned
+        block_rows = np.repeat(np.arange(count), np.diff(forces.indptr))
+        held_blocks = np.flatnonzero(pinned[block_rows] | pinned[forces.indices])
 
     def force(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         out = np.zeros_like(q)
@@ -129,19 +128,25 @@ def scene_system(model: Model) -> System:
             out[a:b] = piece.acceleration(t, q[a:b], v[a:b])
         return out
 
-    def jacobian(t: float, q: np.ndarray, v: np.ndarray, definite: bool = False) -> tuple[Any, Any]:
+    def jacobian(t: float, q: np.ndarray, v: np.ndarray, form: str = "exact") -> tuple[Any, Any]:
         import scipy.sparse as sp
 
         stiffness, damping = [], []
         if count:
             shape = (count, 3)
             x, u = q[:n].reshape(shape), v[:n].reshape(shape)
-            dfdx, dfdv = forces.jacobian(t, x, u, definite)
-            dfdv = dfdv if dfdv is not None else sp.csr_matrix((n, n))
-            if free is not None:
-                dfdx, dfdv = free @ dfdx @ free, free @ dfdv @ free
+            dfdx, dfdv = forces.jacobian(t, x, u, form)
+            if dfdv is None and velocity_dependent:
+                dfdv = sp.bsr_matrix(
+                    (np.zeros_like(dfdx.data), forces.indices, forces.indptr), shape=dfdx.shape
+                )
+            for matrix in (dfdx, dfdv):
+                if held_blocks is not None and matrix is not None:
+                    matrix.data[held_blocks] = 0.0
+            if not pieces:
+                return dfdx, dfdv  # block-sparse, 3×3 blocks, as the forces' sum gives it
             stiffness.append(dfdx)
-            damping.append(dfdv)
+            damping.append(dfdv if dfdv is not None else sp.csr_matrix((n, n)))
         for a, b, piece in pieces:
             dq, dv = piece.force_jacobian(t, q[a:b], v[a:b])
             stiffness.append(sp.csr_matrix(dq))
@@ -162,9 +167,12 @@ def scene_system(model: Model) -> System:
             total += 0.0 if value is None else float(value)
         return total
 
+    def potential(t: float, q: np.ndarray) -> float:
+        return forces.potential(t, q[:n].reshape(count, 3))
+
     velocity_dependent = forces.velocity_dependent or any(p.velocity_dependent for *_, p in pieces)
     analytic = forces.has_jacobian and all(p.has_jacobian for *_, p in pieces)
-    return SceneSystem(
+    system = SceneSystem(
         force,
         mass=mass,
         velocity_dependent=velocity_dependent,
@@ -172,12 +180,21 @@ def scene_system(model: Model) -> System:
         energy=energy,
         layout=names,
     )
+    if count and not pieces and forces.gradient_form:
+        system.potential = potential
+    return system
 
 
 class SceneSystem(SecondOrderSystem):
     """A scene's second-order system; its energy counts only live particles (it reads the
-    state's carried ``particle_alive``), and it gives the forces' definite Jacobian (springs
-    without their negative stiffness) to linearized implicit steps."""
+    state's carried ``particle_alive``), and it gives the forces' symmetric or definite
+    Jacobian (springs without their damper's non-symmetric part, and without a compressed
+    spring's negative stiffness) to implicit steps that ask."""
+
+    #: ``U(t, q)`` [J], the potential of a scene whose force is ``−∇U(q) + D(q) v`` with
+    #: ``D = ∂F/∂v`` symmetric (particles whose forces are conservative or linearly damped),
+    #: else ``None``: backward Euler's step is then the minimum of an incremental potential.
+    potential: Callable[[float, np.ndarray], float] | None = None
 
     def force_jacobian(
         self,
@@ -186,12 +203,12 @@ class SceneSystem(SecondOrderSystem):
         v: np.ndarray,
         force: np.ndarray | None = None,
         *,
-        definite: bool = False,
+        form: str = "exact",
     ) -> tuple[Any, Any]:
-        if not definite or self._jacobian is None:
-            return super().force_jacobian(t, q, v, force, definite=definite)
+        if form == "exact" or self._jacobian is None:
+            return super().force_jacobian(t, q, v, force, form=form)
         self.counters.jacobian_evaluations += 1
-        return self._jacobian(t, q, v, True)  # type: ignore[call-arg]
+        return self._jacobian(t, q, v, form)  # type: ignore[call-arg]
 
     def energy(self, state: State) -> np.ndarray | None:
         """Kinetic plus potential energy [J] of ``state``: live particles and systems."""

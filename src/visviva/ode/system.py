@@ -309,15 +309,16 @@ class SecondOrderSystem:
         v: np.ndarray,
         force: np.ndarray | None = None,
         *,
-        definite: bool = False,
+        form: str = "exact",
     ) -> tuple[Any, Any]:
         """``(∂F/∂q, ∂F/∂v)`` at ``(t, q, v)``; the second is ``None`` for position-only forces.
 
         Each is ``(n, n)``, ``(batch, n, n)`` or sparse ``(n, n)``. Uses the problem's Jacobian
         when given, else forward finite differences of ``F`` (``force`` = ``F(t, q, v)`` saves
-        one evaluation). ``definite`` asks for the Jacobian with each element's negative
-        stiffness dropped where the system knows it (a scene's springs); a plain problem gives
-        its exact one.
+        one evaluation). ``form`` ``"symmetric"`` asks for ``∂F/∂q`` without the
+        non-symmetric part of velocity-dependent forces (``−∇²U`` where ``F = −∇U + D v``),
+        ``"definite"`` for the same with each element's negative stiffness dropped, where the
+        system knows them (a scene's springs); a plain problem gives its exact Jacobian.
         """
         self.counters.jacobian_evaluations += 1
         if self._jacobian is not None:
