@@ -120,9 +120,7 @@ class ProjectedNewton(BackwardEuler):
                 f"(got {projection!r})"
             )
         if linear_solver not in ("cg", "direct"):
-            raise ModelError(
-                f"`linear_solver` must be 'cg' or 'direct' (got {linear_solver!r})"
-            )
+            raise ModelError(f"`linear_solver` must be 'cg' or 'direct' (got {linear_solver!r})")
         self.projection = projection
         self.line_search = bool(line_search)
         self.linear_solver = linear_solver
@@ -299,11 +297,10 @@ class _Merit:
     def backtrack(self, v: np.ndarray, direction: np.ndarray, residual: np.ndarray) -> float:
         """The step ``α`` along ``direction`` from ``V`` that Armijo's rule accepts (the last
         halving's if none does: Newton's stopping rule judges what follows)."""
-        if self.potential is None:
-            slope = -2.0 * self.value(v)[0]  # along the Newton direction, d/dα ½‖g‖² = −‖g‖²
-        else:
-            slope = float(residual @ direction)  # ∇Φ = g
         start, scale = self.value(v)
+        # The merit's slope along the direction: gᵀd for Φ (∇Φ = g); for ½‖g‖² along Newton's
+        # direction, −‖g‖².
+        slope = -2.0 * start if self.potential is None else float(residual @ direction)
         step = 1.0
         for _ in range(HALVINGS):
             trial, size = self.value(v + step * direction)
