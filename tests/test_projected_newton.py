@@ -157,7 +157,7 @@ def test_agrees_with_exact_backward_euler_on_an_undamped_cloth():
 
 
 def _strain(model, positions):
-    network = [e for e in model.forces if isinstance(e, vv.forces.Springs)][0]
+    network = next(e for e in model.forces if isinstance(e, vv.forces.Springs))
     i, j = network.pairs.T
     length = np.linalg.norm(positions[j] - positions[i], axis=1)
     return np.abs(length / network.rest_length - 1.0)
