@@ -115,6 +115,8 @@ class PenaltyContact:
             out,
             np.zeros((0, 3, 3)),
             np.zeros((0, 3, 3)),
+            False,
+            False,
             *self.colliders.kernel_arrays[1:],
         )
 
@@ -133,6 +135,16 @@ class PenaltyContact:
 
     def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
         """The blocks of the module docstring, summed over the colliders in contact."""
+        self._add_jacobian(x, v, dfdx, dfdv, False, False)
+
+    def add_symmetric_jacobian(self, t, x, v, dfdx, dfdv, definite) -> None:  # type: ignore[no-untyped-def]
+        """:meth:`add_jacobian` without the damper's change of direction with position
+        (``−c n vᵀH``); ``definite``: without the curvature term ``f H`` too, which pushes
+        a particle sideways off a sphere (positive in ``∂F/∂x``: it makes the potential's
+        Hessian indefinite)."""
+        self._add_jacobian(x, v, dfdx, dfdv, True, definite)
+
+    def _add_jacobian(self, x, v, dfdx, dfdv, symmetric, definite) -> None:  # type: ignore[no-untyped-def]
         _penalty(
             self._touched,
             x,
@@ -144,6 +156,8 @@ class PenaltyContact:
             np.zeros((0, 3)),
             dfdx,
             dfdv,
+            symmetric,
+            definite,
             *self.colliders.kernel_arrays[1:],
         )
 
@@ -160,6 +174,8 @@ def _penalty(
     out,
     dfdx,
     dfdv,
+    symmetric,
+    definite,
     kinds,
     rows,
     offsets,
@@ -169,7 +185,8 @@ def _penalty(
     tn,
 ):  # pragma: no cover - compiled
     """Forces into ``out`` (if it has rows) and Jacobian blocks into ``dfdx``/``dfdv`` (if they
-    have rows), for the particles ``index``."""
+    have rows), for the particles ``index``; ``symmetric``/``definite`` leave out the terms
+    :meth:`PenaltyContact.add_symmetric_jacobian` names."""
     forces = out.shape[0] > 0
     for b in range(index.shape[0]):
         i = index[b]
@@ -192,13 +209,13 @@ def _penalty(
                     out[i, a] += f * n[a]
                 continue
             curvature = np.zeros((3, 3))
-            if kinds[k] == _SPHERE:
+            if kinds[k] == _SPHERE and not definite:
                 rho = abs(d + rows[k, 3])  # distance of the centre from the sphere's centre
                 for r in range(3):
                     for c in range(3):
                         curvature[r, c] = ((1.0 if r == c else 0.0) - n[r] * n[c]) / rho
             # vᵀH, the velocity's change of v·n along each axis.
-            vh = curvature.T @ v[i]
+            vh = np.zeros(3) if symmetric else curvature.T @ v[i]
             for r in range(3):
                 for c in range(3):
                     dfdx[b, r, c] += (

@@ -48,8 +48,7 @@ class ForceSum:
         self.velocity_dependent = any(f.velocity_dependent for f in self.forces)
         self.conservative = all(f.conservative for f in self.forces)
         self.gradient_form = all(
-            (f.conservative and not f.velocity_dependent) or getattr(f, "linear_damping", False)
-            for f in self.forces
+            f.conservative or getattr(f, "linear_damping", False) for f in self.forces
         )
         patterns = [f.jacobian_blocks() for f in self.forces]
         self.has_jacobian = all(p is not None for p in patterns)
