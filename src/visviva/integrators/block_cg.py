@@ -14,6 +14,10 @@ positive definite) ends the iteration with the iterate so far — the truncated-
 unprojected indefinite matrix still gives a usable step — and says so.
 
 References:
+    D. Baraff, A. Witkin, "Large steps in cloth simulation", SIGGRAPH 1998, §5.3 (filtering
+    constrained particles' directions out of CG).
+    U. M. Ascher, E. Boxerman, "On the modified conjugate gradient method in cloth simulation",
+    The Visual Computer 19 (2003) 526–531.
     M. R. Hestenes, E. Stiefel, "Methods of conjugate gradients for solving linear systems",
     J. Res. Nat. Bur. Standards 49 (1952) 409–436.
     J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer 2006, §5.1 and §7.1.
@@ -92,6 +96,18 @@ def _precondition(inverse, r, z):  # pragma: no cover - compiled
 
 
 @njit(cache=True, parallel=True)
+def _filter(normals, r):  # pragma: no cover - compiled
+    """``r_i ← (I − n_i n_iᵀ) r_i`` where row ``i`` of ``normals`` is a unit normal (rows of
+    zeros leave ``r_i`` as it is)."""
+    for i in prange(r.shape[0]):
+        n0, n1, n2 = normals[i, 0], normals[i, 1], normals[i, 2]
+        along = r[i, 0] * n0 + r[i, 1] * n1 + r[i, 2] * n2
+        r[i, 0] -= along * n0
+        r[i, 1] -= along * n1
+        r[i, 2] -= along * n2
+
+
+@njit(cache=True, parallel=True)
 def _dot(a, b):  # pragma: no cover - compiled
     total = 0.0
     for i in prange(a.shape[0]):
@@ -121,8 +137,9 @@ def _new_direction(beta, z, p):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _cg(indptr, indices, data, inverse, b, x, rtol, max_iterations):  # pragma: no cover
+def _cg(indptr, indices, data, inverse, normals, b, x, rtol, max_iterations):  # pragma: no cover
     rows = b.shape[0]
+    filtered = normals.shape[0] > 0
     r = np.empty((rows, 3))
     z = np.empty((rows, 3))
     ap = np.empty((rows, 3))
@@ -130,14 +147,21 @@ def _cg(indptr, indices, data, inverse, b, x, rtol, max_iterations):  # pragma: 
     for i in range(rows):
         for a in range(3):
             r[i, a] = b[i, a] - ap[i, a]
-    goal = rtol * rtol * _dot(b, b)
+    if filtered:
+        _filter(normals, r)
+    goal = rtol * rtol * _dot(r, r) if filtered else rtol * rtol * _dot(b, b)
     residual = _dot(r, r)
-    if residual <= goal:
+    if residual <= goal or residual == 0.0:
         return 0, True, True
     rz = _precondition(inverse, r, z)
+    if filtered:
+        _filter(normals, z)
+        rz = _dot(r, z)
     p = z.copy()
     for iteration in range(1, max_iterations + 1):
         block_product(indptr, indices, data, p, ap)
+        if filtered:
+            _filter(normals, ap)
         curvature = _dot(p, ap)
         if not curvature > 0.0:
             return iteration, False, False  # not positive definite along p: stop here
@@ -145,6 +169,9 @@ def _cg(indptr, indices, data, inverse, b, x, rtol, max_iterations):  # pragma: 
         if residual <= goal:
             return iteration, True, True
         rz_new = _precondition(inverse, r, z)
+        if filtered:
+            _filter(normals, z)
+            rz_new = _dot(r, z)
         _new_direction(rz_new / rz, z, p)
         rz = rz_new
     return max_iterations, False, True
@@ -158,8 +185,10 @@ def block_cg(
     x: np.ndarray,
     rtol: float,
     max_iterations: int,
+    normals: np.ndarray | None = None,
 ) -> tuple[int, bool, bool]:
-    """Solve ``A x = b`` by preconditioned CG, starting from (and overwriting) ``x``.
+    """Solve ``A x = b`` by preconditioned CG, starting from (and overwriting) ``x``; with
+    ``normals``, in the subspace where each row ``x_i`` is orthogonal to ``normals[i]``.
 
     Args:
         indptr, indices, data: ``A`` in BSR form with 3×3 blocks (``data`` ``(blocks, 3, 3)``),
@@ -168,6 +197,10 @@ def block_cg(
         x: ``(rows, 3)`` initial guess (a warm start), the solution on return.
         rtol: Stop when ``‖b − A x‖ ≤ rtol ‖b‖``.
         max_iterations: Iterations allowed.
+        normals: ``(rows, 3)`` a unit normal per row whose motion along it is held (zero rows
+            are free): CG then solves ``S A S x = S b`` with ``S`` the projection across the
+            normals (Baraff & Witkin's filtered PCG for constrained particles), the residual
+            measured after filtering. ``x`` must start in that subspace.
 
     Returns:
         ``(iterations, converged, positive)``: ``positive`` is false if a direction of
@@ -175,4 +208,5 @@ def block_cg(
     """
     inverse = np.empty((b.shape[0], 3, 3))
     diagonal_inverse(indptr, indices, data, inverse)
-    return _cg(indptr, indices, data, inverse, b, x, rtol, max_iterations)
+    held = np.zeros((0, 3)) if normals is None else normals
+    return _cg(indptr, indices, data, inverse, held, b, x, rtol, max_iterations)

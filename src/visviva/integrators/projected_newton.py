@@ -47,6 +47,7 @@ from numba import njit, prange
 from .._validation import real_number, whole_number
 from ..errors import ModelError, NewtonConvergenceError
 from .block_cg import block_cg, block_product
+from .friction import LaggedFriction
 from .implicit import BackwardEuler
 from .newton import KRYLOV_THRESHOLD, linear_solve, mass_minus
 
@@ -58,6 +59,12 @@ __all__ = ["ProjectedNewton"]
 
 #: When the Newton matrix uses the forces' definite (projected) stiffness.
 PROJECTIONS = ("adaptive", "always", "never")
+#: Times a step whose Newton iteration does not converge may be halved (down to h/8).
+SPLITS = 3
+#: Updates of the set of particles held on colliders' surfaces per step.
+CONTACT_ROUNDS = 4
+#: Sliding speed [m/s] below which friction on held particles acts as a stiff drag (static).
+FRICTION_SLIP = 1e-3
 #: Armijo's fraction of the predicted decrease a step must achieve.
 ARMIJO = 1e-4
 #: Halvings the line search may take (the shortest step is 2⁻¹² of Newton's).
@@ -131,9 +138,99 @@ class ProjectedNewton(BackwardEuler):
         if not _takes(system, state):
             return super().step(system, state, dt)
         q, v = state.parts
-        guess = v if state.acceleration is None else v + dt * state.acceleration
-        v_new = self._minimize(system, state.t + dt, q, v, guess, dt)  # type: ignore[arg-type]
-        return state.from_parts(state.t + dt, (q + dt * v_new, v_new), (v_new, (v_new - v) / dt))
+        acceleration = state.acceleration
+        q, v, acceleration = self._advance(system, state.t, q, v, acceleration, dt, SPLITS)  # type: ignore[arg-type]
+        return state.from_parts(state.t + dt, (q, v), (v, acceleration))
+
+    def _advance(
+        self,
+        system: SecondOrderSystem,
+        t: float,
+        q: np.ndarray,
+        v: np.ndarray,
+        acceleration: np.ndarray | None,
+        h: float,
+        splits: int,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(q, v, a)`` after one backward Euler step of ``h`` [s] — or, if Newton does not
+        converge in it, after two of ``h/2``, each split again up to ``splits`` times (the
+        failed attempts count as ``rejected_steps``)."""
+        guess = v if acceleration is None else v + h * acceleration
+        constraints = getattr(system, "contact_constraints", None)
+        try:
+            if constraints is None:
+                v_new, _ = self._minimize(system, t + h, q, v, guess, h, None)
+            else:
+                v_new = self._in_contact(system, constraints, t + h, q, v, guess, h)
+        except NewtonConvergenceError:
+            if splits == 0:
+                raise
+            system.counters.rejected_steps += 1
+            half = 0.5 * h
+            q, v, acceleration = self._advance(system, t, q, v, acceleration, half, splits - 1)
+            return self._advance(system, t + half, q, v, acceleration, half, splits - 1)
+        return q + h * v_new, v_new, (v_new - v) / h
+
+    def _in_contact(
+        self,
+        system: SecondOrderSystem,
+        constraints: Any,
+        t: float,
+        q_base: np.ndarray,
+        v_base: np.ndarray,
+        v: np.ndarray,
+        h: float,
+    ) -> np.ndarray:
+        """:meth:`_minimize` with the colliders' contacts as constraints (Baraff & Witkin
+        1998, §5): a particle whose end-of-step position ``q_b + hV`` would be inside a
+        collider is held on its surface — its velocity along the surface normal set so that it
+        ends there, and that component filtered out of the solve — and released where holding
+        it would take a pull. The active set is updated from the solution, up to
+        :data:`CONTACT_ROUNDS` times. Each round after the first adds Coulomb friction on the
+        held particles, with the normal impulses of the round before (the residual along the
+        normal is the impulse the collider supplied; :mod:`.friction`). Held contacts are
+        inelastic; what is left (bounces, the odd particle still inside) is the collision
+        stage's, after the step."""
+        count = v.size // 3
+        normals = np.zeros((count, 3))
+        active = np.zeros(count, dtype=bool)
+        v = v.copy()
+        friction = None
+        for _ in range(CONTACT_ROUNDS):
+            # Held particles slide along their tangent planes, which takes them off a curved
+            # surface by up to (hV)²/2R: look for them that far out.
+            reach = h * float(np.abs(v).max())
+            particle, normal, depth, mu = constraints(q_base + h * v, reach)
+            near = np.zeros(count, dtype=bool)
+            near[particle] = True
+            inside = np.zeros(count, dtype=bool)
+            inside[particle[depth > 0.0]] = True
+            entering = inside & ~active
+            active = (active & near) | entering
+            normals.fill(0.0)
+            held = active[particle]
+            normals[particle[held]] = normal[held]
+            # Feasible first: each held particle's velocity along its normal makes it end on
+            # the surface (depth [m] ÷ h).
+            shift = np.zeros((count, 3))
+            shift[particle[held]] = (np.maximum(depth[held], 0.0) / h)[:, None] * normal[held]
+            v += shift.reshape(v.shape)
+            v, residual = self._minimize(system, t, q_base, v_base, v, h, normals, friction)
+            # The collider can only push: release a particle whose constraint force
+            # (residual ÷ h along the normal) pulls it in.
+            pushing = np.einsum("ij,ij->i", residual.reshape(count, 3), normals)
+            pulling = active & (pushing < 0.0)
+            active &= ~pulling
+            weight = np.zeros(count)
+            weight[particle[held]] = mu[held]
+            weight *= np.where(active, pushing, 0.0)  # μ J [N·s]
+            settled = not pulling.any() and not entering.any()
+            if settled and (friction is not None or not weight.any()):
+                break
+            friction = None
+            if weight.any():
+                friction = LaggedFriction(normals * active[:, None], weight, FRICTION_SLIP)
+        return v
 
     def _minimize(
         self,
@@ -143,8 +240,13 @@ class ProjectedNewton(BackwardEuler):
         v_base: np.ndarray,
         v: np.ndarray,
         h: float,
-    ) -> np.ndarray:
-        """``V`` with ``M (V − v_b) = h F(t, q_b + hV, V)``, from the guess ``v``."""
+        normals: np.ndarray | None,
+        friction: LaggedFriction | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``V`` with ``M (V − v_b) = h F(t, q_b + hV, V)``, from the guess ``v``, and the
+        residual at the last iterate; with ``normals`` ``(N, 3)`` (unit rows for held
+        particles, zero rows for free ones), only across the held particles' normals, and
+        with ``friction``'s impulses on them."""
         mass = np.ones_like(v) if system.mass is None else system.mass.diagonal()
         mass = np.broadcast_to(mass, v.shape)
         potential = getattr(system, "potential", None)
@@ -168,18 +270,25 @@ class ProjectedNewton(BackwardEuler):
                 else:
                     force = system.force(t, q, v)
                 residual = mass * (v - v_base) - h * force
-                direction, positive = self._solve(system, mass, stiffness, damping, h, -residual)
+                extra = None
+                if friction is not None:
+                    residual = residual + friction.gradient(v).reshape(v.shape)
+                    extra = friction.blocks(v)
+                free = residual if normals is None else _across(normals, residual)
+                direction, positive = self._solve(
+                    system, mass, stiffness, damping, h, -free, normals, extra
+                )
                 if positive or not adaptive:
                     break
-            norm = _decrement_ratio(residual, direction, mass, v, newton.atol, newton.rtol)
+            norm = _decrement_ratio(free, direction, mass, v, newton.atol, newton.rtol)
             if not np.isfinite(norm):
                 break
             if norm <= 1.0:
-                return v + direction
+                return v + direction, residual
             step = 1.0
             if self.line_search:
-                merit = _Merit(system, t, q_base, v_base, mass, h, damping, potential)
-                step = merit.backtrack(v, direction, residual)
+                merit = _Merit(system, t, q_base, v_base, mass, h, damping, potential, friction)
+                step = merit.backtrack(v, direction, free)
             v = v + step * direction
             if adaptive:
                 exact = step == 1.0
@@ -206,9 +315,13 @@ class ProjectedNewton(BackwardEuler):
         damping: Any,
         h: float,
         rhs: np.ndarray,
+        normals: np.ndarray | None = None,
+        extra: np.ndarray | None = None,
     ) -> tuple[np.ndarray, bool]:
-        """The Newton direction ``d`` with ``(M − h D − h² K) d = rhs``, and whether the matrix
-        was found positive definite along the way (CG only; a direct solve says yes)."""
+        """The Newton direction ``d`` with ``(M − h D − h² K + E) d = rhs``, ``E`` the
+        block-diagonal ``extra`` ``(N, 3, 3)`` if given (friction), across ``normals`` if given
+        (see :func:`~.block_cg.block_cg`), and whether the matrix was found positive definite
+        along the way (CG only; a direct solve says yes)."""
         blocked = _same_blocks(stiffness, damping) and rhs.size % 3 == 0
         if not blocked:
             matrix = mass_minus(system.mass, damping, stiffness, h, rhs.shape)
@@ -219,10 +332,19 @@ class ProjectedNewton(BackwardEuler):
             stiffness.indptr, stiffness.indices, stiffness.data, damping_data,
             mass.reshape(-1, 3), h, data,
         )  # fmt: skip
+        if extra is not None:
+            _add_diagonal(stiffness.indptr, stiffness.indices, data, extra)
         if self.linear_solver == "direct":
             import scipy.sparse as sp
 
             matrix = sp.bsr_matrix((data, stiffness.indices, stiffness.indptr), stiffness.shape)
+            if normals is not None:
+                # S A S + (I − S), S the projection across the normals: the held components
+                # of d solve to 0, the free ones see A restricted to them.
+                across = np.eye(3) - normals[:, :, None] * normals[:, None, :]
+                rows = np.arange(normals.shape[0] + 1, dtype=np.int32)
+                s = sp.bsr_matrix((across, rows[:-1], rows), stiffness.shape)
+                matrix = s @ matrix @ s + sp.identity(rhs.size) - s
             return linear_solve(system, matrix.tocsc(), rhs), True
         system.counters.linear_solves += 1
         direction = np.zeros((rhs.size // 3, 3))
@@ -234,6 +356,7 @@ class ProjectedNewton(BackwardEuler):
             direction,
             self.cg_rtol,
             self.cg_max_iterations,
+            normals,
         )
         system.counters.krylov_iterations += iterations
         # Not converged within the iterations, or stopped by negative curvature: the iterate is
@@ -250,6 +373,13 @@ def _takes(system: System, state: State) -> bool:
         return False
     # Without an analytic Jacobian, finite differences cost one force per unknown.
     return system.has_jacobian or state.parts[0].size <= KRYLOV_THRESHOLD
+
+
+def _across(normals: np.ndarray, vector: np.ndarray) -> np.ndarray:
+    """``vector`` (flat, ``3N``) without its components along each row of ``normals``."""
+    rows = vector.reshape(-1, 3)
+    along = np.einsum("ij,ij->i", rows, normals)
+    return (rows - along[:, None] * normals).reshape(vector.shape)
 
 
 def _product(matrix: Any, v: np.ndarray) -> np.ndarray:
@@ -277,9 +407,11 @@ class _Merit:
         h: float,
         damping: Any,
         potential: Any,
+        friction: LaggedFriction | None = None,
     ) -> None:
         self.system, self.t, self.q_base, self.v_base = system, t, q_base, v_base
         self.mass, self.h, self.damping, self.potential = mass, h, damping, potential
+        self.friction = friction
 
     def value(self, v: np.ndarray) -> tuple[float, float]:
         """The merit at ``V`` and the size of its terms (to judge round-off by)."""
@@ -292,6 +424,8 @@ class _Merit:
         inertia = 0.5 * float(np.dot(self.mass * change, change))
         energy = float(self.potential(self.t, q))
         dissipation = -0.5 * self.h * float(np.dot(v, _product(self.damping, v)))
+        if self.friction is not None:
+            dissipation += self.friction.potential(v)
         return inertia + energy + dissipation, abs(inertia) + abs(energy) + abs(dissipation)
 
     def backtrack(self, v: np.ndarray, direction: np.ndarray, residual: np.ndarray) -> float:
@@ -325,6 +459,17 @@ def _same_blocks(stiffness: Any, damping: Any) -> bool:
         and np.array_equal(damping.indptr, stiffness.indptr)
         and np.array_equal(damping.indices, stiffness.indices)
     )
+
+
+@njit(cache=True, parallel=True)
+def _add_diagonal(indptr, indices, data, extra):  # pragma: no cover - compiled
+    """``data``'s block ``(r, r)`` += ``extra[r]`` for every block row ``r``."""
+    for r in prange(indptr.shape[0] - 1):
+        for b in range(indptr[r], indptr[r + 1]):
+            if indices[b] == r:
+                for a in range(3):
+                    for c in range(3):
+                        data[b, a, c] += extra[r, a, c]
 
 
 @njit(cache=True, parallel=True)

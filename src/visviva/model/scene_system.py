@@ -182,7 +182,56 @@ def scene_system(model: Model) -> System:
     )
     if count and not pieces and forces.gradient_form:
         system.potential = potential
+    system.contact_constraints = _contact_constraints(model)
     return system
+
+
+def _contact_constraints(
+    model: Model,
+) -> Callable[[np.ndarray, float], tuple[np.ndarray, ...]] | None:
+    """``(q, reach) ↦ (particles, normals, push, friction)``: the particles inside the impulse
+    colliders at positions ``q`` or within ``reach`` [m] of them (one contact per particle, the
+    deepest), their
+    colliders' outward normals, how far [m] each must move along its normal to sit just
+    outside (half the touching gap: the collision stage then finds nothing to undo, and the
+    next step still finds it touching) and the colliders' friction coefficients μ (see
+    :attr:`SceneSystem.contact_constraints`); ``None`` for a scene without impulse colliders or
+    with emitters (whose live particles change between steps)."""
+    from ..collision.contacts import DEFAULT_GAP, Contacts, find_contacts
+    from ..collision.response import ParticleCollisions
+
+    stages = [s for s in model.stages if isinstance(s, ParticleCollisions)]
+    if not stages or model.emitters:
+        return None
+    count = model.particle_count
+    radius = model.particle_radius
+    alive = np.ones(count, dtype=bool)
+    friction = np.concatenate([s.response.friction for s in stages])
+
+    def constraints(q: np.ndarray, reach: float) -> tuple[np.ndarray, ...]:
+        x = q[: 3 * count].reshape(count, 3)
+        still = np.zeros_like(x)
+        found = Contacts.join(
+            [
+                find_contacts(
+                    x,
+                    still,
+                    radius,
+                    alive,
+                    s.masks,
+                    s.colliders,
+                    s.response.resting_speed,
+                    s.labels,
+                    max(reach, DEFAULT_GAP),
+                )
+                for s in stages
+            ]
+        )
+        order = np.argsort(found.depth, kind="stable")  # the deepest last: it wins
+        push = found.depth[order] + 0.5 * DEFAULT_GAP
+        return found.particle[order], found.normal[order], push, friction[found.collider[order]]
+
+    return constraints
 
 
 class SceneSystem(SecondOrderSystem):
@@ -195,6 +244,10 @@ class SceneSystem(SecondOrderSystem):
     #: ``D = ∂F/∂v`` symmetric (particles whose forces are conservative or linearly damped),
     #: else ``None``: backward Euler's step is then the minimum of an incremental potential.
     potential: Callable[[float, np.ndarray], float] | None = None
+    #: ``(q, reach) ↦ (particles, normals, push, friction)`` for the impulse colliders at
+    #: positions ``q`` (see :func:`_contact_constraints`), which implicit steps may hold particles
+    #: against (``None``: no such colliders).
+    contact_constraints: Callable[[np.ndarray, float], tuple[np.ndarray, ...]] | None = None
 
     def force_jacobian(
         self,
