@@ -51,6 +51,7 @@ class LaggedFriction:
         rows = v.reshape(-1, 3)
         along = np.einsum("ij,ij->i", rows, self.normals)
         tangential = rows - along[:, None] * self.normals
+        tangential[~np.any(self.normals != 0.0, axis=1)] = 0.0  # free points slide freely
         return tangential, np.linalg.norm(tangential, axis=1)
 
     def potential(self, v: np.ndarray) -> float:
@@ -58,6 +59,7 @@ class LaggedFriction:
         _, u = self._tangential(v)
         e = self.slip
         f0 = np.where(u >= e, u, -(u**3) / (3 * e * e) + u * u / e + e / 3)
+        f0[~np.any(self.normals != 0.0, axis=1)] = 0.0
         return float(np.dot(self.weight, f0))
 
     def gradient(self, v: np.ndarray) -> np.ndarray:

@@ -63,6 +63,8 @@ PROJECTIONS = ("adaptive", "always", "never")
 SPLITS = 3
 #: Updates of the set of particles held on colliders' surfaces per step.
 CONTACT_ROUNDS = 4
+#: The tolerance of the solves that only move the contact set, times the step's.
+ROUGH = 10.0
 #: Sliding speed [m/s] below which friction on held particles acts as a stiff drag (static).
 FRICTION_SLIP = 1e-3
 #: Armijo's fraction of the predicted decrease a step must achieve.
@@ -112,7 +114,7 @@ class ProjectedNewton(BackwardEuler):
         self,
         *,
         rtol: float = 1e-3,
-        atol: float = 1e-5,
+        atol: float = 1e-4,
         max_iterations: int = 30,
         projection: str = "adaptive",
         line_search: bool = True,
@@ -186,8 +188,9 @@ class ProjectedNewton(BackwardEuler):
         collider is held on its surface — its velocity along the surface normal set so that it
         ends there, and that component filtered out of the solve — and released where holding
         it would take a pull. The active set is updated from the solution, up to
-        :data:`CONTACT_ROUNDS` times. Each round after the first adds Coulomb friction on the
-        held particles, with the normal impulses of the round before (the residual along the
+        :data:`CONTACT_ROUNDS` times, roughly (to :data:`ROUGH` times the tolerance); then the
+        last solve, to the tolerance. Each solve after the first adds Coulomb friction on the
+        held particles, with the normal impulses of the one before (the residual along the
         normal is the impulse the collider supplied; :mod:`.friction`). Held contacts are
         inelastic; what is left (bounces, the odd particle still inside) is the collision
         stage's, after the step."""
@@ -196,7 +199,9 @@ class ProjectedNewton(BackwardEuler):
         active = np.zeros(count, dtype=bool)
         v = v.copy()
         friction = None
-        for _ in range(CONTACT_ROUNDS):
+        pulling = np.zeros(count, dtype=bool)
+        weight = np.zeros(count)  # μ J [N·s] of each held particle, from the last solve
+        for round_ in range(CONTACT_ROUNDS + 1):
             # Held particles slide along their tangent planes, which takes them off a curved
             # surface by up to (hV)²/2R: look for them that far out.
             reach = h * float(np.abs(v).max())
@@ -206,30 +211,32 @@ class ProjectedNewton(BackwardEuler):
             inside = np.zeros(count, dtype=bool)
             inside[particle[depth > 0.0]] = True
             entering = inside & ~active
+            settled = round_ > 0 and not entering.any() and not pulling.any()
+            if settled or round_ == CONTACT_ROUNDS:
+                break
             active = (active & near) | entering
             normals.fill(0.0)
             held = active[particle]
             normals[particle[held]] = normal[held]
+            coefficient = np.zeros(count)
+            coefficient[particle[held]] = mu[held]
             # Feasible first: each held particle's velocity along its normal makes it end on
             # the surface (depth [m] ÷ h).
             shift = np.zeros((count, 3))
             shift[particle[held]] = (np.maximum(depth[held], 0.0) / h)[:, None] * normal[held]
             v += shift.reshape(v.shape)
-            v, residual = self._minimize(system, t, q_base, v_base, v, h, normals, friction)
+            friction = _friction(normals, active, weight)
+            # The rounds that move the set only need a rough answer: 10 times the tolerance.
+            v, residual = self._minimize(system, t, q_base, v_base, v, h, normals, friction, ROUGH)
             # The collider can only push: release a particle whose constraint force
             # (residual ÷ h along the normal) pulls it in.
             pushing = np.einsum("ij,ij->i", residual.reshape(count, 3), normals)
             pulling = active & (pushing < 0.0)
             active &= ~pulling
-            weight = np.zeros(count)
-            weight[particle[held]] = mu[held]
-            weight *= np.where(active, pushing, 0.0)  # μ J [N·s]
-            settled = not pulling.any() and not entering.any()
-            if settled and (friction is not None or not weight.any()):
-                break
-            friction = None
-            if weight.any():
-                friction = LaggedFriction(normals * active[:, None], weight, FRICTION_SLIP)
+            weight = coefficient * np.where(active, pushing, 0.0)
+        normals *= active[:, None]
+        friction = _friction(normals, active, weight)
+        v, _ = self._minimize(system, t, q_base, v_base, v, h, normals, friction)
         return v
 
     def _minimize(
@@ -242,11 +249,13 @@ class ProjectedNewton(BackwardEuler):
         h: float,
         normals: np.ndarray | None,
         friction: LaggedFriction | None = None,
+        rough: float = 1.0,
     ) -> tuple[np.ndarray, np.ndarray]:
         """``V`` with ``M (V − v_b) = h F(t, q_b + hV, V)``, from the guess ``v``, and the
         residual at the last iterate; with ``normals`` ``(N, 3)`` (unit rows for held
         particles, zero rows for free ones), only across the held particles' normals, and
-        with ``friction``'s impulses on them."""
+        with ``friction``'s impulses on them; ``rough``: stop at that many times the
+        tolerance."""
         mass = np.ones_like(v) if system.mass is None else system.mass.diagonal()
         mass = np.broadcast_to(mass, v.shape)
         potential = getattr(system, "potential", None)
@@ -283,7 +292,7 @@ class ProjectedNewton(BackwardEuler):
             norm = _decrement_ratio(free, direction, mass, v, newton.atol, newton.rtol)
             if not np.isfinite(norm):
                 break
-            if norm <= 1.0:
+            if norm <= rough:
                 return v + direction, residual
             step = 1.0
             if self.line_search:
@@ -373,6 +382,15 @@ def _takes(system: System, state: State) -> bool:
         return False
     # Without an analytic Jacobian, finite differences cost one force per unknown.
     return system.has_jacobian or state.parts[0].size <= KRYLOV_THRESHOLD
+
+
+def _friction(normals: np.ndarray, active: np.ndarray, weight: np.ndarray) -> LaggedFriction | None:
+    """Friction on the ``active`` particles, ``weight`` ``(N,)`` = μ J [N·s] each (``None``
+    where there is none)."""
+    weight = np.where(active, weight, 0.0)
+    if not weight.any():
+        return None
+    return LaggedFriction(normals * active[:, None], weight, FRICTION_SLIP)
 
 
 def _across(normals: np.ndarray, vector: np.ndarray) -> np.ndarray:
