@@ -29,23 +29,21 @@ from .parts import (
 )
 from .scene import (
     MAX_PARTICLES,
-    Cloth,
     Collider,
     Emitter,
     ForceField,
     ParticleCloud,
     Particles,
-    Rope,
     Scene,
-    SoftLattice,
     System,
 )
+from .scene_bodies import BODIES, POINT_BODIES, Body, Hair, Rope, SpringGraph
 from .systems import SYSTEMS
 
 __all__ = ["build_model", "entity_names"]
 
 #: Entities that hold particles (which forces and colliders may target).
-PARTICLE_ENTITIES = (Particles, ParticleCloud, Rope, Cloth, SoftLattice, Emitter)
+PARTICLE_ENTITIES = (Particles, ParticleCloud, *BODIES, Emitter)
 
 
 def entity_names(scene: Scene) -> list[str]:
@@ -73,9 +71,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     except Located as located:
         raise SceneError([located.problem]) from None
     slots = sum(s.capacity for s in specs) + sum(
-        _count(e)
-        for e in scene.entities
-        if isinstance(e, (Particles, ParticleCloud, Rope, Cloth, SoftLattice))
+        _count(e) for e in scene.entities if isinstance(e, (Particles, ParticleCloud, *BODIES))
     )
     if slots > MAX_PARTICLES:
         raise SceneError(
@@ -260,10 +256,10 @@ def _check(scene: Scene) -> list[SceneProblem]:
                 )
             else:
                 seen[entity.name] = index
-        if isinstance(entity, (Particles, Rope)):
+        if isinstance(entity, (Particles, *POINT_BODIES)):
             total += _count(entity)
             problems += _check_lengths(entity, where)
-        elif isinstance(entity, (ParticleCloud, Cloth, SoftLattice)):
+        elif isinstance(entity, (ParticleCloud, *BODIES)):
             total += _count(entity)
         elif isinstance(entity, System):
             problems += _check_system(entity, where)
@@ -353,18 +349,16 @@ def _check_first_order(scene: Scene) -> list[SceneProblem]:
     return []
 
 
-def _count(entity: Particles | ParticleCloud | Rope | Cloth | SoftLattice) -> int:
+def _count(entity: Particles | ParticleCloud | Body) -> int:
     """How many particles an entity that lists or counts them holds."""
     if isinstance(entity, Particles):
         return len(entity.positions)
-    if isinstance(entity, Rope):
-        return len(entity.points)
-    if isinstance(entity, (Cloth, SoftLattice)):
-        return int(np.prod(entity.resolution))
-    return entity.count
+    if isinstance(entity, ParticleCloud):
+        return entity.count
+    return entity.point_count
 
 
-def _check_lengths(entity: Particles | Rope, where: str) -> list[SceneProblem]:
+def _check_lengths(entity: Particles | Rope | Hair | SpringGraph, where: str) -> list[SceneProblem]:
     count = _count(entity)
     problems = []
     for name in ("velocities", "mass", "radius"):

@@ -19,7 +19,6 @@ from ..errors import SceneError
 from .build import build_model
 from .model import Model
 from .scene import (
-    Cloth,
     Collider,
     Emitter,
     ForceField,
@@ -27,12 +26,11 @@ from .scene import (
     Output,
     ParticleCloud,
     Particles,
-    Rope,
     Scene,
-    SoftLattice,
     System,
     World,
 )
+from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, SpringGraph
 from .scene_errors import scene_problems
 
 __all__ = ["SceneBuilder"]
@@ -160,6 +158,54 @@ class SceneBuilder:
         (indices) stay where they are."""
         return self._add(Rope, "rope", _given(locals()))
 
+    def add_hair(
+        self,
+        points: Any,
+        *,
+        mass: float | Sequence[float],
+        stiffness: float,
+        bending: float,
+        torsion: float | None = None,
+        damping: float | None = None,
+        pinned: Sequence[int] | None = None,
+        velocities: Any = None,
+        radius: float | None = None,
+        color: Vector | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add a hair strand (Selle, Lentine & Fedkiw 2008): particles at ``points`` [m]
+        ``(n, 3)``, root first (in this order in the state), of ``mass`` [kg] (one value or
+        one per point), joined by edge springs of ``stiffness`` [N/m] between consecutive
+        points, bending springs of ``bending`` [N/m] between points two apart and torsion
+        springs of ``torsion`` [N/m] (default none) between points three apart, each with
+        ``damping`` [N·s/m]; the points ``pinned`` (default: the root, ``[0]``; ``[]`` for a
+        free strand) stay where they are. Selle et al.'s altitude springs are left out (see
+        :mod:`visviva.deformables.topology`)."""
+        return self._add(Hair, "hair", _given(locals()))
+
+    def add_springs(
+        self,
+        points: Any,
+        pairs: Any,
+        *,
+        mass: float | Sequence[float],
+        stiffness: float | Sequence[float],
+        rest_length: float | Sequence[float] | None = None,
+        damping: float | None = None,
+        pinned: Sequence[int] | None = None,
+        velocities: Any = None,
+        radius: float | None = None,
+        color: Vector | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add particles at ``points`` [m] ``(n, 3)`` (in this order in the state) of ``mass``
+        [kg] (one value or one per point) joined by a spring on each of ``pairs`` ``(S, 2)``
+        (indices into ``points``, each unordered pair once), of ``stiffness`` [N/m] and
+        ``rest_length`` [m] (each one value or one per spring; rest lengths by default the
+        springs' lengths as built) and ``damping`` [N·s/m]; the points ``pinned`` stay where
+        they are."""
+        return self._add(SpringGraph, "springs", _given(locals()))
+
     def add_cloth(
         self,
         resolution: Sequence[int],
@@ -212,6 +258,52 @@ class SceneBuilder:
         given = _given(locals())
         given["resolution"] = tuple(given["resolution"])
         return self._add(SoftLattice, "soft_lattice", given)
+
+    def add_cloth_mesh(
+        self,
+        vertices: Any,
+        triangles: Any,
+        *,
+        density: float,
+        stretch: float,
+        bend: float | None = None,
+        damping: float | None = None,
+        pinned: Sequence[int] | None = None,
+        velocity: Vector | None = None,
+        radius: float | None = None,
+        color: Vector | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add cloth on a triangle mesh: a particle at each of the ``vertices`` [m] ``(n, 3)``
+        (in this order in the state) weighing the areal ``density`` [kg/m²] times a third of
+        the area of each of its ``triangles`` ``(T, 3)`` (vertex indices); stretch springs of
+        ``stretch`` [N/m] on every edge and bend springs of ``bend`` [N/m] (default none)
+        between the vertices facing each other across every edge two triangles share, each
+        with ``damping`` [N·s/m]. A triangle resists shear by itself: there is no shear
+        family. The vertices ``pinned`` stay where they are."""
+        return self._add(ClothMesh, "cloth_mesh", _given(locals()))
+
+    def add_soft_mesh(
+        self,
+        vertices: Any,
+        tetrahedra: Any,
+        *,
+        density: float,
+        stiffness: float,
+        damping: float | None = None,
+        pinned: Sequence[int] | None = None,
+        velocity: Vector | None = None,
+        radius: float | None = None,
+        color: Vector | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add a soft body on a tetrahedral mesh: a particle at each of the ``vertices`` [m]
+        ``(n, 3)`` (in this order in the state) weighing the ``density`` [kg/m³] times a
+        quarter of the volume of each of its ``tetrahedra`` ``(T, 4)`` (vertex indices
+        [a, b, c, d] with (b − a)·((c − a) × (d − a)) > 0), and a spring of ``stiffness``
+        [N/m] and ``damping`` [N·s/m] on every edge; the vertices ``pinned`` stay where they
+        are."""
+        return self._add(SoftMesh, "soft_mesh", _given(locals()))
 
     def add_system(
         self, system: str, parameters: Mapping[str, float] | None = None, *, name: str | None = None

@@ -14,8 +14,8 @@ Per frame (:func:`frame_fields`), following the recording convention of
     color                 (P, 3)       with colour ramps: sRGB colours in [0, 1]
 
 Once (:func:`static_fields`): the radii and colours that do not change, particle masses, and
-the edges to draw between points: the stretch springs of ropes and cloth, then the systems'
-links (point indices, shifted past the particles).
+the edges to draw between points: the stretch springs of the deformable bodies, then the
+systems' links (point indices, shifted past the particles).
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..particles.emitters import ramp_values
+from .scene_bodies import BODIES
 from .systems import SYSTEMS
 
 if TYPE_CHECKING:
@@ -143,15 +144,17 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
 
 
 def _spring_edges(model: Model) -> list[np.ndarray]:
-    """The stretch springs of each rope, cloth and soft lattice, as pairs of point indices (the
-    other families are not drawn: they cross the fabric or the body)."""
+    """The stretch springs of each deformable body (a rope's or hair's segments, a cloth's
+    structural springs or mesh edges, a soft body's edges, every spring of a ``springs``
+    entity), as pairs of point indices (the other families are not drawn: they cross the
+    fabric or the body)."""
     from ..deformables.topology import STRETCH
     from .parts import spring_network
 
     starts = {g.entity: g.start for g in model.particle_groups}
     edges = []
     for index, entity in enumerate(model.scene.entities):
-        if entity.type in ("rope", "cloth", "soft_lattice"):
-            network = spring_network(entity)  # type: ignore[arg-type]
+        if isinstance(entity, BODIES):
+            network = spring_network(entity)
             edges.append(network.pairs[network.family == STRETCH] + starts[index])
     return edges

@@ -14,7 +14,17 @@ from typing import Any
 
 import numpy as np
 
-from ..deformables import SpringNetwork, cloth_grid, rope, soft_lattice
+from ..deformables import (
+    DeformableError,
+    SpringNetwork,
+    cloth_grid,
+    cloth_mesh,
+    hair,
+    rope,
+    soft_lattice,
+    soft_mesh,
+    spring_graph,
+)
 from ..errors import ModelError, SceneProblem
 from ..forces import (
     Attractor,
@@ -30,17 +40,17 @@ from ..forces import (
 from ..mechanics.gravity import GRAVITATIONAL_CONSTANT
 from ..particles.emitters import SHAPES, EmitterSpec, unit_vector, value_range
 from .model import ParticleGroup
-from .scene import (
-    MAX_PARTICLES,
+from .scene import MAX_PARTICLES, Collider, Emitter, ForceField, ParticleCloud, Particles, Scene
+from .scene_bodies import (
+    BODIES,
+    POINT_BODIES,
+    Body,
     Cloth,
-    Collider,
-    Emitter,
-    ForceField,
-    ParticleCloud,
-    Particles,
+    ClothMesh,
+    Hair,
     Rope,
-    Scene,
     SoftLattice,
+    SoftMesh,
 )
 
 __all__ = [
@@ -151,22 +161,23 @@ def particle_arrays(
     for index, entity in enumerate(scene.entities):
         pinned = np.zeros(0, dtype=np.int64)
         mass = None
-        if isinstance(entity, (Particles, Rope)):
-            x = np.array(entity.points if isinstance(entity, Rope) else entity.positions)
-            x = x.astype(np.float64)
+        if isinstance(entity, Particles):
+            x = np.array(entity.positions, dtype=np.float64)
             count = x.shape[0]
             v = np.zeros_like(x) if entity.velocities is None else np.array(entity.velocities)
             color = entity.color
-            if isinstance(entity, Rope):
-                pinned = np.array(entity.pinned, dtype=np.int64)
-        elif isinstance(entity, (Cloth, SoftLattice)):
+        elif isinstance(entity, BODIES):
             try:
-                sheet = spring_network(entity)
+                body = spring_network(entity)
             except ModelError as error:
-                raise Located(f"entities[{index}]", str(error)) from None
-            x, mass = sheet.points, sheet.mass
+                raise _located(index, error) from None
+            x, mass = body.points, body.mass
             count = x.shape[0]
-            v = np.broadcast_to(np.asarray(entity.velocity, dtype=np.float64), (count, 3))
+            if isinstance(entity, POINT_BODIES):
+                listed = entity.velocities
+                v = np.zeros_like(x) if listed is None else np.array(listed)
+            else:
+                v = np.broadcast_to(np.asarray(entity.velocity, dtype=np.float64), (count, 3))
             color = entity.color
             pinned = np.array(entity.pinned, dtype=np.int64)
         elif isinstance(entity, ParticleCloud):
@@ -266,34 +277,79 @@ def _force(e: ForceField, targets: Targets, mass: np.ndarray) -> Force:
     )
 
 
+def _located(index: int, error: ModelError, field: str | None = None) -> Located:
+    """``error`` located at ``entities[index]``: at the field and item a
+    :class:`~visviva.deformables.DeformableError` names, else at ``field`` if given."""
+    where = f"entities[{index}]"
+    if isinstance(error, DeformableError):
+        where += f".{error.field}" + ("" if error.index is None else f"[{error.index}]")
+    elif field is not None:
+        where += f".{field}"
+    return Located(where, str(error))
+
+
 def spring_forces(scene: Scene, groups: Sequence[ParticleGroup], count: int) -> list[Force]:
-    """The springs of each rope, cloth and soft lattice (see
-    :mod:`visviva.deformables.topology`), each at rest at its initial length."""
+    """The springs of each deformable body (see :mod:`visviva.deformables`), each at rest at
+    its initial length unless the body gives its rest lengths."""
     from ..forces import Springs
 
     forces: list[Force] = []
     starts = {g.entity: g.start for g in groups}
     for index, entity in enumerate(scene.entities):
-        if not isinstance(entity, (Rope, Cloth, SoftLattice)):
+        if not isinstance(entity, BODIES):
             continue
-        network = spring_network(entity)
         try:
+            network = spring_network(entity)
             rest = network.rest_length()
         except ModelError as error:
-            field = "points" if isinstance(entity, Rope) else "resolution"
-            raise Located(f"entities[{index}].{field}", str(error)) from None
+            raise _located(index, error, _placed_by(entity)) from None
         first = starts[index]
         pairs = network.pairs + first
         forces.append(Springs(pairs, rest, network.stiffness, entity.damping, count))
     return forces
 
 
-def spring_network(entity: Rope | Cloth | SoftLattice) -> SpringNetwork:
-    """The particles and springs of a rope, cloth or soft lattice entity."""
-    if isinstance(entity, Rope):
+def _placed_by(entity: Body) -> str:
+    """The field that places a body's points (where points too close or too far are fixed)."""
+    if isinstance(entity, (Cloth, SoftLattice)):
+        return "resolution"
+    if isinstance(entity, (ClothMesh, SoftMesh)):
+        return "vertices"
+    return "points"
+
+
+def spring_network(entity: Body) -> SpringNetwork:
+    """The particles and springs of a deformable body entity.
+
+    Raises:
+        ModelError: A :class:`~visviva.deformables.DeformableError` naming the field and item
+            at fault, or a body beyond what a float holds.
+    """
+    if isinstance(entity, ClothMesh):
+        return cloth_mesh(
+            np.array(entity.vertices, dtype=np.float64),
+            np.array(entity.triangles, dtype=np.int64).reshape(-1, 3),
+            entity.density,
+            entity.stretch,
+            entity.bend,
+        )
+    if isinstance(entity, SoftMesh):
+        return soft_mesh(
+            np.array(entity.vertices, dtype=np.float64),
+            np.array(entity.tetrahedra, dtype=np.int64).reshape(-1, 4),
+            entity.density,
+            entity.stiffness,
+        )
+    if isinstance(entity, POINT_BODIES):
         points = np.array(entity.points, dtype=np.float64)
         mass = np.broadcast_to(np.asarray(entity.mass, dtype=np.float64), (points.shape[0],))
-        return rope(points, mass, entity.stiffness, entity.bending)
+        if isinstance(entity, Rope):
+            return rope(points, mass, entity.stiffness, entity.bending)
+        if isinstance(entity, Hair):
+            return hair(points, mass, entity.stiffness, entity.bending, entity.torsion)
+        rest = None if entity.rest_length is None else np.asarray(entity.rest_length)
+        stiffness = np.asarray(entity.stiffness, dtype=np.float64)
+        return spring_graph(points, mass, np.array(entity.pairs), stiffness, rest)
     if isinstance(entity, SoftLattice):
         return soft_lattice(
             np.asarray(entity.origin, dtype=np.float64),

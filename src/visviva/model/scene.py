@@ -11,19 +11,34 @@ frozen :class:`~visviva.model.Model`. Files are read and written by :mod:`visviv
 nothing here knows about files.
 
 Entities (``[[entities]]``, each with a ``type``): ``particles`` and ``particle_cloud`` (particles
-placed once), ``emitter`` (particles born and dying over time), ``system`` (a named mechanical
+placed once), ``emitter`` (particles born and dying over time), the deformable bodies of
+:mod:`.scene_bodies` (``rope``, ``hair``, ``springs``, ``cloth``, ``cloth_mesh``,
+``soft_lattice``, ``soft_mesh``: particles joined by springs), ``system`` (a named mechanical
 system: pendulums, Kepler orbits, star clusters...), ``force`` (a force field on particles, or
-gravitation among them) and ``collider`` (a static shape particles bounce off).
+gravitation among them) and ``collider`` (a static shape particles bounce off). The value types
+the tables share are in :mod:`.scene_fields`.
 """
 
 from __future__ import annotations
 
 from typing import Annotated, Literal, get_args
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, Field, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
 from .._validation import did_you_mean
+from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, SpringGraph
+from .scene_fields import (
+    MAX_PARTICLES,
+    Color,
+    Finite,
+    Fraction,
+    Name,
+    NonNegative,
+    Positive,
+    Strict,
+    Vector,
+)
 
 __all__ = [
     "COLLIDER_SHAPES",
@@ -34,10 +49,12 @@ __all__ = [
     "OUTPUT_FORMATS",
     "Burst",
     "Cloth",
+    "ClothMesh",
     "Collider",
     "Emitter",
     "Entity",
     "ForceField",
+    "Hair",
     "Integration",
     "Output",
     "ParticleCloud",
@@ -46,39 +63,28 @@ __all__ = [
     "Scene",
     "SceneInfo",
     "SoftLattice",
+    "SoftMesh",
+    "SpringGraph",
     "System",
     "World",
 ]
 
-#: Most particles one scene may create: 50 million is ~2.4 GB of state; more is a typo.
-MAX_PARTICLES = 50_000_000
 #: Output formats ``visviva run`` can write besides ``recording.h5`` and ``summary.json``.
 OutputFormat = Literal["mp4", "gif", "html", "usd", "glb", "obj", "pc2"]
 OUTPUT_FORMATS: tuple[str, ...] = get_args(OutputFormat)
 
-Finite = Annotated[float, Field(strict=True, allow_inf_nan=False)]
-Positive = Annotated[float, Field(strict=True, gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(strict=True, ge=0, allow_inf_nan=False)]
-Vector = tuple[Finite, Finite, Finite]
-Name = Annotated[str, Field(strict=True, min_length=1, max_length=200, pattern=r"^[^\x00-\x1f]*$")]
-Fraction = Annotated[float, Field(strict=True, ge=0, le=1, allow_inf_nan=False)]
-Color = tuple[Fraction, Fraction, Fraction]
 #: Most steps between recorded frames: a run takes at most 1e9 steps (simulation.loop).
 MAX_RECORD_EVERY = 10**9
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-
-class SceneInfo(_Strict):
+class SceneInfo(Strict):
     """``[scene]``: what the scene is."""
 
     name: Name = "untitled"
     description: Annotated[str, Field(strict=True, max_length=10_000)] = ""
 
 
-class World(_Strict):
+class World(Strict):
     """``[world]``: gravity and conventions (SI units, Y up)."""
 
     gravity: Vector = Field((0.0, -9.81, 0.0), description="gravitational acceleration [m/s^2]")
@@ -86,7 +92,7 @@ class World(_Strict):
     units: Literal["SI"] = Field("SI", description="unit system: metres, kilograms, seconds")
 
 
-class Integration(_Strict):
+class Integration(Strict):
     """``[integration]``: how time advances."""
 
     method: Name = Field("symplectic_euler", description="integrator (visviva integrators)")
@@ -124,7 +130,7 @@ class Integration(_Strict):
         return method
 
 
-class Output(_Strict):
+class Output(Strict):
     """``[output]``: files ``visviva run`` writes besides the recording and the summary."""
 
     formats: list[OutputFormat] = Field(default_factory=list, description="extra outputs")
@@ -143,7 +149,7 @@ class Output(_Strict):
     )
 
 
-class Particles(_Strict):
+class Particles(Strict):
     """``type = "particles"``: particles at given positions, moving freely under the forces."""
 
     type: Literal["particles"]
@@ -161,7 +167,7 @@ class Particles(_Strict):
     color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
 
 
-class ParticleCloud(_Strict):
+class ParticleCloud(Strict):
     """``type = "particle_cloud"``: ``count`` particles placed at random in a box."""
 
     type: Literal["particle_cloud"]
@@ -183,139 +189,7 @@ class ParticleCloud(_Strict):
     seed: Annotated[int, Field(strict=True, ge=0, lt=2**63)] = Field(0, description="random seed")
 
 
-def _check_pins(pinned: list[int], count: int, body: str) -> None:
-    """Refuse a pinned index past the body's ``count`` points."""
-    outside = [i for i in pinned if i >= count]
-    if outside:
-        raise PydanticCustomError(
-            "pin_out_of_range",
-            "pinned index {index} is not a point of this {body} (it has {count}: 0 to {last})",
-            {"index": outside[0], "body": body, "count": count, "last": count - 1},
-        )
-
-
-class Rope(_Strict):
-    """``type = "rope"``: particles at ``points`` joined in order by damped springs (seed 002).
-
-    Each consecutive pair is a stretch spring of ``stiffness`` k [N/m] and ``damping`` c
-    [N·s/m] along the spring, at rest at the points' distance; ``bending`` > 0 adds springs
-    between particles two apart, which resist bending (and, seed 000 warns, also stretch).
-    Particles listed in ``pinned`` stay where they are.
-    """
-
-    type: Literal["rope"]
-    name: Name | None = None
-    points: Annotated[list[Vector], Field(min_length=2)] = Field(
-        description="positions of the particles along the rope [m], in order"
-    )
-    velocities: list[Vector] | None = Field(None, description="initial velocities [m/s]")
-    mass: Positive | Annotated[list[Positive], Field(min_length=1)] = Field(
-        1.0, description="mass of each particle [kg]: one value or one per point"
-    )
-    stiffness: Positive = Field(description="stiffness k of each stretch spring [N/m]")
-    damping: NonNegative = Field(0.0, description="damping c of each spring [N s/m]")
-    bending: NonNegative = Field(
-        0.0, description="stiffness of the springs between particles two apart [N/m] (0: none)"
-    )
-    pinned: list[Annotated[int, Field(strict=True, ge=0)]] = Field(
-        default_factory=list, description="indices of the points held fixed"
-    )
-    radius: Positive = Field(0.02, description="radius of each particle [m]")
-    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
-
-    @model_validator(mode="after")
-    def _pins_on_the_rope(self) -> Rope:
-        _check_pins(self.pinned, len(self.points), "rope")
-        return self
-
-
-class Cloth(_Strict):
-    """``type = "cloth"``: a sheet of ``resolution`` = [nu, nv] particles on a grid spanning
-    ``origin + s·along + t·across`` (s, t in [0, 1]), joined by structural (``stretch``), shear
-    (cell diagonals) and bend (two apart) springs (Choi & Ko 2002). Point (i, j) has index
-    j·nu + i. Each point weighs ``density`` times its share of the cells around it."""
-
-    type: Literal["cloth"]
-    name: Name | None = None
-    origin: Vector = Field((0.0, 1.0, 0.0), description="position of point (0, 0) [m]")
-    along: Vector = Field((1.0, 0.0, 0.0), description="edge from point (0, 0) to (nu − 1, 0) [m]")
-    across: Vector = Field((0.0, 0.0, 1.0), description="edge from point (0, 0) to (0, nv − 1) [m]")
-    resolution: tuple[
-        Annotated[int, Field(strict=True, ge=2, le=4096)],
-        Annotated[int, Field(strict=True, ge=2, le=4096)],
-    ] = Field(description="points along and across [nu, nv]")
-    density: Positive = Field(0.2, description="mass per area [kg/m²]")
-    stretch: Positive = Field(description="stiffness of the structural springs [N/m]")
-    shear: NonNegative | None = Field(
-        None, description="stiffness of the shear springs [N/m] (default: stretch; 0: none)"
-    )
-    bend: NonNegative = Field(0.0, description="stiffness of the bend springs [N/m] (0: none)")
-    damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
-    pinned: list[Annotated[int, Field(strict=True, ge=0)]] = Field(
-        default_factory=list, description="indices (j·nu + i) of the points held fixed"
-    )
-    velocity: Vector = Field((0.0, 0.0, 0.0), description="initial velocity [m/s]")
-    radius: Positive = Field(0.01, description="radius of each particle [m]")
-    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
-
-    @model_validator(mode="after")
-    def _a_sheet(self) -> Cloth:
-        a, b = self.along, self.across
-        normal = (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-        if not any(normal):
-            raise PydanticCustomError(
-                "no_area",
-                "`along` {along} and `across` {across} are parallel or zero: the sheet has no "
-                "area; give two edges at an angle",
-                {"along": list(a), "across": list(b)},
-            )
-        _check_pins(self.pinned, self.resolution[0] * self.resolution[1], "cloth")
-        return self
-
-
-class SoftLattice(_Strict):
-    """``type = "soft_lattice"``: a volumetric soft body (seed 004): ``resolution`` = [nx, ny,
-    nz] particles on a lattice filling the box from ``origin`` with edge lengths ``size``,
-    joined by structural (``stretch``), face-diagonal (``shear``) and body-diagonal
-    (``diagonal``) springs. Point (i, j, k) has index (k·ny + j)·nx + i; each weighs
-    ``density`` times an eighth of each cell around it."""
-
-    type: Literal["soft_lattice"]
-    name: Name | None = None
-    origin: Vector = Field((0.0, 0.5, 0.0), description="the box's lowest corner [m]")
-    size: tuple[Positive, Positive, Positive] = Field(
-        (0.5, 0.5, 0.5), description="edge lengths of the box [m]"
-    )
-    resolution: tuple[
-        Annotated[int, Field(strict=True, ge=2, le=512)],
-        Annotated[int, Field(strict=True, ge=2, le=512)],
-        Annotated[int, Field(strict=True, ge=2, le=512)],
-    ] = Field(description="points along x, y and z [nx, ny, nz]")
-    density: Positive = Field(1000.0, description="mass per volume [kg/m³]")
-    stretch: Positive = Field(description="stiffness of the structural springs [N/m]")
-    shear: NonNegative | None = Field(
-        None, description="stiffness of the face-diagonal springs [N/m] (default: stretch)"
-    )
-    diagonal: NonNegative | None = Field(
-        None, description="stiffness of the body-diagonal springs [N/m] (default: stretch)"
-    )
-    damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
-    pinned: list[Annotated[int, Field(strict=True, ge=0)]] = Field(
-        default_factory=list, description="indices of the points held fixed"
-    )
-    velocity: Vector = Field((0.0, 0.0, 0.0), description="initial velocity [m/s]")
-    radius: Positive = Field(0.01, description="radius of each particle [m]")
-    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
-
-    @model_validator(mode="after")
-    def _pins_in_the_lattice(self) -> SoftLattice:
-        _check_pins(
-            self.pinned, self.resolution[0] * self.resolution[1] * self.resolution[2], "lattice"
-        )
-        return self
-
-
-class System(_Strict):
+class System(Strict):
     """``type = "system"``: a named mechanical system (see ``visviva run --list-systems``)."""
 
     type: Literal["system"]
@@ -377,14 +251,14 @@ def _ramp_order(stops: list[tuple[float, ...]] | None, name: str) -> None:
         )
 
 
-class Burst(_Strict):
+class Burst(Strict):
     """A burst: ``count`` particles born at once at ``time``."""
 
     time: NonNegative = Field(description="when [s]")
     count: Count = Field(description="how many particles")
 
 
-class Emitter(_Strict):
+class Emitter(Strict):
     """``type = "emitter"``: particles born over time from a shape, each living for its lifetime.
 
     Particles are born at ``rate`` per second between ``start`` and ``stop`` (the fractional
@@ -480,7 +354,7 @@ FORCE_PARAMETERS: dict[str, dict[str, bool]] = {
 }
 
 
-class ForceField(_Strict):
+class ForceField(Strict):
     """``type = "force"``: a force on particles (all of them, or the entities in ``targets``).
 
     Kinds and their parameters: ``drag`` (``coefficient`` k [N·s/m]: F = −k v), ``wind``
@@ -555,7 +429,7 @@ _REQUIRED_COLLIDER_FIELDS = {
 }
 
 
-class Collider(_Strict):
+class Collider(Strict):
     """``type = "collider"``: a static shape that particles bounce off or are pushed out of.
 
     Shapes: ``plane`` (``point``, outward ``normal``, optional ``thickness`` [m]: a thin wall;
@@ -644,8 +518,12 @@ Entity = Annotated[
     Particles
     | ParticleCloud
     | Rope
+    | Hair
+    | SpringGraph
     | Cloth
+    | ClothMesh
     | SoftLattice
+    | SoftMesh
     | Emitter
     | System
     | ForceField
@@ -656,8 +534,12 @@ ENTITY_TYPES: dict[str, type[BaseModel]] = {
     "particles": Particles,
     "particle_cloud": ParticleCloud,
     "rope": Rope,
+    "hair": Hair,
+    "springs": SpringGraph,
     "cloth": Cloth,
+    "cloth_mesh": ClothMesh,
     "soft_lattice": SoftLattice,
+    "soft_mesh": SoftMesh,
     "emitter": Emitter,
     "system": System,
     "force": ForceField,
@@ -665,7 +547,7 @@ ENTITY_TYPES: dict[str, type[BaseModel]] = {
 }
 
 
-class Scene(_Strict):
+class Scene(Strict):
     """A whole scene."""
 
     scene: SceneInfo = SceneInfo()

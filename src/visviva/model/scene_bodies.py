@@ -1,0 +1,352 @@
+"""The deformable bodies a scene may hold: particles joined by damped springs, each entity a
+spring topology of :mod:`visviva.deformables` (built from these fields by
+:func:`visviva.model.parts.spring_network`).
+
+Curves: ``rope`` (seed 002) and ``hair`` (Selle, Lentine & Fedkiw 2008). Sheets: ``cloth`` (a
+grid, Choi & Ko 2002) and ``cloth_mesh`` (any triangle mesh). Solids: ``soft_lattice`` (a
+lattice, seed 004) and ``soft_mesh`` (any tetrahedral mesh). Any graph: ``springs``. Every
+body's particles enter the state in the order of its points (or vertices), its ``pinned``
+points stay where they are, and every spring rests at its length as built (a ``springs``
+entity may give its own rest lengths).
+
+The schema checks each field (types, signs, finite numbers) and the pins; what only the
+geometry can tell — points that coincide, a triangle without area, a tetrahedron turned inside
+out, an index past the points — is refused when the body is built, at the field and item at
+fault (``entities[2].triangles[7]``).
+
+References:
+    K.-J. Choi, H.-S. Ko, "Stable but responsive cloth", SIGGRAPH 2002.
+    A. Selle, M. Lentine, R. Fedkiw, "A mass spring model for hair simulation", SIGGRAPH 2008.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+from pydantic_core import PydanticCustomError
+
+from .scene_fields import Color, Index, Name, NonNegative, Positive, Strict, Vector
+
+__all__ = [
+    "BODIES",
+    "POINT_BODIES",
+    "Body",
+    "Cloth",
+    "ClothMesh",
+    "Hair",
+    "Rope",
+    "SoftLattice",
+    "SoftMesh",
+    "SpringGraph",
+]
+
+#: Indices of the points held fixed.
+Pins = list[Index]
+#: One value, or one per point (or per spring).
+PositiveEach = Positive | Annotated[list[Positive], Field(min_length=1)]
+
+
+def _check_pins(pinned: list[int], count: int, body: str) -> None:
+    """Refuse a pinned index past the body's ``count`` points."""
+    outside = [i for i in pinned if i >= count]
+    if outside:
+        raise PydanticCustomError(
+            "pin_out_of_range",
+            "pinned index {index} is not a point of this {body} (it has {count}: 0 to {last})",
+            {"index": outside[0], "body": body, "count": count, "last": count - 1},
+        )
+
+
+class Rope(Strict):
+    """``type = "rope"``: particles at ``points`` joined in order by damped springs (seed 002).
+
+    Each consecutive pair is a stretch spring of ``stiffness`` k [N/m] and ``damping`` c
+    [N·s/m] along the spring, at rest at the points' distance; ``bending`` > 0 adds springs
+    between particles two apart, which resist bending (and, seed 000 warns, also stretch).
+    Particles listed in ``pinned`` stay where they are.
+    """
+
+    type: Literal["rope"]
+    name: Name | None = None
+    points: Annotated[list[Vector], Field(min_length=2)] = Field(
+        description="positions of the particles along the rope [m], in order"
+    )
+    velocities: list[Vector] | None = Field(None, description="initial velocities [m/s]")
+    mass: PositiveEach = Field(
+        1.0, description="mass of each particle [kg]: one value or one per point"
+    )
+    stiffness: Positive = Field(description="stiffness k of each stretch spring [N/m]")
+    damping: NonNegative = Field(0.0, description="damping c of each spring [N s/m]")
+    bending: NonNegative = Field(
+        0.0, description="stiffness of the springs between particles two apart [N/m] (0: none)"
+    )
+    pinned: Pins = Field(default_factory=list, description="indices of the points held fixed")
+    radius: Positive = Field(0.02, description="radius of each particle [m]")
+    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
+
+    @property
+    def point_count(self) -> int:
+        """The rope's particles."""
+        return len(self.points)
+
+    @model_validator(mode="after")
+    def _pins_on_the_rope(self) -> Rope:
+        _check_pins(self.pinned, self.point_count, "rope")
+        return self
+
+
+class Hair(Strict):
+    """``type = "hair"``: a strand of hair (Selle, Lentine & Fedkiw 2008): particles at
+    ``points``, from the root, joined by damped springs in three families — *edge* springs of
+    ``stiffness`` k [N/m] between consecutive points, *bending* springs of ``bending`` [N/m]
+    between points two apart and *torsion* springs of ``torsion`` [N/m] between points three
+    apart (a family of stiffness 0 is left out) — each with ``damping`` c [N·s/m] along the
+    spring and at rest at its length as built. The root (point 0) is pinned unless ``pinned``
+    says otherwise. Selle et al.'s altitude springs (which keep a straight stretch of strand
+    from folding flat) are left out."""
+
+    type: Literal["hair"]
+    name: Name | None = None
+    points: Annotated[list[Vector], Field(min_length=2)] = Field(
+        description="positions of the particles along the strand [m], root first"
+    )
+    velocities: list[Vector] | None = Field(None, description="initial velocities [m/s]")
+    mass: PositiveEach = Field(description="mass of each particle [kg]: one value or one per point")
+    stiffness: Positive = Field(description="stiffness k of the edge springs [N/m]")
+    bending: NonNegative = Field(
+        description="stiffness of the bending springs, between points two apart [N/m] (0: none)"
+    )
+    torsion: NonNegative = Field(
+        0.0, description="stiffness of the torsion springs, between points three apart [N/m]"
+    )
+    damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
+    pinned: Pins = Field(
+        default_factory=lambda: [0],
+        description="indices of the points held fixed (default: the root, point 0)",
+    )
+    radius: Positive = Field(0.005, description="radius of each particle [m]")
+    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
+
+    @property
+    def point_count(self) -> int:
+        """The strand's particles."""
+        return len(self.points)
+
+    @model_validator(mode="after")
+    def _pins_on_the_strand(self) -> Hair:
+        _check_pins(self.pinned, self.point_count, "hair strand")
+        return self
+
+
+class SpringGraph(Strict):
+    """``type = "springs"``: particles at ``points`` joined by damped springs on any ``pairs``
+    of them (indices into ``points``, each unordered pair at most once). Each spring has
+    ``stiffness`` k [N/m] and ``rest_length`` L [m] (by default its length as built), one value
+    or one per spring, and ``damping`` c [N·s/m] along it."""
+
+    type: Literal["springs"]
+    name: Name | None = None
+    points: Annotated[list[Vector], Field(min_length=2)] = Field(
+        description="positions of the particles [m]"
+    )
+    pairs: Annotated[list[tuple[Index, Index]], Field(min_length=1)] = Field(
+        description="the springs: [i, j] indices of the two points each one joins"
+    )
+    velocities: list[Vector] | None = Field(None, description="initial velocities [m/s]")
+    mass: PositiveEach = Field(description="mass of each particle [kg]: one value or one per point")
+    stiffness: PositiveEach = Field(
+        description="stiffness k of the springs [N/m]: one value or one per spring"
+    )
+    rest_length: PositiveEach | None = Field(
+        None,
+        description="rest length L of the springs [m]: one value or one per spring (default: "
+        "each spring's length as built)",
+    )
+    damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
+    pinned: Pins = Field(default_factory=list, description="indices of the points held fixed")
+    radius: Positive = Field(0.02, description="radius of each particle [m]")
+    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
+
+    @property
+    def point_count(self) -> int:
+        """The network's particles."""
+        return len(self.points)
+
+    @model_validator(mode="after")
+    def _pins_in_the_network(self) -> SpringGraph:
+        _check_pins(self.pinned, self.point_count, "spring network")
+        return self
+
+
+class Cloth(Strict):
+    """``type = "cloth"``: a sheet of ``resolution`` = [nu, nv] particles on a grid spanning
+    ``origin + s·along + t·across`` (s, t in [0, 1]), joined by structural (``stretch``), shear
+    (cell diagonals) and bend (two apart) springs (Choi & Ko 2002). Point (i, j) has index
+    j·nu + i. Each point weighs ``density`` times its share of the cells around it."""
+
+    type: Literal["cloth"]
+    name: Name | None = None
+    origin: Vector = Field((0.0, 1.0, 0.0), description="position of point (0, 0) [m]")
+    along: Vector = Field((1.0, 0.0, 0.0), description="edge from point (0, 0) to (nu − 1, 0) [m]")
+    across: Vector = Field((0.0, 0.0, 1.0), description="edge from point (0, 0) to (0, nv − 1) [m]")
+    resolution: tuple[
+        Annotated[int, Field(strict=True, ge=2, le=4096)],
+        Annotated[int, Field(strict=True, ge=2, le=4096)],
+    ] = Field(description="points along and across [nu, nv]")
+    density: Positive = Field(0.2, description="mass per area [kg/m²]")
+    stretch: Positive = Field(description="stiffness of the structural springs [N/m]")
+    shear: NonNegative | None = Field(
+        None, description="stiffness of the shear springs [N/m] (default: stretch; 0: none)"
+    )
+    bend: NonNegative = Field(0.0, description="stiffness of the bend springs [N/m] (0: none)")
+    damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
+    pinned: Pins = Field(
+        default_factory=list, description="indices (j·nu + i) of the points held fixed"
+    )
+    velocity: Vector = Field((0.0, 0.0, 0.0), description="initial velocity [m/s]")
+    radius: Positive = Field(0.01, description="radius of each particle [m]")
+    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
+
+    @property
+    def point_count(self) -> int:
+        """The sheet's particles, nu·nv."""
+        return self.resolution[0] * self.resolution[1]
+
+    @model_validator(mode="after")
+    def _a_sheet(self) -> Cloth:
+        a, b = self.along, self.across
+        normal = (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+        if not any(normal):
+            raise PydanticCustomError(
+                "no_area",
+                "`along` {along} and `across` {across} are parallel or zero: the sheet has no "
+                "area; give two edges at an angle",
+                {"along": list(a), "across": list(b)},
+            )
+        _check_pins(self.pinned, self.point_count, "cloth")
+        return self
+
+
+class ClothMesh(Strict):
+    """``type = "cloth_mesh"``: cloth from any triangle mesh. A particle at each of the
+    ``vertices`` [m], weighing the areal ``density`` [kg/m²] times a third of the area of each
+    triangle around it (so the cloth weighs density × area); *stretch* springs of ``stretch``
+    [N/m] on every edge of the mesh and *bend* springs of ``bend`` [N/m] between the two
+    vertices facing each other across every edge two triangles share; every spring with
+    ``damping`` c [N·s/m]. A triangle resists shear by itself, so a mesh has no shear family.
+    The mesh must be manifold (no edge in three triangles) with every vertex in a triangle."""
+
+    type: Literal["cloth_mesh"]
+    name: Name | None = None
+    vertices: Annotated[list[Vector], Field(min_length=3)] = Field(
+        description="positions of the mesh's vertices, one particle each [m]"
+    )
+    triangles: Annotated[list[tuple[Index, Index, Index]], Field(min_length=1)] = Field(
+        description="the triangles: three indices into `vertices` each"
+    )
+    density: Positive = Field(description="mass per area [kg/m²]")
+    stretch: Positive = Field(description="stiffness of the springs on the edges [N/m]")
+    bend: NonNegative = Field(
+        0.0, description="stiffness of the springs across the edges [N/m] (0: none)"
+    )
+    damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
+    pinned: Pins = Field(default_factory=list, description="indices of the vertices held fixed")
+    velocity: Vector = Field((0.0, 0.0, 0.0), description="initial velocity [m/s]")
+    radius: Positive = Field(0.01, description="radius of each particle [m]")
+    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
+
+    @property
+    def point_count(self) -> int:
+        """The mesh's particles, one per vertex."""
+        return len(self.vertices)
+
+    @model_validator(mode="after")
+    def _pins_on_the_mesh(self) -> ClothMesh:
+        _check_pins(self.pinned, self.point_count, "cloth mesh")
+        return self
+
+
+class SoftLattice(Strict):
+    """``type = "soft_lattice"``: a volumetric soft body (seed 004): ``resolution`` = [nx, ny,
+    nz] particles on a lattice filling the box from ``origin`` with edge lengths ``size``,
+    joined by structural (``stretch``), face-diagonal (``shear``) and body-diagonal
+    (``diagonal``) springs. Point (i, j, k) has index (k·ny + j)·nx + i; each weighs
+    ``density`` times an eighth of each cell around it."""
+
+    type: Literal["soft_lattice"]
+    name: Name | None = None
+    origin: Vector = Field((0.0, 0.5, 0.0), description="the box's lowest corner [m]")
+    size: tuple[Positive, Positive, Positive] = Field(
+        (0.5, 0.5, 0.5), description="edge lengths of the box [m]"
+    )
+    resolution: tuple[
+        Annotated[int, Field(strict=True, ge=2, le=512)],
+        Annotated[int, Field(strict=True, ge=2, le=512)],
+        Annotated[int, Field(strict=True, ge=2, le=512)],
+    ] = Field(description="points along x, y and z [nx, ny, nz]")
+    density: Positive = Field(1000.0, description="mass per volume [kg/m³]")
+    stretch: Positive = Field(description="stiffness of the structural springs [N/m]")
+    shear: NonNegative | None = Field(
+        None, description="stiffness of the face-diagonal springs [N/m] (default: stretch)"
+    )
+    diagonal: NonNegative | None = Field(
+        None, description="stiffness of the body-diagonal springs [N/m] (default: stretch)"
+    )
+    damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
+    pinned: Pins = Field(default_factory=list, description="indices of the points held fixed")
+    velocity: Vector = Field((0.0, 0.0, 0.0), description="initial velocity [m/s]")
+    radius: Positive = Field(0.01, description="radius of each particle [m]")
+    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
+
+    @property
+    def point_count(self) -> int:
+        """The lattice's particles, nx·ny·nz."""
+        return self.resolution[0] * self.resolution[1] * self.resolution[2]
+
+    @model_validator(mode="after")
+    def _pins_in_the_lattice(self) -> SoftLattice:
+        _check_pins(self.pinned, self.point_count, "lattice")
+        return self
+
+
+class SoftMesh(Strict):
+    """``type = "soft_mesh"``: a volumetric soft body from a tetrahedral mesh. A particle at
+    each of the ``vertices`` [m], weighing the ``density`` [kg/m³] times a quarter of the
+    volume of each tetrahedron around it (so the body weighs density × volume), and a spring
+    of ``stiffness`` [N/m] and ``damping`` c [N·s/m] on every edge of every tetrahedron. Each
+    tetrahedron [a, b, c, d] must have a positive volume in the standard orientation,
+    (b − a)·((c − a) × (d − a)) > 0, and every vertex must be in one."""
+
+    type: Literal["soft_mesh"]
+    name: Name | None = None
+    vertices: Annotated[list[Vector], Field(min_length=4)] = Field(
+        description="positions of the mesh's vertices, one particle each [m]"
+    )
+    tetrahedra: Annotated[list[tuple[Index, Index, Index, Index]], Field(min_length=1)] = Field(
+        description="the tetrahedra: four indices into `vertices` each, positively oriented"
+    )
+    density: Positive = Field(description="mass per volume [kg/m³]")
+    stiffness: Positive = Field(description="stiffness k of the springs on the edges [N/m]")
+    damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
+    pinned: Pins = Field(default_factory=list, description="indices of the vertices held fixed")
+    velocity: Vector = Field((0.0, 0.0, 0.0), description="initial velocity [m/s]")
+    radius: Positive = Field(0.01, description="radius of each particle [m]")
+    color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
+
+    @property
+    def point_count(self) -> int:
+        """The mesh's particles, one per vertex."""
+        return len(self.vertices)
+
+    @model_validator(mode="after")
+    def _pins_on_the_mesh(self) -> SoftMesh:
+        _check_pins(self.pinned, self.point_count, "soft mesh")
+        return self
+
+
+#: Every deformable entity: particles joined by springs.
+Body = Rope | Hair | SpringGraph | Cloth | ClothMesh | SoftLattice | SoftMesh
+BODIES = (Rope, Hair, SpringGraph, Cloth, ClothMesh, SoftLattice, SoftMesh)
+#: The bodies whose particles are listed one by one (``points``, ``velocities``, ``mass``).
+POINT_BODIES = (Rope, Hair, SpringGraph)
