@@ -302,3 +302,33 @@ def test_cloth_drapes_over_a_sphere_held_inside_the_solve():
     assert x[:, 1].max() < 0.96  # nothing left above the ball's top
     assert x[:, 1].min() > 0.0  # still on the ball, hanging around it
     assert np.isfinite(x).all()
+
+
+def _bob(method, omega_h):
+    """A 1 kg bob hanging by a spring (k = 100 N/m, ω = 10 rad/s) from a pinned point,
+    released where the spring is unstretched: a linear oscillator along the spring, of
+    amplitude mg/k, stepped at ``ω h``."""
+    builder = vv.SceneBuilder(name="bob")
+    builder.set_world(gravity=(0.0, -9.81, 0.0))
+    h = omega_h / 10.0
+    builder.set_integration(method="symplectic_euler", dt=h, duration=200 * h)
+    builder.add_rope([[0.0, 0.0, 0.0], [0.0, -1.0, 0.0]], mass=1.0, stiffness=100.0, pinned=[0])
+    return vv.Simulation(builder.build(), method=method)
+
+
+@pytest.mark.parametrize("omega_h", [0.5, 2.0])
+def test_projected_trapezoidal_keeps_a_linear_oscillators_energy(omega_h):
+    """On a linear oscillator the trapezoidal rule's |R(iωh)| = 1: the oscillation's energy
+    E − E_eq = ½ k (mg/k)² stays to round-off for 200 steps even at ωh = 2, far beyond
+    explicit stability, while backward Euler's shrinks by 1/(1 + (ωh)²) per step."""
+    tight = {"rtol": 1e-12, "atol": 1e-14, "cg_rtol": 1e-14}
+    trapezoid = _bob(vv.integrators.ProjectedTrapezoidal(**tight), omega_h)
+    euler = _bob(vv.integrators.ProjectedNewton(**tight), omega_h)
+    sag = 9.81 / 100.0
+    equilibrium = 0.5 * 100.0 * sag**2 - 9.81 * (1.0 + sag)  # E_eq [J]
+    oscillation = 0.5 * 100.0 * sag**2  # [J]
+    assert trapezoid.energy() - equilibrium == pytest.approx(oscillation, rel=1e-12)
+    trapezoid.step(200)
+    euler.step(200)
+    assert trapezoid.energy() - equilibrium == pytest.approx(oscillation, rel=1e-9)
+    assert euler.energy() - equilibrium < oscillation * (1.0 / (1.0 + omega_h**2)) ** 100

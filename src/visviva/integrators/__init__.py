@@ -28,7 +28,7 @@ from .implicit import (
     Trapezoidal,
 )
 from .newton import NewtonOptions
-from .projected_newton import ProjectedNewton
+from .projected_newton import ProjectedNewton, ProjectedTrapezoidal
 from .runge_kutta import (
     ButcherTableau,
     ExplicitEuler,
@@ -56,6 +56,7 @@ __all__ = [
     "Midpoint",
     "NewtonOptions",
     "ProjectedNewton",
+    "ProjectedTrapezoidal",
     "RungeKutta4",
     "SymplecticEuler",
     "SymplecticEulerPositionFirst",
@@ -135,6 +136,7 @@ for _method in (
     ImplicitMidpoint,
     LinearlyImplicitEuler,
     ProjectedNewton,
+    ProjectedTrapezoidal,
 ):
     register(_method)
 del _method
