@@ -20,6 +20,7 @@ from .._registry import Registry
 from ..errors import ModelError
 from .base import CompiledStep, Integrator
 from .dopri5 import DormandPrince5
+from .fast_springs import FastMassSprings
 from .implicit import (
     BackwardEuler,
     ImplicitMidpoint,
@@ -47,6 +48,7 @@ __all__ = [
     "DormandPrince5",
     "ExplicitEuler",
     "ExplicitRungeKutta",
+    "FastMassSprings",
     "Heun",
     "ImplicitMidpoint",
     "ImplicitOneStage",
@@ -137,6 +139,7 @@ for _method in (
     LinearlyImplicitEuler,
     ProjectedNewton,
     ProjectedTrapezoidal,
+    FastMassSprings,
 ):
     register(_method)
 del _method

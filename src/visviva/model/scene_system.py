@@ -20,6 +20,8 @@ made of a first-order system alone (Dahlquist's test equation) is that system, p
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cached_property
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
@@ -27,6 +29,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..forces.assembly import ForceSum
+from ..forces.springs import Springs
 from ..ode.mass import Mass
 from ..ode.problems import Problem, SecondOrderProblem
 from ..ode.state import Layout, PartView, State
@@ -36,7 +39,7 @@ if TYPE_CHECKING:
     from ..ode.system import System
     from .model import Model
 
-__all__ = ["SceneSystem", "as_problem", "initial_state", "layout", "scene_system"]
+__all__ = ["SceneSystem", "SpringView", "as_problem", "initial_state", "layout", "scene_system"]
 
 
 def _first_order(model: Model) -> bool:
@@ -183,7 +186,58 @@ def scene_system(model: Model) -> System:
     if count and not pieces and forces.gradient_form:
         system.potential = potential
     system.contact_constraints = _contact_constraints(model)
+    springs = [f for f in model.forces if isinstance(f, Springs)]
+    if springs and not pieces:
+        network = SpringView(model.particle_mass, model.particle_pinned, tuple(springs))
+        system.spring_network = lambda: network
     return system
+
+
+@dataclass(frozen=True)
+class SpringView:
+    """A scene's springs as one network, for solvers made for springs
+    (:mod:`visviva.deformables.fast_springs`).
+
+    Attributes:
+        mass: ``(N,)`` particle masses [kg].
+        pinned: ``(N,)`` which particles are held.
+        forces: The scene's :class:`~visviva.forces.Springs`.
+    """
+
+    mass: np.ndarray
+    pinned: np.ndarray
+    forces: tuple[Springs, ...]
+
+    @cached_property
+    def pairs(self) -> np.ndarray:
+        """``(S, 2)`` every spring's particles."""
+        return np.concatenate([f.pairs for f in self.forces])
+
+    @cached_property
+    def first(self) -> np.ndarray:
+        return np.ascontiguousarray(self.pairs[:, 0])
+
+    @cached_property
+    def second(self) -> np.ndarray:
+        return np.ascontiguousarray(self.pairs[:, 1])
+
+    @cached_property
+    def rest_length(self) -> np.ndarray:
+        """``(S,)`` [m]."""
+        return np.concatenate([f.rest_length for f in self.forces])
+
+    @cached_property
+    def stiffness(self) -> np.ndarray:
+        """``(S,)`` [N/m]."""
+        return np.concatenate([f.stiffness for f in self.forces])
+
+    def elastic(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``(N, 3)`` the springs' elastic forces [N] at positions ``x`` (no damper)."""
+        out = np.zeros_like(x)
+        still = np.zeros_like(x)
+        for force in self.forces:
+            force.accumulate(t, x, still, out)
+        return out
 
 
 def _contact_constraints(
@@ -248,6 +302,9 @@ class SceneSystem(SecondOrderSystem):
     #: positions ``q`` (see :func:`_contact_constraints`), which implicit steps may hold particles
     #: against (``None``: no such colliders).
     contact_constraints: Callable[[np.ndarray, float], tuple[np.ndarray, ...]] | None = None
+    #: The scene's springs as one :class:`SpringView` (``None``: no springs, or generalized
+    #: coordinates beside the particles).
+    spring_network: Callable[[], SpringView] | None = None
 
     def force_jacobian(
         self,
