@@ -58,6 +58,12 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
         ("dotted.toml", ".".join(f"k{i}" for i in range(50_000)) + " = 1\n"),
         ("quoted.toml", '"a".' * 1000 + "b = 1\n"),
         ("inline.toml", "x = " + "{a = " * 300 + "1" + "}" * 300 + "\n"),
+        (
+            "mesh.toml",
+            (EXAMPLES / "flag.toml")
+            .read_text()
+            .replace("triangles = [[0, 1, 7]", "triangles = " + "[" * 20 + "0" + "]" * 20 + " #"),
+        ),
     ],
 )
 def test_deep_nesting_is_refused_at_once(tmp_path, name, text):
@@ -132,6 +138,43 @@ def test_validate_refuses_what_run_would_refuse(tmp_path, text, fragments):
     path = write(tmp_path, "scene.toml", text)
     error = refused(path, *fragments)
     assert all(p.line is not None for p in error.problems), error  # each with its line
+
+
+HAIR = (EXAMPLES / "hair.toml").read_text()
+TRUSS = (EXAMPLES / "truss.toml").read_text()
+FLAG = (EXAMPLES / "flag.toml").read_text()
+SOFT_CUBE = (EXAMPLES / "soft_cube.toml").read_text()
+FLAG_TRIANGLES = "triangles = [[0, 1, 7], [0, 7, 6],"
+
+
+@pytest.mark.parametrize(
+    "text, fragments",
+    [
+        (replaced("[-0.0911, 0.6405", "[nan, 0.6405", SOFT_CUBE), ["vertices[0][0]", "finite"]),
+        (replaced("[-0.0911, 0.6405", "[-inf, 0.6405", SOFT_CUBE), ["vertices[0][0]", "finite"]),
+        (replaced("[-0.0911, 0.6405", "[-1e300, 0.6405", SOFT_CUBE), ["entities[0]", "a float"]),
+        (replaced("[0.019, 1.500", "[1e308, 1.500", HAIR), ["entities[1].points", "a float"]),
+        (replaced("[0.25, 1.4, 0.0]", "[0.25, 1e200, 0.0]", TRUSS), ["entities[0]", "a float"]),
+        (replaced("[0, 5, 3, 6]", "[0, 5, 3, 18446744073709551616]", SOFT_CUBE), ["less than"]),
+        (replaced("[0, 5, 3, 6]", "[0, 5, 3, 6.0]", SOFT_CUBE), ["tetrahedra[0][3]", "integer"]),
+        (replaced("[0, 5, 3, 6]", "[0, 5, 6, 3]", SOFT_CUBE), ["tetrahedra[0]", "swap two"]),
+        (replaced(FLAG_TRIANGLES, "triangles = [", FLAG), ["vertices[0]", "in no triangle"]),
+        (replaced("pairs = [[0, 1],", "pairs = [[0, 0],", TRUSS), ["pairs[0]", "to itself"]),
+        (
+            replaced("points = [[-0.100", "points = [] #", HAIR),
+            ["entities[0].points", "at least 2"],
+        ),
+        (
+            replaced("pairs = [[0, 1], [1, 2]", "pairs = [] # [1, 2]", TRUSS),
+            ["pairs", "at least 1"],
+        ),
+        (replaced("mass = [2.0, 2.0, 20.0,", "mass = [2.0, 20.0,", TRUSS), ["mass", "8 entries"]),
+        (replaced("pinned = [0, 6, 12, 18]", "pinned = [24]", FLAG), ["pinned index 24"]),
+    ],
+)
+def test_deformable_bodies_refuse_hostile_values_at_their_line(tmp_path, text, fragments):
+    error = refused(write(tmp_path, "scene.toml", text), *fragments)
+    assert all(p.line is not None for p in error.problems), error
 
 
 def test_a_count_given_as_text_is_refused(tmp_path):

@@ -267,6 +267,18 @@ def entity(text: str) -> str:
     return VALID + "\n[[entities]]\n" + text
 
 
+HAIR = (
+    'type = "hair"\npoints = [[0, 0, 0], [0, -1, 0]]\nmass = 0.1\nstiffness = 10.0\nbending = 1.0\n'
+)
+SPRINGS = 'type = "springs"\npoints = [[0, 0, 0], [1, 0, 0]]\nmass = 1.0\nstiffness = 10.0\n'
+CLOTH_MESH = (
+    'type = "cloth_mesh"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 0, 1]]\ndensity = 0.1\n'
+    "stretch = 1.0\n"
+)
+SOFT_MESH = (
+    'type = "soft_mesh"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]\ndensity = 1.0\n'
+    "stiffness = 1.0\n"
+)
 OPEN_MESH = """type = "collider"
 shape = "mesh"
 vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]
@@ -343,6 +355,29 @@ triangles = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 1]]
             + '\n[[entities]]\ntype = "force"\nkind = "gravitation"\ntargets = ["spray"]',
             ["entities[3].targets[0]", "born and die"],
         ),
+        (entity(HAIR + "pinned = [2]"), ["entities[2]", "pinned index 2", "hair strand"]),
+        (entity(HAIR + "torsion = -1.0"), ["entities[2].torsion", "-1.0"]),
+        (entity(SPRINGS + "pairs = [[0, 1], [1, 1]]"), ["entities[2].pairs[1]", "to itself"]),
+        (
+            entity(SPRINGS + "pairs = [[0, 1]]\nrest_length = [1.0, 2.0]"),
+            ["entities[2].rest_length", "2 values for 1 springs"],
+        ),
+        (
+            entity(CLOTH_MESH + "triangles = [[0, 1, 2], [2, 1, 0]]"),
+            ["entities[2].triangles[1]", "the same vertices"],
+        ),
+        (
+            entity(CLOTH_MESH + "triangles = [[0, 1, 3]]"),
+            ["entities[2].triangles[0]", "names a vertex past the 3"],
+        ),
+        (
+            entity(SOFT_MESH + "tetrahedra = [[0, 2, 1, 3]]"),
+            ["entities[2].tetrahedra[0]", "inside out", "swap two vertices of tetrahedron 0"],
+        ),
+        (
+            entity(SOFT_MESH.replace("[0, 0, 1]", "[1, 1, 0]") + "tetrahedra = [[0, 1, 2, 3]]"),
+            ["entities[2].tetrahedra[0]", "no volume"],
+        ),
     ],
     ids=[
         "negative-rate",
@@ -366,6 +401,14 @@ triangles = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 1]]
         "parameter-of-another-kind",
         "attractor-without-softening",
         "gravitation-among-emitted",
+        "hair-pin-past-the-strand",
+        "negative-torsion",
+        "spring-to-itself",
+        "rest-lengths-not-one-per-spring",
+        "duplicate-triangle",
+        "triangle-index-past-the-vertices",
+        "inside-out-tetrahedron",
+        "flat-tetrahedron",
     ],
 )
 def test_bad_particle_entity_is_refused(monkeypatch, capsys, tmp_path, text, fragments):

@@ -5,11 +5,11 @@ springs join.
   apart with bending springs (which, seed 000 warns, also resist stretch).
 * A **hair** strand (Selle, Lentine & Fedkiw 2008) joins consecutive points with edge
   (stretch) springs, points two apart with bending springs and points three apart with torsion
-  springs, each family with its own stiffness. Selle et al. also tie each spring's tetrahedron
-  of four consecutive points with *altitude* springs (and add ghost particles where a strand is
-  straight), so that the tetrahedron cannot collapse flat or invert; those are left out here:
-  a strand's bending and torsion springs resist bending and twisting only while the strand is
-  curved, and a straight stretch of strand may fold with little resistance.
+  springs, each family with its own stiffness. Selle et al. also tie each run of four
+  consecutive points (a tetrahedron) with *altitude* springs (and add ghost particles where a
+  strand is straight), so that the tetrahedron cannot collapse flat or invert; those are left
+  out here: a strand's bending and torsion springs resist bending and twisting only while the
+  strand is curved, and a straight stretch of strand may fold with little resistance.
 * A **spring graph** is any topology: particles at given points and a spring on each given
   pair of them, with stiffness (and, if given, rest length) one value or one per spring.
 * A **cloth grid** (Choi & Ko 2002; seed 001) of ``nu × nv`` points joins grid neighbours with
