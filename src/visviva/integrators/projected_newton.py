@@ -1,30 +1,38 @@
 """Backward Euler as an energy minimization: projected Newton with a line search and CG.
 
-For forces of the form ``F(q, v) = −∇U(q) + D(q) v`` (springs, gravity, linear damping), the
-backward Euler step ``M (V − v) = h F(q + hV, V)`` is the stationary point of the *incremental
-potential*
+For forces of the form ``F(q, v) = −∇U(q) + D(q) v`` (springs, gravity, linear damping,
+conservative penalty contact), the backward Euler step ``M (V − v) = h F(q + hV, V)`` is the
+stationary point of the *incremental potential*
 
     Φ(V) = ½ (V − v)ᵀ M (V − v) + U(q + hV) − ½ h Vᵀ D V                    [J]
 
-(``∇Φ`` is the residual ``g(V) = M (V − v) − h F``; ``D`` is held at the iterate), and a
-minimum when ``Φ`` is convex there. Newton's method on ``g`` then gets what makes optimization
-robust (Gast et al. 2015; Martin et al. 2011):
+with the dampers' ``D`` held at the first iterate (so the dampers act along their directions
+at the start of the step; ``∇Φ`` is then the residual ``g(V) = M (V − v) − h F``), and its
+minimum where ``Φ`` is convex. Newton's method on ``g`` gets what makes optimization robust
+(Gast et al. 2015; Martin et al. 2011):
 
-* **projection**: the Newton matrix ``A = M − h D − h² K`` uses each force's stiffness made
+* **projection**: the Newton matrix ``A = M − h D − h² K`` with each force's stiffness made
   positive semi-definite (a compressed spring's negative stiffness dropped, see
-  :meth:`~visviva.forces.Springs.add_symmetric_jacobian`), so ``A`` is symmetric positive
-  definite and every Newton direction ``d = −A⁻¹ g`` goes downhill: ``gᵀd < 0``;
+  :meth:`~visviva.forces.Springs.add_symmetric_jacobian`; Teran et al. 2005) is symmetric
+  positive definite, so every Newton direction ``d = −A⁻¹ g`` goes downhill (``gᵀd < 0``). The
+  projected matrix converges only linearly where springs buckle, so by default (``"adaptive"``)
+  each iteration first tries the exact Hessian and falls back to the projected one where CG
+  meets negative curvature or the last step had to be shortened (Longva et al. 2023);
 * **a backtracking line search** on ``Φ`` (Armijo: ``Φ(V + αd) ≤ Φ(V) + c α gᵀd``, halving
-  ``α``): a step that would overshoot into a buckled, energy-raising configuration is
-  shortened instead of taken;
+  ``α``): a step into a buckled, energy-raising configuration is shortened instead of taken;
 * **preconditioned conjugate gradients** (:mod:`.block_cg`) solve ``A d = −g`` inexactly (to
-  ``cg_rtol``; Newton corrects the rest) — or a direct sparse factorization, for comparison.
-  The Newton iteration starts from the previous step's acceleration, ``V₀ = v + h a``.
+  ``cg_rtol``; Newton corrects the rest) — or a direct sparse factorization, for comparison;
+* the iteration starts from the previous step's acceleration, ``V₀ = v + h a``, and stops when
+  Newton's decrement, as a mass-weighted RMS velocity ``√(−gᵀd/Σm)``, is below ``atol +
+  rtol·(RMS speed)`` (:func:`_decrement_ratio`);
+* a step that does not converge within ``max_iterations`` is retried as two half steps, up to
+  :data:`SPLITS` times, before :class:`~visviva.errors.NewtonConvergenceError` is raised;
+* the colliders' contacts, where the system offers them, are held inside the solve, with
+  Coulomb friction (:mod:`.contact_set`, :mod:`.friction`).
 
-A system whose force is not of that form (wind, penalty contact, generalized coordinates) has
-no potential; the line search then asks for a smaller residual ``‖g‖`` instead. Iteration stops
-when every component of the Newton direction is below ``atol + rtol·|V|``; a step that does not
-get there within ``max_iterations`` raises :class:`~visviva.errors.NewtonConvergenceError`.
+A system whose force is not of that form (wind, damped penalty contact, generalized
+coordinates) has no potential; the line search then asks for a smaller residual ``‖g‖``.
+:class:`ProjectedTrapezoidal` solves the trapezoidal rule's implicit half the same way.
 
 References:
     T. F. Gast, C. Schroeder, A. Stomakhin, C. Jiang, J. M. Teran, "Optimization integrator for
@@ -33,6 +41,9 @@ References:
     SIGGRAPH 2011 (backward Euler as minimization of an incremental potential).
     J. Teran, E. Sifakis, G. Irving, R. Fedkiw, "Robust quasistatic finite elements and flesh
     simulation", SCA 2005 (projecting each element's stiffness to be definite).
+    A. Longva, F. Löschner, J. A. Fernández-Fernández, E. Larionov, U. M. Ascher, J. Bender,
+    "Pitfalls of projection: a study of Newton-type solvers for incremental potentials",
+    arXiv:2311.14526 (2023) (projecting on demand).
     J. Nocedal, S. J. Wright, *Numerical Optimization*, 2nd ed., Springer 2006, §3.1 (Armijo
     backtracking) and §7.1 (inexact Newton–CG).
 """
@@ -47,6 +58,7 @@ from numba import njit, prange
 from .._validation import real_number, whole_number
 from ..errors import ModelError, NewtonConvergenceError
 from .block_cg import block_cg, block_product
+from .contact_set import hold_contacts
 from .friction import LaggedFriction
 from .implicit import BackwardEuler, Trapezoidal
 from .newton import KRYLOV_THRESHOLD, NewtonOptions, linear_solve, mass_minus
@@ -61,12 +73,6 @@ __all__ = ["ProjectedNewton", "ProjectedTrapezoidal"]
 PROJECTIONS = ("adaptive", "always", "never")
 #: Times a step whose Newton iteration does not converge may be halved (down to h/8).
 SPLITS = 3
-#: Updates of the set of particles held on colliders' surfaces per step.
-CONTACT_ROUNDS = 4
-#: The tolerance of the solves that only move the contact set, times the step's.
-ROUGH = 10.0
-#: Sliding speed [m/s] below which friction on held particles acts as a stiff drag (static).
-FRICTION_SLIP = 1e-3
 #: Armijo's fraction of the predicted decrease a step must achieve.
 ARMIJO = 1e-4
 #: Halvings the line search may take (the shortest step is 2⁻¹² of Newton's).
@@ -172,7 +178,15 @@ class ProjectedNewton(BackwardEuler):
             if constraints is None:
                 v_new, _ = self._minimize(system, t + h, q_base, v_base, guess, theta_h, None)
             else:
-                v_new = self._in_contact(system, constraints, t + h, q_base, v_base, guess, theta_h)
+
+                def minimize(
+                    v: np.ndarray, normals: np.ndarray, friction: Any, rough: float
+                ) -> tuple[np.ndarray, np.ndarray]:
+                    return self._minimize(
+                        system, t + h, q_base, v_base, v, theta_h, normals, friction, rough
+                    )
+
+                v_new = hold_contacts(minimize, constraints, q_base, guess, theta_h)
         except NewtonConvergenceError:
             if splits == 0:
                 raise
@@ -181,72 +195,6 @@ class ProjectedNewton(BackwardEuler):
             q, v, acceleration = self._advance(system, t, q, v, acceleration, half, splits - 1)
             return self._advance(system, t + half, q, v, acceleration, half, splits - 1)
         return q_base + theta_h * v_new, v_new, (v_new - v_base) / theta_h
-
-    def _in_contact(
-        self,
-        system: SecondOrderSystem,
-        constraints: Any,
-        t: float,
-        q_base: np.ndarray,
-        v_base: np.ndarray,
-        v: np.ndarray,
-        h: float,
-    ) -> np.ndarray:
-        """:meth:`_minimize` with the colliders' contacts as constraints (Baraff & Witkin
-        1998, §5): a particle whose end-of-step position ``q_b + hV`` would be inside a
-        collider is held on its surface — its velocity along the surface normal set so that it
-        ends there, and that component filtered out of the solve — and released where holding
-        it would take a pull. The active set is updated from the solution, up to
-        :data:`CONTACT_ROUNDS` times, roughly (to :data:`ROUGH` times the tolerance); then the
-        last solve, to the tolerance. Each solve after the first adds Coulomb friction on the
-        held particles, with the normal impulses of the one before (the residual along the
-        normal is the impulse the collider supplied; :mod:`.friction`). Held contacts are
-        inelastic; what is left (bounces, the odd particle still inside) is the collision
-        stage's, after the step."""
-        count = v.size // 3
-        normals = np.zeros((count, 3))
-        active = np.zeros(count, dtype=bool)
-        v = v.copy()
-        friction = None
-        pulling = np.zeros(count, dtype=bool)
-        weight = np.zeros(count)  # μ J [N·s] of each held particle, from the last solve
-        for round_ in range(CONTACT_ROUNDS + 1):
-            # Held particles slide along their tangent planes, which takes them off a curved
-            # surface by up to (hV)²/2R: look for them that far out.
-            reach = h * float(np.abs(v).max())
-            particle, normal, depth, mu = constraints(q_base + h * v, reach)
-            near = np.zeros(count, dtype=bool)
-            near[particle] = True
-            inside = np.zeros(count, dtype=bool)
-            inside[particle[depth > 0.0]] = True
-            entering = inside & ~active
-            settled = round_ > 0 and not entering.any() and not pulling.any()
-            if settled or round_ == CONTACT_ROUNDS:
-                break
-            active = (active & near) | entering
-            normals.fill(0.0)
-            held = active[particle]
-            normals[particle[held]] = normal[held]
-            coefficient = np.zeros(count)
-            coefficient[particle[held]] = mu[held]
-            # Feasible first: each held particle's velocity along its normal makes it end on
-            # the surface (depth [m] ÷ h).
-            shift = np.zeros((count, 3))
-            shift[particle[held]] = (np.maximum(depth[held], 0.0) / h)[:, None] * normal[held]
-            v += shift.reshape(v.shape)
-            friction = _friction(normals, active, weight)
-            # The rounds that move the set only need a rough answer: 10 times the tolerance.
-            v, residual = self._minimize(system, t, q_base, v_base, v, h, normals, friction, ROUGH)
-            # The collider can only push: release a particle whose constraint force
-            # (residual ÷ h along the normal) pulls it in.
-            pushing = np.einsum("ij,ij->i", residual.reshape(count, 3), normals)
-            pulling = active & (pushing < 0.0)
-            active &= ~pulling
-            weight = coefficient * np.where(active, pushing, 0.0)
-        normals *= active[:, None]
-        friction = _friction(normals, active, weight)
-        v, _ = self._minimize(system, t, q_base, v_base, v, h, normals, friction)
-        return v
 
     def _minimize(
         self,
@@ -414,15 +362,6 @@ def _takes(system: System, state: State) -> bool:
         return False
     # Without an analytic Jacobian, finite differences cost one force per unknown.
     return system.has_jacobian or state.parts[0].size <= KRYLOV_THRESHOLD
-
-
-def _friction(normals: np.ndarray, active: np.ndarray, weight: np.ndarray) -> LaggedFriction | None:
-    """Friction on the ``active`` particles, ``weight`` ``(N,)`` = μ J [N·s] each (``None``
-    where there is none)."""
-    weight = np.where(active, weight, 0.0)
-    if not weight.any():
-        return None
-    return LaggedFriction(normals * active[:, None], weight, FRICTION_SLIP)
 
 
 def _across(normals: np.ndarray, vector: np.ndarray) -> np.ndarray:
