@@ -33,7 +33,7 @@ from numba import njit, prange
 
 from ..errors import ModelError
 
-__all__ = ["Springs"]
+__all__ = ["Springs", "spring_forces", "spring_incidence"]
 
 
 class Springs:
@@ -77,8 +77,8 @@ class Springs:
         self.count = count
         # Each particle's springs, for the force's gather: those it is the first end of, and
         # those it is the second end of (pulled by +f and −f), as CSR lists.
-        self._as_first = _incidence(self.pairs[:, 0], count)
-        self._as_second = _incidence(self.pairs[:, 1], count)
+        self._as_first = spring_incidence(self.pairs[:, 0], count)
+        self._as_second = spring_incidence(self.pairs[:, 1], count)
         # 32-bit ends: the force pass gathers by them, and AVX-512 gathers 8 at a time with
         # 32-bit indices.
         self._first = np.ascontiguousarray(self.pairs[:, 0], dtype=np.int32)
@@ -105,7 +105,7 @@ class Springs:
         fx, fy, fz = self._spring_force
         columns = self._columns
         _columns(x, v, columns)
-        _spring_forces(
+        spring_forces(
             self._first, self._second, self.rest_length, self.stiffness, self.damping,
             *columns, fx, fy, fz,
         )  # fmt: skip
@@ -168,7 +168,7 @@ class Springs:
         )
 
 
-def _incidence(ends: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+def spring_incidence(ends: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
     """CSR lists of the springs at each particle: the springs with particle ``p`` at ``ends``
     are ``springs[start[p]:start[p + 1]]`` (32-bit, in spring order)."""
     start = np.zeros(count + 1, dtype=np.int64)
@@ -235,7 +235,7 @@ def _columns(x, v, columns):  # pragma: no cover - compiled
 
 # fmt: off
 @njit(cache=True, parallel=True, error_model="numpy")
-def _spring_forces(
+def spring_forces(
     first, second, rest, k, c, x, y, z, vx, vy, vz, fx, fy, fz,
 ):  # pragma: no cover - compiled
     """``(fx, fy, fz)[s]``: the force of spring ``s`` on its first particle [N] (positions and

@@ -1,10 +1,14 @@
 """The fused particle step: the whole step in one compiled call for scenes made only of particles.
 
-A scene of particles under field forces, with colliders and emitters, stepped by symplectic
-Euler (the scenes' default), is bound by memory traffic: the generic pipeline reads and writes
-the particle arrays once for each force, for the integrator's kick and drift, for each stage
-and for the divergence watch. This module takes the whole step in place, on every core
-(``prange``), in two passes:
+A scene of particles under field forces and springs, with colliders, emitters and pins, stepped
+by symplectic Euler (the scenes' default), is bound by memory traffic: the generic pipeline
+reads and writes the particle arrays once for each force, for the integrator's kick and drift,
+for each stage and for the divergence watch. This module takes the whole step in place, on
+every core (``prange``). With springs, a first pass computes each spring's force on its first
+end (:func:`~visviva.forces.springs.spring_forces`, vectorized over springs), and each particle
+sums its springs' forces through its CSR lists in pass 1 below (that pass is then not
+vectorized: a loop per particle; plain particle scenes compile without it). Then, in two
+passes:
 
 1. a pass over every particle that the compiler vectorizes (AVX-512: eight particles at a
    time), since every particle takes the same path, with no loop, no call and no conditional
@@ -14,8 +18,8 @@ and for the divergence watch. This module takes the whole step in place, on ever
    plane (the floor, most often), ageing, the divergence watch's check, and a cheap test of
    whether the particle needs more: it is near another plane, may meet another collider or
    hit a plane within the step (time of impact), a field acts on it by its law (attractors,
-   vortices, quadratic drag, forces on some particles only), it dies, or its size follows a
-   ramp. Such a particle keeps its start values;
+   vortices, quadratic drag, forces on some particles only), it dies, its size follows a
+   ramp, or it is pinned. Such a particle keeps its start values (a pinned one keeps them);
 2. a pass over those few, each by the general path from its start values: the fields by their
    law (:mod:`visviva.forces.laws`), the collision stage's own per-particle function
    (:func:`visviva.collision.response.resolve`), the emission stage's ageing and death
@@ -46,6 +50,7 @@ from ..collision.queries import plane_distance
 from ..collision.response import ParticleCollisions, _contact, _tolerance, resolve
 from ..forces.fields import Attractor, Damping, Drag, QuadraticDrag, UniformGravity, Vortex
 from ..forces.laws import attractor_force, quadratic_drag_force, vortex_air_velocity
+from ..forces.springs import Springs, spring_forces, spring_incidence
 from .emission import Emission, age_one
 
 if TYPE_CHECKING:
@@ -64,7 +69,12 @@ class FusedParticles:
     """The fused step of a particle scene, if it has one (see :meth:`of`)."""
 
     def __init__(
-        self, count: int, forces: tuple[Force, ...], mass: np.ndarray, stages: tuple[Any, ...]
+        self,
+        count: int,
+        forces: tuple[Force, ...],
+        mass: np.ndarray,
+        stages: tuple[Any, ...],
+        pinned: np.ndarray | None = None,
     ) -> None:
         self.count = count
         self.inverse_mass = 1.0 / mass
@@ -73,7 +83,10 @@ class FusedParticles:
         self.air = np.zeros(3)  # Σ k w [N]
         self.damping = 0.0  # Σ γ of damping on every particle [1/s]
         laws = []
+        springs = [f for f in forces if isinstance(f, Springs)]
         for force in forces:
+            if isinstance(force, Springs):
+                continue
             every = force.targets.everything
             if isinstance(force, UniformGravity) and every:
                 self.gravity += force.gravity
@@ -96,7 +109,14 @@ class FusedParticles:
         self._collision, contacts = _collision_arguments(self.collisions)
         # Which particles take the kernel's pass 2 (none can without emitters, fields by law,
         # and colliders other than a first plane without time of impact).
+        self._springs = _spring_arguments(springs, count)
+        # Each spring's force on its first particle, one array per component.
+        self._spring_force = np.empty(
+            (3, 0 if self._springs[0] is None else len(self._springs[0][0]))
+        )
+        self.pinned = pinned if pinned is not None and pinned.any() else None
         general = contacts or self.emission is not None or len(laws) > 0
+        general = general or self.pinned is not None
         self._special = np.zeros(count, dtype=np.bool_) if general else None
         # The working copy: positions and velocities, (3, N) each (one contiguous array per
         # component, which the compiler vectorizes over), and the state they belong to.
@@ -108,14 +128,12 @@ class FusedParticles:
     @classmethod
     def of(cls, model: Any, method: str) -> FusedParticles | None:
         """The fused step of ``model`` for ``method``, or ``None`` if it has none: the method
-        must be symplectic Euler, the scene made only of free particles (none pinned), every
-        force a field (gravitation, springs and penalty contact are not), every stage
-        collisions or emission."""
+        must be symplectic Euler, the scene made only of particles, every force a field or
+        springs (gravitation and penalty contact are not), every stage collisions or
+        emission."""
         if method != "symplectic_euler" or model.systems or not model.particle_count:
             return None
-        if model.particle_pinned.any():
-            return None
-        if not all(isinstance(f, _FIELDS) for f in model.forces):
+        if not all(isinstance(f, (*_FIELDS, Springs)) for f in model.forces):
             return None
         # A stage that declares no compiled form keeps the generic pipeline; of those that
         # do, the fused step knows how to take the collisions' and the emission's place.
@@ -123,11 +141,19 @@ class FusedParticles:
             s.compiled and isinstance(s, (ParticleCollisions, Emission)) for s in model.stages
         ):
             return None
-        laws = [f for f in model.forces if not (isinstance(f, _FOLDED) and f.targets.everything)]
+        laws = [
+            f
+            for f in model.forces
+            if not ((isinstance(f, _FOLDED) and f.targets.everything) or isinstance(f, Springs))
+        ]
         if len(laws) > MAX_LAW_FIELDS:
             return None
         return cls(
-            model.particle_count, model.forces, np.asarray(model.particle_mass), model.stages
+            model.particle_count,
+            model.forces,
+            np.asarray(model.particle_mass),
+            model.stages,
+            np.asarray(model.particle_pinned),
         )
 
     def step(self, state: State, h: float, t_after: float, limit: float) -> tuple[State, bool]:
@@ -143,6 +169,9 @@ class FusedParticles:
             self._load(state)
         carried = dict(state.carried)
         emission = self.emission
+        springs, lists = self._springs
+        if springs is not None:
+            spring_forces(*springs, *self._x, *self._v, *self._spring_force)
         suspects = _fused(
             *self._x,
             *self._v,
@@ -162,6 +191,9 @@ class FusedParticles:
             *self._collision,
             limit,
             self._special,
+            None if springs is None else self._spring_force,
+            lists,
+            self.pinned,
         )
         if emission is not None:
             born = emission.give_birth(state.t, t_after, self._x.T, self._v.T, carried)
@@ -195,6 +227,21 @@ class FusedParticles:
             self._end = int(live[-1]) + 1 if live.shape[0] else 0
 
 
+@njit(cache=True, inline="always")
+def _spring_sum(force, lists, i):  # pragma: no cover - compiled
+    """The springs' force on particle ``i`` [N]: ``+f`` of those it is the first end of,
+    ``−f`` of those it is the second end of."""
+    first_start, as_first, second_start, as_second = lists
+    fx = fy = fz = 0.0
+    for b in range(first_start[i], first_start[i + 1]):
+        s = as_first[b]
+        fx, fy, fz = fx + force[0, s], fy + force[1, s], fz + force[2, s]
+    for b in range(second_start[i], second_start[i + 1]):
+        s = as_second[b]
+        fx, fy, fz = fx - force[0, s], fy - force[1, s], fz - force[2, s]
+    return fx, fy, fz
+
+
 @njit(cache=True, parallel=True)
 def _interleave(columns, flat):  # pragma: no cover - compiled
     """``flat`` (3N,) ← ``columns`` (3, N): x0 y0 z0 x1 y1 z1 ..."""
@@ -215,6 +262,24 @@ def _deinterleave(flat, columns):  # pragma: no cover - compiled
 
 _FOLDED = (UniformGravity, Drag, Damping)
 _FIELDS = (*_FOLDED, QuadraticDrag, Attractor, Vortex)
+
+
+def _spring_arguments(
+    springs: list[Springs], count: int
+) -> tuple[tuple[np.ndarray, ...] | None, tuple[np.ndarray, ...] | None]:
+    """The scene's springs as one set for the kernels: ``(first, second, rest, k, c)`` and
+    each particle's CSR lists of the springs it is the first and the second end of (``None``,
+    ``None`` without springs)."""
+    if not springs:
+        return None, None
+    pairs = np.concatenate([f.pairs for f in springs])
+    ends = tuple(np.ascontiguousarray(pairs[:, e], dtype=np.int32) for e in range(2))
+    values = tuple(
+        np.concatenate([getattr(f, name) for f in springs])
+        for name in ("rest_length", "stiffness", "damping")
+    )
+    lists = (*spring_incidence(pairs[:, 0], count), *spring_incidence(pairs[:, 1], count))
+    return (*ends, *values), lists
 
 
 def _law(force: Force) -> tuple[int, list[float]]:
@@ -371,7 +436,7 @@ def _fused(
     alive, radius, age, lifetime, size, slot_emitter, size_ramps, slot_ramped, end,
     collider_masks, common_mask, floor, floor_bit, e, mu, rests, near_planes, impact_planes,
     restitution, friction, resting, toi, planes, rows, others, everything,
-    limit, special,
+    limit, special, spring_force, lists, pinned,
 ):  # pragma: no cover - compiled
     """The step of the module docstring for every particle, in place (positions ``x, y, z``
     and velocities ``vx, vy, vz``, one array per component; ``special`` is scratch, ``None``
@@ -393,6 +458,11 @@ def _fused(
         ux = svx + h * (gx - c * svx + wx * w)
         uy = svy + h * (gy - c * svy + wy * w)
         uz = svz + h * (gz - c * svz + wz * w)
+        if spring_force is not None:
+            fx, fy, fz = _spring_sum(spring_force, lists, i)
+            ux += h * w * fx
+            uy += h * w * fy
+            uz += h * w * fz
         px, py, pz = sx + h * ux, sy + h * uy, sz + h * uz
         r = radius[i]
         mask = common_mask if collider_masks is None else collider_masks[i]
@@ -417,6 +487,8 @@ def _fused(
             odd |= (mask >> beyond) != 0
         if kinds is not None:
             odd |= law_masks[i] != 0
+        if pinned is not None:
+            odd |= pinned[i]
         # Only emitted particles die: without emitters, every slot is alive.
         live = True
         if age is not None:
@@ -447,12 +519,19 @@ def _fused(
     for i in prange(end):
         if not special[i]:
             continue
+        if pinned is not None and pinned[i]:
+            continue  # held where it is: it kept its start values in pass 1
         sx, sy, sz, svx, svy, svz = x[i], y[i], z[i], vx[i], vy[i], vz[i]
         w = inverse_mass[i]
         c = drag * w + damping
         ax = gx - c * svx + wx * w
         ay = gy - c * svy + wy * w
         az = gz - c * svz + wz * w
+        if spring_force is not None:
+            fx, fy, fz = _spring_sum(spring_force, lists, i)
+            ax += w * fx
+            ay += w * fy
+            az += w * fz
         if kinds is not None:
             bits = law_masks[i]
             for k in range(kinds.shape[0]):
