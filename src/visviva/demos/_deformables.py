@@ -1,0 +1,87 @@
+"""What the deformable demos measure on their runs: spring forces, loads on pins, strain, energy.
+
+Shared by ``cloth-hang``, ``cloth-drape``, ``flag``, ``hair``, ``jelly``, ``stiffness-study``
+and ``refinement-study``. Every quantity is computed from the model's own forces and the
+recorded frames, so a demo's check compares the simulation with physics, not with itself.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+import numba
+import numpy as np
+
+from ..forces.springs import Springs
+from ..model.model import Model
+from ..simulation.recording import Recording
+
+#: Standard gravity [m/s²]: the scenes' default world.
+GRAVITY = 9.81
+
+
+@contextmanager
+def one_thread() -> Iterator[None]:
+    """Numba's parallel kernels on one thread while the block runs.
+
+    The demos' bodies have at most a few hundred points: a parallel kernel then costs more to
+    launch and join than it saves (NOTES.md: below a 64 × 64 cloth one thread wins), and on a
+    busy two-core machine each join can wait milliseconds for a descheduled thread, while
+    projected Newton's conjugate gradients call such kernels thousands of times per simulated
+    second. Measured on the 16 × 16 drape, 0.5 s simulated: 1.4 s on one thread, 50 s on two
+    with the other core busy. The springs' forces do not depend on the thread count.
+    """
+    previous = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(previous)
+
+
+def springs_of(model: Model) -> Springs:
+    """The scene's spring network (one :class:`Springs` holds every body's springs)."""
+    for force in model.forces:
+        if isinstance(force, Springs):
+            return force
+    raise ValueError(f"scene {model.name!r} has no springs")
+
+
+def spring_forces(model: Model, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The force [N] of the springs alone (dampers included) on each particle, ``(N, 3)``, at
+    positions ``x`` [m] and velocities ``v`` [m/s]."""
+    out = np.zeros_like(x)
+    springs_of(model).accumulate(0.0, x, v, out)
+    return out
+
+
+def load_on_pins(model: Model, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The springs' total pull [N] on the pinned particles, ``(3,)``: at rest, minus the pins'
+    reaction on the rest of the body, which then balances every other force on it."""
+    return spring_forces(model, x, v)[model.particle_pinned].sum(axis=0)
+
+
+def kinetic_energy(recording: Recording) -> np.ndarray:
+    """``½ Σ m v²`` [J] of each recorded frame, ``(frames,)``."""
+    mass = recording.static["mass"]
+    return 0.5 * np.einsum("i,fij,fij->f", mass, recording["velocities"], recording["velocities"])
+
+
+def strain(model: Model, points: np.ndarray, pairs: np.ndarray | None = None) -> np.ndarray:
+    """``l/L − 1`` of each spring (or of the springs on ``pairs``, ``(S, 2)``, rest lengths
+    taken from the model's first frame) at ``points`` ``(..., N, 3)`` [m]."""
+    if pairs is None:
+        springs = springs_of(model)
+        pairs, rest = springs.pairs, springs.rest_length
+    else:
+        start = model.particle_position
+        rest = np.linalg.norm(start[pairs[:, 1]] - start[pairs[:, 0]], axis=-1)
+    length = np.linalg.norm(points[..., pairs[:, 1], :] - points[..., pairs[:, 0], :], axis=-1)
+    return length / rest - 1.0
+
+
+def largest_rise(energy: np.ndarray) -> float:
+    """The largest increase [J] of ``energy`` from one recorded frame to the next (negative
+    if it only fell)."""
+    return float(np.diff(energy).max()) if energy.size > 1 else 0.0

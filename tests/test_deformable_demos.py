@@ -1,0 +1,50 @@
+"""The deformable demos (cloth, flag, hair, jelly, the stiffness and refinement studies): each
+runs, shortened where it can be, and its summary holds the physics it shows."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import visviva as vv
+from visviva.demos import run_demo
+
+
+def summary(directory: Path) -> dict:
+    return json.loads((directory / "summary.json").read_text())
+
+
+def outputs(directory: Path, figure: str) -> vv.simulation.Recording:
+    """The demo wrote its recording, summary and figure, and finished; its first run, read
+    back, has points that moved."""
+    for file in ("recording.h5", "summary.json", f"{figure}.png"):
+        assert (directory / file).stat().st_size > 1000, file
+    assert summary(directory)["complete"] is True
+    recording = next(iter(vv.io.read_recordings(directory / "recording.h5").values()))
+    points = recording["points"]
+    assert points.shape[0] > 10 and points.shape[1] > 0
+    assert np.abs(points[-1] - points[0]).max() > 1e-3
+    return recording
+
+
+def test_cloth_hang_never_gains_energy_and_rests_on_its_pins(tmp_path):
+    run_demo("cloth-hang", tmp_path)  # its full 8 s: the swing has died out by then
+    recording = outputs(tmp_path, "cloth_hang")
+    data = summary(tmp_path)
+    # Backward Euler only dissipates: no step gains energy.
+    assert data["largest_energy_rise_per_step_J"] <= data["energy_rise_tolerance_J"]
+    assert data["energy_J"]["end"] < data["energy_J"]["start"]
+    # At rest the pins carry the whole weight, and pull straight up.
+    assert data["kinetic_energy_at_end_J"] < 1e-5
+    load = data["load_on_pins_N"]
+    assert load["relative_error"] < 1e-3
+    assert load["springs_pull_down"] == pytest.approx(load["free_points_weight"], rel=1e-3)
+    assert load["springs_pull_sideways"] < 1e-3 * load["cloth_weight_M_g"]
+    # The pins stay where they are to the last bit; the fabric stretches by about 1 %.
+    pins = recording["points"][:, [0, 19]]
+    assert np.array_equal(pins, np.broadcast_to(pins[0], pins.shape))
+    assert 0.0 < data["largest_stretch_at_rest"] < 0.02
+    assert 0.0 < data["sag_at_rest_m"]["top_edge_middle"] < 0.05
