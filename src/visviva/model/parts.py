@@ -160,12 +160,12 @@ def particle_arrays(
     emitted = iter(range(len(specs)))
     for index, entity in enumerate(scene.entities):
         pinned = np.zeros(0, dtype=np.int64)
-        mass = None
+        mass: float | list[float] | np.ndarray
         if isinstance(entity, Particles):
             x = np.array(entity.positions, dtype=np.float64)
             count = x.shape[0]
             v = np.zeros_like(x) if entity.velocities is None else np.array(entity.velocities)
-            color = entity.color
+            color, mass = entity.color, entity.mass
         elif isinstance(entity, BODIES):
             try:
                 body = spring_network(entity)
@@ -188,19 +188,17 @@ def particle_arrays(
                 x = np.asarray(entity.center) + offsets
                 jitter = entity.velocity_jitter * rng.standard_normal((count, 3))
                 v = np.asarray(entity.velocity) + jitter
-            color = entity.color
+            color, mass = entity.color, entity.mass
         elif isinstance(entity, Emitter):
             k = next(emitted)
             specs[k] = _with(specs[k], first_slot=start)
             count = specs[k].capacity
             x = v = np.zeros((count, 3))
-            color = tuple(specs[k].color_ramp[0, 1:])
+            color, mass = tuple(specs[k].color_ramp[0, 1:]), specs[k].mass
         else:
             continue
         columns["position"].append(x)
         columns["velocity"].append(np.asarray(v, dtype=np.float64))
-        if mass is None:
-            mass = specs[k].mass if isinstance(entity, Emitter) else entity.mass
         radius = specs[k].particle_radius[0] if isinstance(entity, Emitter) else entity.radius
         columns["mass"].append(np.broadcast_to(np.asarray(mass, dtype=np.float64), (count,)))
         columns["radius"].append(np.broadcast_to(np.asarray(radius, dtype=np.float64), (count,)))
