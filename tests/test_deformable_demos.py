@@ -48,3 +48,23 @@ def test_cloth_hang_never_gains_energy_and_rests_on_its_pins(tmp_path):
     assert np.array_equal(pins, np.broadcast_to(pins[0], pins.shape))
     assert 0.0 < data["largest_stretch_at_rest"] < 0.02
     assert 0.0 < data["sag_at_rest_m"]["top_edge_middle"] < 0.05
+
+
+def test_cloth_drape_stays_outside_the_ball_which_carries_it_within_coulombs_cone(tmp_path):
+    run_demo("cloth-drape", tmp_path)  # its full 3 s: at rest by then
+    outputs(tmp_path, "cloth_drape")
+    data = summary(tmp_path)
+    assert data["deepest_inside_ball_m"] <= data["inside_tolerance_m"]
+    assert data["largest_energy_rise_per_step_J"] <= data["energy_rise_tolerance_J"]
+    assert data["kinetic_energy_at_end_J"] < 1e-5
+    # Dozens of points rest on the ball (of 256), down to near its equator.
+    contacts = data["contacts_at_rest"]
+    assert contacts["resting"] >= 30 and contacts["colliding"] == 0
+    assert data["lowest_contact_from_top_deg"] > 60.0
+    # The ball carries the whole cloth, and static friction stays inside Coulomb's cone.
+    carried = data["ball_carries_N"]
+    assert carried["relative_error"] < 1e-3
+    assert carried["sideways"] < 1e-3 * carried["cloth_weight_M_g"]
+    friction = data["friction_at_rest"]
+    assert friction["pressed_contacts"] >= 30
+    assert friction["largest_along_over_pressing"] <= friction["mu"]

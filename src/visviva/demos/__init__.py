@@ -197,6 +197,7 @@ def _interrupted_run_name(output: JobOutput, error: Interrupted) -> str:
 def _load_builtins() -> None:
     from . import (  # noqa: F401 - registers the demos
         circular,
+        cloth_drape,
         cloth_hang,
         constrained_pendulum,
         dahlquist,
