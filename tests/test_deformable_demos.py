@@ -68,3 +68,22 @@ def test_cloth_drape_stays_outside_the_ball_which_carries_it_within_coulombs_con
     friction = data["friction_at_rest"]
     assert friction["pressed_contacts"] >= 30
     assert friction["largest_along_over_pressing"] <= friction["mu"]
+
+
+def test_flag_leans_where_the_wind_and_its_weight_balance(tmp_path):
+    run_demo("flag", tmp_path)  # its full 4 s: settled by 2 s
+    recording = outputs(tmp_path, "flag")
+    data = summary(tmp_path)
+    assert data["kinetic_energy_at_end_J"] < 1e-6
+    # Exact at rest: the staff's load leans by atan(drag / weight).
+    pull = data["pull_on_staff"]
+    assert pull["angle_from_vertical_deg"] == pytest.approx(
+        pull["atan_drag_over_weight_deg"], abs=0.01
+    )
+    assert abs(pull["along_staff_N"]) < 1e-9
+    # The sheet settles within a degree of the rigid plate's angle, after overshooting it.
+    angle = data["deflection_deg"]
+    assert abs(angle["mean_second_half"] - angle["rigid_plate"]) < angle["tolerance"]
+    assert angle["drag_over_weight"] < angle["mean_second_half"] < angle["largest"]
+    staff = recording["points"][:, :16]
+    assert np.array_equal(staff, np.broadcast_to(staff[0], staff.shape))

@@ -203,6 +203,7 @@ def _load_builtins() -> None:
         dahlquist,
         double_pendulum,
         fireworks,
+        flag,
         fountain,
         galaxy,
         kepler,
