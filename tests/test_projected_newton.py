@@ -332,3 +332,21 @@ def test_projected_trapezoidal_keeps_a_linear_oscillators_energy(omega_h):
     euler.step(200)
     assert trapezoid.energy() - equilibrium == pytest.approx(oscillation, rel=1e-9)
     assert euler.energy() - equilibrium < oscillation * (1.0 / (1.0 + omega_h**2)) ** 100
+
+
+@pytest.mark.parametrize(
+    ("method", "order"), [(ProjectedNewton, 1), (vv.integrators.ProjectedTrapezoidal, 2)]
+)
+def test_measured_order_on_a_scene(method, order):
+    """The bob on a spring against its closed form y(t) = y_eq + (y₀ − y_eq) cos ωt: halving
+    h divides the error at t = 1 s by 2^order (within 15 %)."""
+    tight = {"rtol": 1e-12, "atol": 1e-14, "cg_rtol": 1e-14}
+    sag = 9.81 / 100.0
+    exact = -1.0 - sag + sag * np.cos(10.0 * 1.0)  # y₀ − y_eq = sag
+    errors = []
+    for omega_h in (0.04, 0.02, 0.01):
+        sim = _bob(method(**tight), omega_h)
+        sim.step(round(1.0 / (omega_h / 10.0)))
+        errors.append(abs(sim.state["particle_position"][1, 1] - exact))
+    ratios = np.array(errors[:-1]) / np.array(errors[1:])
+    np.testing.assert_allclose(ratios, 2.0**order, rtol=0.15)

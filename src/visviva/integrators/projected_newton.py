@@ -61,7 +61,7 @@ from .block_cg import block_cg, block_product
 from .contact_set import hold_contacts
 from .friction import LaggedFriction
 from .implicit import BackwardEuler, Trapezoidal
-from .newton import KRYLOV_THRESHOLD, NewtonOptions, linear_solve, mass_minus
+from .newton import NewtonOptions, linear_solve, mass_minus
 
 if TYPE_CHECKING:
     from ..ode.state import State
@@ -98,9 +98,8 @@ class ProjectedNewton(BackwardEuler):
         cg_rtol: Relative residual CG reaches in each Newton iteration.
         cg_max_iterations: CG iterations allowed per linear solve.
 
-    Systems it cannot take this road on (first-order ones, batches, a mass matrix that is not
-    diagonal, more than :data:`~.newton.KRYLOV_THRESHOLD` unknowns without an analytic
-    Jacobian) are stepped by :class:`BackwardEuler`'s plain Newton iteration (the trapezoidal
+    Systems it is not made for (plain problems, batches, scenes whose forces lack analytic
+    Jacobians) are stepped by :class:`BackwardEuler`'s plain Newton iteration (the trapezoidal
     rule's, for :class:`ProjectedTrapezoidal`) with its default tolerances.
     """
 
@@ -354,14 +353,12 @@ class ProjectedTrapezoidal(ProjectedNewton):
 
 
 def _takes(system: System, state: State) -> bool:
-    """Whether the minimization road suits the system (see :class:`ProjectedNewton`)."""
-    if not system.second_order or state.parts[0].ndim != 1:
+    """Whether the minimization road suits the system (see :class:`ProjectedNewton`): a
+    scene's, whose Jacobians are 3×3 block-sparse, one at a time, with a diagonal mass."""
+    if not getattr(system, "block_jacobian", False) or state.parts[0].ndim != 1:
         return False
     mass = system.mass  # type: ignore[union-attr]
-    if mass is not None and mass.kind != "diagonal":
-        return False
-    # Without an analytic Jacobian, finite differences cost one force per unknown.
-    return system.has_jacobian or state.parts[0].size <= KRYLOV_THRESHOLD
+    return (mass is None or mass.kind == "diagonal") and system.has_jacobian
 
 
 def _across(normals: np.ndarray, vector: np.ndarray) -> np.ndarray:

@@ -298,6 +298,9 @@ class SceneSystem(SecondOrderSystem):
     #: ``D = ∂F/∂v`` symmetric (particles whose forces are conservative or linearly damped),
     #: else ``None``: backward Euler's step is then the minimum of an incremental potential.
     potential: Callable[[float, np.ndarray], float] | None = None
+    #: Its particles' Jacobians are block-sparse with 3×3 blocks (BSR), on a fixed pattern:
+    #: what solvers for deformables (:mod:`visviva.integrators.projected_newton`) work on.
+    block_jacobian = True
     #: ``(q, reach) ↦ (particles, normals, push, friction)`` for the impulse colliders at
     #: positions ``q`` (see :func:`_contact_constraints`), which implicit steps may hold particles
     #: against (``None``: no such colliders).
