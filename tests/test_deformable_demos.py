@@ -87,3 +87,28 @@ def test_flag_leans_where_the_wind_and_its_weight_balance(tmp_path):
     assert angle["drag_over_weight"] < angle["mean_second_half"] < angle["largest"]
     staff = recording["points"][:, :16]
     assert np.array_equal(staff, np.broadcast_to(staff[0], staff.shape))
+
+
+def test_hair_swings_from_fixed_roots_with_the_period_of_a_hanging_chain(tmp_path):
+    run_demo("hair", tmp_path)  # its full 6 s: five swings of the longest strand
+    recording = outputs(tmp_path, "hair")
+    data = summary(tmp_path)
+    assert data["roots_bit_identical"] is True
+    roots = recording["points"][:, [0, 8, 18, 30, 44]]
+    assert np.array_equal(roots, np.broadcast_to(roots[0], roots.shape))
+    # Suddenly loaded: at most twice the static stretch (plus the swing's pull).
+    stretch = data["largest_stretch"]
+    assert stretch["static"] < stretch["measured"] <= stretch["bound_2_static_1_plus_amplitude2"]
+    # Periods: a chain's (to 1 %), 2 % slower than the strand made rigid, growing as √L.
+    assert data["dt"] / data["substeps"] < data["advisor_largest_stable_step_s"]
+    ratios = []
+    for strand in data["strands"]:
+        assert strand["amplitude_rad"] < 0.15  # small swings
+        period = strand["period_s"]
+        assert period == pytest.approx(
+            strand["hanging_chain_period_s"], rel=data["period_tolerance"]
+        )
+        rigid = strand["compound_pendulum_period_s"]
+        assert rigid < period < (1.0 + data["compound_tolerance"]) * rigid
+        ratios.append(period / np.sqrt(strand["length_m"]))
+    assert max(ratios) / min(ratios) < 1.03

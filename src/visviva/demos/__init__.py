@@ -206,6 +206,7 @@ def _load_builtins() -> None:
         flag,
         fountain,
         galaxy,
+        hair,
         kepler,
         oscillator,
         pendulum,

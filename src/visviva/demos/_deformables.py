@@ -40,19 +40,28 @@ def one_thread() -> Iterator[None]:
         numba.set_num_threads(previous)
 
 
-def springs_of(model: Model) -> Springs:
-    """The scene's spring network (one :class:`Springs` holds every body's springs)."""
-    for force in model.forces:
-        if isinstance(force, Springs):
-            return force
-    raise ValueError(f"scene {model.name!r} has no springs")
+def springs_of(model: Model) -> list[Springs]:
+    """The scene's spring forces (one per body that has springs)."""
+    return [force for force in model.forces if isinstance(force, Springs)]
+
+
+def spring_pairs(model: Model) -> tuple[np.ndarray, np.ndarray]:
+    """Every spring of the scene: its particles ``(S, 2)`` and rest length [m] ``(S,)``."""
+    springs = springs_of(model)
+    if not springs:
+        return np.zeros((0, 2), dtype=np.int64), np.zeros(0)
+    return (
+        np.concatenate([s.pairs for s in springs]),
+        np.concatenate([s.rest_length for s in springs]),
+    )
 
 
 def spring_forces(model: Model, x: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The force [N] of the springs alone (dampers included) on each particle, ``(N, 3)``, at
     positions ``x`` [m] and velocities ``v`` [m/s]."""
     out = np.zeros_like(x)
-    springs_of(model).accumulate(0.0, x, v, out)
+    for springs in springs_of(model):
+        springs.accumulate(0.0, x, v, out)
     return out
 
 
@@ -68,15 +77,11 @@ def kinetic_energy(recording: Recording) -> np.ndarray:
     return 0.5 * np.einsum("i,fij,fij->f", mass, recording["velocities"], recording["velocities"])
 
 
-def strain(model: Model, points: np.ndarray, pairs: np.ndarray | None = None) -> np.ndarray:
-    """``l/L − 1`` of each spring (or of the springs on ``pairs``, ``(S, 2)``, rest lengths
-    taken from the model's first frame) at ``points`` ``(..., N, 3)`` [m]."""
-    if pairs is None:
-        springs = springs_of(model)
-        pairs, rest = springs.pairs, springs.rest_length
-    else:
-        start = model.particle_position
-        rest = np.linalg.norm(start[pairs[:, 1]] - start[pairs[:, 0]], axis=-1)
+def strain(model: Model, points: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """``l/L − 1`` of the springs on ``pairs`` ``(S, 2)`` at ``points`` ``(..., N, 3)`` [m],
+    ``L`` their length in the model's initial state (springs are built at rest there)."""
+    start = model.particle_position
+    rest = np.linalg.norm(start[pairs[:, 1]] - start[pairs[:, 0]], axis=-1)
     length = np.linalg.norm(points[..., pairs[:, 1], :] - points[..., pairs[:, 0], :], axis=-1)
     return length / rest - 1.0
 
