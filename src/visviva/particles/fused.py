@@ -19,7 +19,7 @@ passes:
    whether the particle needs more: it is near another plane, may meet another collider or
    hit a plane within the step (time of impact), a field acts on it by its law (attractors,
    vortices, quadratic drag, forces on some particles only), it dies, its size follows a
-   ramp, or it is pinned. Such a particle keeps its start values (a pinned one keeps them);
+   ramp. Such a particle keeps its start values (and a pinned one keeps them for good);
 2. a pass over those few, each by the general path from its start values: the fields by their
    law (:mod:`visviva.forces.laws`), the collision stage's own per-particle function
    (:func:`visviva.collision.response.resolve`), the emission stage's ageing and death
@@ -116,7 +116,6 @@ class FusedParticles:
         )
         self.pinned = pinned if pinned is not None and pinned.any() else None
         general = contacts or self.emission is not None or len(laws) > 0
-        general = general or self.pinned is not None
         self._special = np.zeros(count, dtype=np.bool_) if general else None
         # The working copy: positions and velocities, (3, N) each (one contiguous array per
         # component, which the compiler vectorizes over), and the state they belong to.
@@ -487,8 +486,12 @@ def _fused(
             odd |= (mask >> beyond) != 0
         if kinds is not None:
             odd |= law_masks[i] != 0
+        # A pinned particle keeps its place (and needs nothing else: pinned particles are
+        # not emitted, and colliders skip them).
+        held = False
         if pinned is not None:
-            odd |= pinned[i]
+            held = pinned[i]
+            odd &= not held
         # Only emitted particles die: without emitters, every slot is alive.
         live = True
         if age is not None:
@@ -501,7 +504,7 @@ def _fused(
             special[i] = odd
             pending += odd
         # A free slot stays parked; a special particle keeps its start for pass 2.
-        keep = live & (not odd)
+        keep = live & (not odd) & (not held)
         if age is not None:
             age[i] = older if keep else age[i]
         x[i] = px if keep else sx
@@ -519,8 +522,6 @@ def _fused(
     for i in prange(end):
         if not special[i]:
             continue
-        if pinned is not None and pinned[i]:
-            continue  # held where it is: it kept its start values in pass 1
         sx, sy, sz, svx, svy, svz = x[i], y[i], z[i], vx[i], vy[i], vz[i]
         w = inverse_mass[i]
         c = drag * w + damping
