@@ -10,7 +10,10 @@ import numpy as np
 import pytest
 
 import visviva as vv
-from visviva.demos import run_demo
+from visviva.demos import jelly, run_demo
+from visviva.io.scene_files import load_scene
+
+EXAMPLES = Path(__file__).parents[1] / "examples" / "scenes"
 
 
 def summary(directory: Path) -> dict:
@@ -112,3 +115,41 @@ def test_hair_swings_from_fixed_roots_with_the_period_of_a_hanging_chain(tmp_pat
         assert rigid < period < (1.0 + data["compound_tolerance"]) * rigid
         ratios.append(period / np.sqrt(strand["length_m"]))
     assert max(ratios) / min(ratios) < 1.03
+
+
+def test_jelly_falls_freely_never_sinks_and_rests_squashed_as_linear_elasticity_says(tmp_path):
+    run_demo("jelly", tmp_path)  # its full 3 s
+    outputs(tmp_path, "jelly")
+    data = summary(tmp_path)
+    touch = data["first_touch_s"]
+    assert abs(touch["measured"] - touch["free_fall_sqrt_2h_over_g"]) <= touch["frame_s"]
+    assert data["lowest_below_floor_m"] <= data["floor_tolerance_m"]
+    assert data["cube_height_m"]["smallest"] < 0.95 * data["cube_height_m"]["undeformed"]
+    # At rest: squashed between the linear estimates with the bottom held and sliding, the
+    # shape kept to 1 %, the drop's energy gone down to the squashed cube's static energy.
+    assert data["kinetic_energy_at_end_J"] < 1e-3
+    squash = data["compression_at_rest_m"]
+    low, high = squash["linear_bottom_held"], squash["linear_bottom_sliding"]
+    assert 0.99 * low < squash["measured"] < 1.01 * high
+    top = data["top_height_at_rest_m"]
+    assert top["measured"] == pytest.approx(top["size_plus_radius_minus_compression"], abs=1e-4)
+    assert data["largest_stretch_at_rest"] < 0.01
+    energy = data["energy_J"]
+    share = energy["undeformed_on_the_floor"] - energy["at_rest_linear_elasticity"]
+    assert abs(energy["end"] - energy["at_rest_linear_elasticity"]) < 0.1 * share
+
+
+def test_the_jelly_scene_file_is_the_demo_s_scene():
+    """``examples/scenes/jelly.toml`` and the demo describe the same scene, and their models
+    step bit for bit alike."""
+    path = EXAMPLES / "jelly.toml"
+    from_file, _ = load_scene(path)
+    from_demo = jelly.build_scene()
+    assert from_file == from_demo.scene
+    states = []
+    for model in (vv.load_model(path), from_demo.build()):
+        simulation = vv.Simulation(model)
+        simulation.step(30)  # past the first touch
+        states.append(simulation.raw_state)
+    for a, b in zip(states[0].parts, states[1].parts, strict=True):
+        assert a.tobytes() == b.tobytes()

@@ -207,6 +207,7 @@ def _load_builtins() -> None:
         fountain,
         galaxy,
         hair,
+        jelly,
         kepler,
         oscillator,
         pendulum,
