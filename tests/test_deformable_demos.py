@@ -153,3 +153,29 @@ def test_the_jelly_scene_file_is_the_demo_s_scene():
         states.append(simulation.raw_state)
     for a, b in zip(states[0].parts, states[1].parts, strict=True):
         assert a.tobytes() == b.tobytes()
+
+
+def test_stiffness_study_symplectic_euler_survives_exactly_where_the_advisor_says(tmp_path):
+    run_demo("stiffness-study", tmp_path, duration=1.0)  # every blow-up comes within 0.4 s
+    outputs(tmp_path, "stiffness_study")
+    data = summary(tmp_path)
+    assert data["all_predictions_hold"] is True
+    table = data["stiffness"]
+    assert [row["k_N_per_m"] for row in table] == [3.0, 10.0, 30.0, 100.0, 1000.0, 10000.0]
+    for row in table:
+        stable = row["h_over_h_max"] < 1.0
+        assert (row["symplectic_euler"] == "survived") == stable, row
+        assert abs(np.log(row["h_over_h_max"])) > np.log(1.2)  # no case on the fence
+        for method in ("projected_newton", "linearly_implicit_euler"):
+            assert row[method]["survived"], (method, row["k_N_per_m"])
+        assert row["projected_newton"]["largest_energy_rise_per_step_J"] <= 1e-9
+    # Both sides are shown, h_max falls as 1/√k, and stiff cloth barely stretches.
+    assert {row["predicted"] for row in table} == {"stable", "unstable"}
+    limits = np.array([row["advisor_h_max_s"] for row in table])
+    k = np.array([row["k_N_per_m"] for row in table])
+    np.testing.assert_allclose(limits * np.sqrt(k), limits[0] * np.sqrt(k[0]), rtol=0.02)
+    assert table[-1]["projected_newton"]["largest_stretch_at_end"] < 0.01
+    assert table[0]["projected_newton"]["largest_stretch_at_end"] > 0.2
+    runs = summary(tmp_path)["runs"]
+    assert next(iter(runs)) == "projected_newton_k10000"  # the video's run
+    assert runs["symplectic_euler_k10000"]["success"] is False

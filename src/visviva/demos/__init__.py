@@ -214,5 +214,6 @@ def _load_builtins() -> None:
         rock,
         snow,
         spring_pendulum,
+        stiffness_study,
         sun_earth_moon,
     )
