@@ -179,3 +179,34 @@ def test_stiffness_study_symplectic_euler_survives_exactly_where_the_advisor_say
     runs = summary(tmp_path)["runs"]
     assert next(iter(runs)) == "projected_newton_k10000"  # the video's run
     assert runs["symplectic_euler_k10000"]["success"] is False
+
+
+def test_refinement_study_a_curtain_converges_a_cloth_held_at_two_points_does_not(tmp_path):
+    run_demo("refinement-study", tmp_path)  # its full 4 s: every run at rest
+    outputs(tmp_path, "refinement_study")
+    data = summary(tmp_path)
+    assert data["largest_speed_at_rest_m_per_s"] < 1e-3
+    # The curtain: each refinement changes the drop about half as much as the last, and the
+    # finest lies between the membrane's estimates held from contracting and free to.
+    curtain = data["curtain_bottom_drop_m"]
+    first, second = curtain["successive_changes"]
+    assert 0.0 < second < 0.7 * first
+    finest = curtain["per_resolution"]["21"]
+    assert curtain["held_from_contracting_rho_g_H2_over_2C11"] < finest
+    assert finest < curtain["free_to_contract_rho_g_H2_over_2E"]
+    # Two corners: about 2 mm more at every doubling, of the order of (F/E) ln 2.
+    corners = data["two_corners_top_middle_sag_m"]
+    first, second = corners["successive_changes"]
+    assert second > 0.8 * first > 1e-3
+    assert 0.5 < corners["growth_per_doubling"] / corners["scale_F_over_E_ln2"] < 2.0
+    assert corners["spread_max_minus_min"] > 10 * curtain["spread_max_minus_min"]
+    # Seed 001: only shear springs resist shear; bend springs (and only they) resist bending.
+    study = data["structure_study"]
+    for springs, droop in study.items():
+        resists_shear = "shear" in springs
+        assert (droop["in_plane_shear_droop_m"] < 0.01) == resists_shear, springs
+        assert (droop["in_plane_shear_droop_m"] > 0.9) == (not resists_shear), springs
+    limp = study["structural"]["bending_droop_m"]
+    assert study["structural+shear"]["bending_droop_m"] == pytest.approx(limp, rel=1e-3)
+    assert study["structural+bend"]["bending_droop_m"] < 0.9 * limp
+    assert study["structural+shear+bend"]["bending_droop_m"] < 0.9 * limp

@@ -211,6 +211,7 @@ def _load_builtins() -> None:
         kepler,
         oscillator,
         pendulum,
+        refinement_study,
         rock,
         snow,
         spring_pendulum,
