@@ -21,7 +21,7 @@ References:
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal, Self
 
 from pydantic import Field, model_validator
 from pydantic_core import PydanticCustomError
@@ -58,7 +58,25 @@ def _check_pins(pinned: list[int], count: int, body: str) -> None:
         )
 
 
-class Rope(Strict):
+class _Body(Strict):
+    """What every deformable body's schema shares: its pins must be among its points."""
+
+    #: The body's name in messages.
+    noun: ClassVar[str]
+    pinned: Pins
+
+    @property
+    def point_count(self) -> int:
+        """The body's particles."""
+        raise NotImplementedError
+
+    @model_validator(mode="after")
+    def _pins_on_the_body(self) -> Self:
+        _check_pins(self.pinned, self.point_count, self.noun)
+        return self
+
+
+class Rope(_Body):
     """``type = "rope"``: particles at ``points`` joined in order by damped springs (seed 002).
 
     Each consecutive pair is a stretch spring of ``stiffness`` k [N/m] and ``damping`` c
@@ -68,6 +86,7 @@ class Rope(Strict):
     """
 
     type: Literal["rope"]
+    noun: ClassVar[str] = "rope"
     name: Name | None = None
     points: Annotated[list[Vector], Field(min_length=2)] = Field(
         description="positions of the particles along the rope [m], in order"
@@ -90,13 +109,8 @@ class Rope(Strict):
         """The rope's particles."""
         return len(self.points)
 
-    @model_validator(mode="after")
-    def _pins_on_the_rope(self) -> Rope:
-        _check_pins(self.pinned, self.point_count, "rope")
-        return self
 
-
-class Hair(Strict):
+class Hair(_Body):
     """``type = "hair"``: a strand of hair (Selle, Lentine & Fedkiw 2008): particles at
     ``points``, from the root, joined by damped springs in three families — *edge* springs of
     ``stiffness`` k [N/m] between consecutive points, *bending* springs of ``bending`` [N/m]
@@ -107,6 +121,7 @@ class Hair(Strict):
     from folding flat) are left out."""
 
     type: Literal["hair"]
+    noun: ClassVar[str] = "hair strand"
     name: Name | None = None
     points: Annotated[list[Vector], Field(min_length=2)] = Field(
         description="positions of the particles along the strand [m], root first"
@@ -133,19 +148,15 @@ class Hair(Strict):
         """The strand's particles."""
         return len(self.points)
 
-    @model_validator(mode="after")
-    def _pins_on_the_strand(self) -> Hair:
-        _check_pins(self.pinned, self.point_count, "hair strand")
-        return self
 
-
-class SpringGraph(Strict):
+class SpringGraph(_Body):
     """``type = "springs"``: particles at ``points`` joined by damped springs on any ``pairs``
     of them (indices into ``points``, each unordered pair at most once). Each spring has
     ``stiffness`` k [N/m] and ``rest_length`` L [m] (by default its length as built), one value
     or one per spring, and ``damping`` c [N·s/m] along it."""
 
     type: Literal["springs"]
+    noun: ClassVar[str] = "spring network"
     name: Name | None = None
     points: Annotated[list[Vector], Field(min_length=2)] = Field(
         description="positions of the particles [m]"
@@ -173,19 +184,15 @@ class SpringGraph(Strict):
         """The network's particles."""
         return len(self.points)
 
-    @model_validator(mode="after")
-    def _pins_in_the_network(self) -> SpringGraph:
-        _check_pins(self.pinned, self.point_count, "spring network")
-        return self
 
-
-class Cloth(Strict):
+class Cloth(_Body):
     """``type = "cloth"``: a sheet of ``resolution`` = [nu, nv] particles on a grid spanning
     ``origin + s·along + t·across`` (s, t in [0, 1]), joined by structural (``stretch``), shear
     (cell diagonals) and bend (two apart) springs (Choi & Ko 2002). Point (i, j) has index
     j·nu + i. Each point weighs ``density`` times its share of the cells around it."""
 
     type: Literal["cloth"]
+    noun: ClassVar[str] = "cloth"
     name: Name | None = None
     origin: Vector = Field((0.0, 1.0, 0.0), description="position of point (0, 0) [m]")
     along: Vector = Field((1.0, 0.0, 0.0), description="edge from point (0, 0) to (nu − 1, 0) [m]")
@@ -224,11 +231,10 @@ class Cloth(Strict):
                 "area; give two edges at an angle",
                 {"along": list(a), "across": list(b)},
             )
-        _check_pins(self.pinned, self.point_count, "cloth")
         return self
 
 
-class ClothMesh(Strict):
+class ClothMesh(_Body):
     """``type = "cloth_mesh"``: cloth from any triangle mesh. A particle at each of the
     ``vertices`` [m], weighing the areal ``density`` [kg/m²] times a third of the area of each
     triangle around it (so the cloth weighs density × area); *stretch* springs of ``stretch``
@@ -238,6 +244,7 @@ class ClothMesh(Strict):
     The mesh must be manifold (no edge in three triangles) with every vertex in a triangle."""
 
     type: Literal["cloth_mesh"]
+    noun: ClassVar[str] = "cloth mesh"
     name: Name | None = None
     vertices: Annotated[list[Vector], Field(min_length=3)] = Field(
         description="positions of the mesh's vertices, one particle each [m]"
@@ -261,13 +268,8 @@ class ClothMesh(Strict):
         """The mesh's particles, one per vertex."""
         return len(self.vertices)
 
-    @model_validator(mode="after")
-    def _pins_on_the_mesh(self) -> ClothMesh:
-        _check_pins(self.pinned, self.point_count, "cloth mesh")
-        return self
 
-
-class SoftLattice(Strict):
+class SoftLattice(_Body):
     """``type = "soft_lattice"``: a volumetric soft body (seed 004): ``resolution`` = [nx, ny,
     nz] particles on a lattice filling the box from ``origin`` with edge lengths ``size``,
     joined by structural (``stretch``), face-diagonal (``shear``) and body-diagonal
@@ -275,6 +277,7 @@ class SoftLattice(Strict):
     ``density`` times an eighth of each cell around it."""
 
     type: Literal["soft_lattice"]
+    noun: ClassVar[str] = "lattice"
     name: Name | None = None
     origin: Vector = Field((0.0, 0.5, 0.0), description="the box's lowest corner [m]")
     size: tuple[Positive, Positive, Positive] = Field(
@@ -304,13 +307,8 @@ class SoftLattice(Strict):
         """The lattice's particles, nx·ny·nz."""
         return self.resolution[0] * self.resolution[1] * self.resolution[2]
 
-    @model_validator(mode="after")
-    def _pins_in_the_lattice(self) -> SoftLattice:
-        _check_pins(self.pinned, self.point_count, "lattice")
-        return self
 
-
-class SoftMesh(Strict):
+class SoftMesh(_Body):
     """``type = "soft_mesh"``: a volumetric soft body from a tetrahedral mesh. A particle at
     each of the ``vertices`` [m], weighing the ``density`` [kg/m³] times a quarter of the
     volume of each tetrahedron around it (so the body weighs density × volume), and a spring
@@ -319,6 +317,7 @@ class SoftMesh(Strict):
     (b − a)·((c − a) × (d − a)) > 0, and every vertex must be in one."""
 
     type: Literal["soft_mesh"]
+    noun: ClassVar[str] = "soft mesh"
     name: Name | None = None
     vertices: Annotated[list[Vector], Field(min_length=4)] = Field(
         description="positions of the mesh's vertices, one particle each [m]"
@@ -338,11 +337,6 @@ class SoftMesh(Strict):
     def point_count(self) -> int:
         """The mesh's particles, one per vertex."""
         return len(self.vertices)
-
-    @model_validator(mode="after")
-    def _pins_on_the_mesh(self) -> SoftMesh:
-        _check_pins(self.pinned, self.point_count, "soft mesh")
-        return self
 
 
 #: Every deformable entity: particles joined by springs.
