@@ -1,6 +1,6 @@
 """Demo ``stiffness-study``: one cloth at growing stiffness, explicit against implicit steps.
 
-A 1 m square of heavy canvas (1 kg/m², 10 × 10 points) held at two corners falls from
+A 1 m square of heavy canvas (1 kg/m², 8 × 8 points) held at two corners falls from
 horizontal under undamped structural and shear springs of stiffness ``k`` from 3 to 10⁴ N/m,
 always at h = 1/60 s, stepped by symplectic Euler, by backward Euler as a minimization
 (``projected_newton``; Gast et al. 2015) and by Baraff & Witkin's linearized backward Euler
@@ -24,7 +24,7 @@ Why it matters: the cloths symplectic Euler survives at h = 1/60 s are rubber. W
 ``ω_max² ≈ c k/m`` (``c`` ≈ 11 here, from the advisor: a point pulled by eight springs)
 stability needs ``k/m < 4/(c h²)``, while a column of ``n`` points of mass ``m`` hanging from
 springs of length ``a`` stretches its top spring by ``n m g/(k a)``: at least
-``c n g h²/(4a)``, 60 % for this canvas (n = 9, a = 11 cm). The summary gives each implicit
+``c n g h²/(4a)``, about 40 % for this canvas (n = 7, a = 14 cm). The summary gives each implicit
 run's stretch: tens of percent or more at the stiffnesses the explicit method survives, a
 fraction of a percent at 10⁴ N/m.
 
@@ -56,14 +56,14 @@ if TYPE_CHECKING:
 
 DURATION = 2.0  # [s]
 DT = 1.0 / 60.0  # [s]
-STIFFNESS = (3.0, 10.0, 30.0, 100.0, 1000.0, 10000.0)  # k [N/m], structural and shear
+STIFFNESS = (3.0, 10.0, 100.0, 1000.0, 10000.0)  # k [N/m], structural and shear
 EXPLICIT = "symplectic_euler"
 IMPLICIT = ("projected_newton", "linearly_implicit_euler")
-POINTS = 10  # per side
+POINTS = 8  # per side: the advisor takes the eigenvalues of a 384 × 384 matrix
 SIZE = 1.0  # [m]
 HEIGHT = 1.5  # [m]
 DENSITY = 1.0  # [kg/m²]: heavy canvas
-DESCRIPTION = "a 1 m square of 1 kg/m² canvas, 10 × 10 points, held at two corners"
+DESCRIPTION = "a 1 m square of 1 kg/m² canvas, 8 × 8 points, held at two corners"
 
 
 def build_scene(stiffness: float, method: str, duration: float = DURATION) -> SceneBuilder:
