@@ -84,7 +84,7 @@ def layer(model: Model) -> np.ndarray:
 def stiffness_at_rest(model: Model) -> np.ndarray:
     """The springs' stiffness matrix [N/m] at rest, ``(3N, 3N)``: ``k u uᵀ`` per spring."""
     count = model.particle_count
-    matrix = np.zeros((count, 3, count, 3))
+    blocks = np.zeros((count, count, 3, 3))  # [row particle, column particle, row, column]
     x = model.particle_position
     for springs in springs_of(model):
         i, j = springs.pairs.T
@@ -92,8 +92,8 @@ def stiffness_at_rest(model: Model) -> np.ndarray:
         u /= np.linalg.norm(u, axis=1, keepdims=True)
         block = springs.stiffness[:, None, None] * u[:, :, None] * u[:, None, :]
         for a, b, sign in ((i, i, 1.0), (j, j, 1.0), (i, j, -1.0), (j, i, -1.0)):
-            np.add.at(matrix, (a, slice(None), b), sign * block)
-    return matrix.reshape(3 * count, 3 * count)
+            np.add.at(blocks, (a, b), sign * block)
+    return blocks.transpose(0, 2, 1, 3).reshape(3 * count, 3 * count)
 
 
 def linear_compression(model: Model, *, sliding: bool) -> tuple[float, np.ndarray]:

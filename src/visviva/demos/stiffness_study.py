@@ -152,9 +152,12 @@ def _figure(table: list[dict[str, Any]], recordings: dict[str, Recording]) -> Fi
     energy over time."""
     from matplotlib.figure import Figure
 
+    methods = (EXPLICIT, *IMPLICIT)
     figure = Figure(figsize=(15, 8.5), layout="constrained")
-    top, bottom = figure.subfigures(2, 1)
-    limit, board = top.subplots(1, 2)
+    # L: the limit, B: the board; one panel of energies per method (E, P, I).
+    axes = figure.subplot_mosaic("LLLBBB;EEPPII")
+    limit, board = axes["L"], axes["B"]
+    panels = dict(zip(methods, (axes["E"], axes["P"], axes["I"]), strict=True))
     k = np.array([row["k_N_per_m"] for row in table])
     advised = np.array([row["advisor_h_max_s"] for row in table])
     survived = np.array([row[EXPLICIT] == "survived" for row in table])
@@ -166,7 +169,6 @@ def _figure(table: list[dict[str, Any]], recordings: dict[str, Recording]) -> Fi
     limit.set_ylabel("step [ms]")
     limit.set_title("Stable where h < h_max ∝ 1/√k")
     limit.legend(fontsize=8)
-    methods = (EXPLICIT, *IMPLICIT)
     for row_index, method in enumerate(methods):
         for column, entry in enumerate(table):
             result = entry[method]
@@ -177,19 +179,19 @@ def _figure(table: list[dict[str, Any]], recordings: dict[str, Recording]) -> Fi
     board.set_xlabel("spring stiffness k [N/m]")
     board.set_ylim(-0.5, len(methods) - 0.5)
     board.set_title("At h = 1/60 s: o survived, x blew up")
-    panels = bottom.subplots(1, len(methods), sharey=True)
-    for axes, method in zip(panels, methods, strict=True):
+    for method in methods:
+        panel = panels[method]
         for index, entry in enumerate(table):
             recording = recordings[f"{method}_k{entry['k_N_per_m']:g}"]
             energy = recording["energy"]
             change = np.abs(energy - energy[0]) / abs(energy[0])
-            axes.semilogy(recording.time[1:], np.maximum(change[1:], 1e-12), color=f"C{index}",
-                          label=f"k = {entry['k_N_per_m']:g}")  # fmt: skip
-        axes.set_xlabel("t [s]")
-        axes.set_title(method)
-    panels[0].set_ylabel("|E − E₀| / E₀")
-    panels[0].set_ylim(1e-6, 1e6)
-    panels[-1].legend(fontsize=8)
+            panel.semilogy(recording.time[1:], np.maximum(change[1:], 1e-12), color=f"C{index}",
+                           label=f"k = {entry['k_N_per_m']:g}")  # fmt: skip
+        panel.set_xlabel("t [s]")
+        panel.set_ylabel("|E − E₀| / E₀")
+        panel.set_ylim(1e-6, 1e6)
+        panel.set_title(method)
+    panels[methods[-1]].legend(fontsize=8)
     return figure
 
 
