@@ -14,8 +14,10 @@ import numba
 import numpy as np
 
 from ..forces.springs import Springs
+from ..model.builder import SceneBuilder
 from ..model.model import Model
 from ..simulation.recording import Recording
+from ..simulation.simulation import Simulation
 
 #: Standard gravity [m/s²]: the scenes' default world.
 GRAVITY = 9.81
@@ -38,6 +40,16 @@ def one_thread() -> Iterator[None]:
         yield
     finally:
         numba.set_num_threads(previous)
+
+
+def record_alone(builder: SceneBuilder, duration: float) -> tuple[Model, Simulation, Recording]:
+    """The scene's model, its simulation after ``duration`` [s] and the recording of it, run
+    on one thread (:func:`one_thread`)."""
+    model = builder.build()
+    simulation = Simulation(model)
+    with one_thread():
+        recording = simulation.record(until=duration)
+    return model, simulation, recording
 
 
 def springs_of(model: Model) -> list[Springs]:

@@ -39,9 +39,14 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
-from ..simulation.simulation import Simulation
 from . import Demo, register_demo
-from ._deformables import GRAVITY, kinetic_energy, largest_rise, one_thread, spring_forces
+from ._deformables import (
+    GRAVITY,
+    kinetic_energy,
+    largest_rise,
+    record_alone,
+    spring_forces,
+)
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -115,10 +120,7 @@ def clearance(points: np.ndarray) -> np.ndarray:
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
-    model = build_scene(duration).build()
-    simulation = Simulation(model)
-    with one_thread():
-        recording = simulation.record(until=duration)
+    model, simulation, recording = record_alone(build_scene(duration), duration)
     output.recordings[METHOD] = recording
     energy, kinetic = recording["energy"], kinetic_energy(recording)
     state = simulation.state

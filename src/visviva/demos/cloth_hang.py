@@ -37,9 +37,15 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
-from ..simulation.simulation import Simulation
 from . import Demo, register_demo
-from ._deformables import GRAVITY, kinetic_energy, largest_rise, load_on_pins, one_thread, strain
+from ._deformables import (
+    GRAVITY,
+    kinetic_energy,
+    largest_rise,
+    load_on_pins,
+    record_alone,
+    strain,
+)
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -92,10 +98,7 @@ def build_scene(duration: float = DURATION) -> SceneBuilder:
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
-    model = build_scene(duration).build()
-    simulation = Simulation(model)
-    with one_thread():
-        recording = simulation.record(until=duration)
+    model, simulation, recording = record_alone(build_scene(duration), duration)
     output.recordings[METHOD] = recording
     energy, kinetic = recording["energy"], kinetic_energy(recording)
     state = simulation.state

@@ -40,9 +40,8 @@ import numpy as np
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..model.model import Model
-from ..simulation.simulation import Simulation
 from . import Demo, register_demo
-from ._deformables import GRAVITY, kinetic_energy, load_on_pins, one_thread
+from ._deformables import GRAVITY, kinetic_energy, load_on_pins, record_alone
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -117,10 +116,7 @@ def deflection(model: Model, points: np.ndarray) -> np.ndarray:
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
-    model = build_scene(duration).build()
-    simulation = Simulation(model)
-    with one_thread():
-        recording = simulation.record(until=duration)
+    model, simulation, recording = record_alone(build_scene(duration), duration)
     output.recordings[METHOD] = recording
     t = recording.time
     angle = deflection(model, recording["points"])

@@ -32,9 +32,15 @@ import numpy as np
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..model.model import Model
-from ..simulation.simulation import Simulation
 from . import Demo, register_demo
-from ._deformables import GRAVITY, kinetic_energy, one_thread, spring_pairs, springs_of, strain
+from ._deformables import (
+    GRAVITY,
+    kinetic_energy,
+    record_alone,
+    spring_pairs,
+    springs_of,
+    strain,
+)
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -129,10 +135,7 @@ def static_energy(model: Model, u: np.ndarray) -> float:
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
-    model = build_scene(duration).build()
-    simulation = Simulation(model)
-    with one_thread():
-        recording = simulation.record(until=duration)
+    model, _, recording = record_alone(build_scene(duration), duration)
     output.recordings["symplectic_euler"] = recording
     t, points, energy = recording.time, recording["points"], recording["energy"]
     clearance = points[..., 1] - RADIUS
