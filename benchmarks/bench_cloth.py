@@ -2,12 +2,19 @@
 """Cloth benchmark: an explicit mass-spring cloth step (symplectic Euler), against peers.
 
 Run ``python benchmarks/bench_cloth.py`` (about 10 s on 2 cores once compiled) or add
-``--quick`` for a smoke run whose figures mean nothing. The Warp-CPU peer is optional and
-never a visviva dependency; install it into a directory of its own and name that directory,
-as for ``bench_particles.py``::
+``--quick`` for a smoke run whose figures mean nothing. The peers, Warp-CPU and NVIDIA Newton
+(built on Warp), are optional and never visviva dependencies; install them into a directory of
+their own and name it, as for ``bench_particles.py``. One directory can hold both (Newton 1.8.0
+needs warp-lang ≥ 1.17 and nothing else for what runs here)::
 
-    pip install --no-deps --target /tmp/peers-warp warp-lang
-    python benchmarks/bench_cloth.py --peers /tmp/peers-warp
+    pip install --no-deps --target /tmp/peers-newton newton warp-lang
+    python benchmarks/bench_cloth.py --peers /tmp/peers-newton
+
+``--peers DIR`` is where ``warp`` is found and, unless ``--newton DIR`` names another directory,
+``newton`` too (a Warp-only directory, ``pip install --no-deps --target /tmp/peers-warp
+warp-lang``, still works: Newton is then reported as not installed). Warp is loaded once per
+process: with two directories, Newton runs on the Warp from ``--peers``; the header prints the
+versions in use.
 
 The scene, the same for every runner (float64 throughout):
 
@@ -39,17 +46,40 @@ compiles; repeated calls keep advancing the same cloth):
   kernel on one thread, and visviva's cloth step runs on one too: both are printed);
 * Warp-CPU: what a Warp user writes, a spring kernel scattering with ``wp.atomic_add`` into a
   force array and an integration kernel, ``vec3d`` arrays, one launch pair per step;
+* Newton semi-implicit (CPU): ``newton.solvers.SolverSemiImplicit`` on ``device="cpu"``, as
+  Newton's cloth examples drive it (``state.clear_forces()``, ``solver.step(state_in,
+  state_out, control, None, h)``, the states swapped; the two alternating steps replayed as CPU
+  graphs captured with ``wp.ScopedCapture``, as those examples do, or launched directly where
+  capture fails). Newton is float32 only (``wp.vec3`` positions and velocities, float32 masses,
+  spring constants and forces): the one runner not in float64. Its scene is built from the
+  benchmark's lists (``ModelBuilder.add_particles``, and the five spring lists that
+  ``add_spring`` appends to, filled in bulk), not with ``add_cloth_grid``, which makes triangle
+  FEM elements, dihedral bending and springs along the triangles' edges only, with masses from
+  triangle areas. The same points, masses and springs (rest lengths from the float32
+  positions, as ``add_spring`` computes them), damping along
+  each spring (Newton's ``eval_spring`` is the force above), gravity as a vector with the y axis
+  up; pinned points get mass 0, Newton's kinematic particles (1/m = 0, no gravity, so they stay
+  put); radius 0, so no particle–particle contact hash grid is built or searched; no shapes, no
+  ground, no contacts (``None``), no triangles, edges or tetrahedra, triangle contact off.
+  ``particle_max_velocity`` keeps Newton's 1e5 m/s, which the cloth never nears. The step
+  integrates exactly v ← v + h (F/m + g), x ← x + h v, in float32: near y = 1 m, where
+  float32 numbers are 6e-8 m apart, a move h v under 3e-8 m rounds to nothing, so at N = 256
+  (h = 1e-5 s) Newton's cloth stays put for its first ~30 steps (visviva's falls 4e-7 m); it
+  does the same work per step all the same. (c) checks the model it builds;
 * visviva through its public API (``visviva_runner``).
 
 Figures per N: time per step, springs/s (springs × steps / s), GB/s, the fraction of a STREAM
 triad's bandwidth over arrays of the cloth state's total size, measured in the same run, and
-the ratios visviva ÷ Warp and visviva ÷ plain Numba. GB/s counts what a spring-list step must
-move at least, 104 B per point (reads x, v and 1/m: 7 float64; writes x, v: 6 float64) plus
-32 B per spring (reads its two ends as int32, L, k and c as float64); a runner that moves more
-(the plain Numba one writes and re-reads a force per spring) still gets only this count.
-Finally the runners' positions after 100 steps at N = 32 from the same start are compared
-(they sum forces in different orders, so they agree to round-off, not bit for bit). This is
-not a test: it prints figures and exits 1 only if a sanity check fails.
+the ratios visviva ÷ Warp, visviva ÷ Newton and visviva ÷ plain Numba. GB/s counts what a
+spring-list step must move at least, 104 B per point (reads x, v and 1/m: 7 float64; writes
+x, v: 6 float64) plus 32 B per spring (reads its two ends as int32, L, k and c as float64); a
+runner that moves more (the plain Numba one writes and re-reads a force per spring) still gets
+only this count, and so does Newton, which in float32 moves less (its GB/s is a float64
+equivalent). Finally the runners' positions after 100 steps at N = 32 from the same start are
+compared (they sum forces in different orders, so they agree to round-off, not bit for bit):
+the float64 runners with plain Numba to 1e-9 m, Newton with visviva to ``NEWTON_TOLERANCE``
+(see there); Newton's model is checked against the scene too. This is not a test: it prints
+figures and exits 1 only if a sanity check fails.
 """
 
 from __future__ import annotations
@@ -105,6 +135,11 @@ STEP_BY_SIZE = {16: 1e-4, 32: 1e-4, 64: 5e-5, 128: 2.5e-5, 256: 1e-5}
 CHECK_N = 32
 CHECK_STEPS = 100
 CHECK_TOLERANCE = 1e-9
+#: The same for Newton, in float32, against visviva [m]. Near y = 1 m float32 numbers are
+#: 6e-8 m apart, so each x ← x + h v rounds by up to 3e-8 m; over 100 steps these add up like
+#: a random walk to ~3e-7 m (2.3e-7 m measured at N = 32 with Newton 1.8.0). 1e-6 m allows
+#: that with room and is still 0.2% of the 0.5 mm the cloth sags by then.
+NEWTON_TOLERANCE = 1e-6
 
 #: Bytes a step must move at least (see the module docstring for what they are).
 BYTES_PER_POINT = (7 + 6) * 8
@@ -114,6 +149,7 @@ STATE_BYTES_PER_POINT = 7 * 8
 
 #: The targets for visviva, printed next to the figures.
 TARGET_VS_WARP = 2.0  # × Warp-CPU's springs/s
+TARGET_VS_NEWTON = 2.0  # × Newton semi-implicit CPU's springs/s
 TARGET_FRACTION = 1.0 / 3.0  # of the triad's bandwidth
 
 
@@ -421,6 +457,139 @@ def load_warp(peers: str | None) -> tuple[WarpCloth | None, str]:
 
 
 # --------------------------------------------------------------------------------------------
+# Newton peer (optional; never a visviva dependency)
+# --------------------------------------------------------------------------------------------
+
+
+class NewtonCloth:
+    """NVIDIA Newton's semi-implicit solver on the same scene, ``device="cpu"``, float32.
+
+    How the scene maps onto Newton's model: see the module docstring (and ``scene_problems``).
+    """
+
+    def __init__(self, directory: str | None) -> None:
+        with on_path(directory):
+            self.newton = importlib.import_module("newton")
+            importlib.import_module("newton.solvers")
+            self.wp = importlib.import_module("warp")
+        self.wp.config.log_level = self.wp.LOG_WARNING  # no start-up banner
+        self.wp.init()
+        self.captured: bool | None = None  # CPU graph replay: None until a runner has tried
+
+    @property
+    def version(self) -> str:
+        return f"{self.newton.__version__} on Warp {self.wp.__version__}"
+
+    def build(self, n: int) -> tuple[Cloth, object]:
+        """The scene at ``n`` and Newton's model of it (on the CPU)."""
+        newton = self.newton
+        cloth = cloth_scene(n)
+        builder = newton.ModelBuilder(up_axis=newton.Axis.Y, gravity=GRAVITY)
+        mass = cloth.mass.copy()
+        mass[cloth.pinned] = 0.0  # Newton's kinematic particles: 1/m = 0 and no gravity
+        positions = cloth.positions.astype(np.float32)
+        builder.add_particles(
+            pos=positions.tolist(),
+            vel=np.zeros_like(positions).tolist(),
+            mass=mass.tolist(),
+            radius=[0.0] * (n * n),  # no particle-particle contact (and no hash grid)
+        )
+        # What add_spring(i, j, k, c, control=0.0) appends to the builder's five spring lists,
+        # rest length from the float32 positions included, but for all springs at once: one
+        # Python call per spring (2 to 6 µs each) took seconds at N = 256 (391k springs).
+        ends = positions[cloth.pairs[:, 1]] - positions[cloth.pairs[:, 0]]
+        builder.spring_indices.extend(cloth.pairs.reshape(-1).tolist())
+        builder.spring_rest_length.extend(np.sqrt((ends * ends).sum(axis=1)).tolist())
+        builder.spring_stiffness.extend(cloth.stiffness.tolist())
+        builder.spring_damping.extend(cloth.damping.tolist())
+        builder.spring_control.extend([0.0] * cloth.springs)
+        return cloth, builder.finalize(device="cpu")
+
+    def scene_problems(self, n: int) -> list[str]:
+        """Where Newton's model at ``n`` differs from the scene (empty: nowhere)."""
+        cloth, model = self.build(n)
+        f32 = np.float32
+        problems = []
+
+        def compare(what: str, got: np.ndarray, want: np.ndarray, rtol: float = 0.0) -> None:
+            if got.shape != want.shape or not np.allclose(got, want, rtol=rtol, atol=0.0):
+                problems.append(what)
+
+        compare("spring ends", model.spring_indices.numpy().reshape(-1, 2), cloth.pairs)
+        compare("stiffness", model.spring_stiffness.numpy(), cloth.stiffness.astype(f32))
+        compare("damping", model.spring_damping.numpy(), cloth.damping.astype(f32))
+        # add_spring takes rest lengths from the float32 positions: a relative 2e-6 from the
+        # float64 ones at N = 32 (0.03 m between coordinates rounded to 6e-8 m near 1 m).
+        start = cloth.positions.astype(f32).astype(np.float64)
+        ends = start[cloth.pairs[:, 1]] - start[cloth.pairs[:, 0]]
+        compare(
+            "rest lengths", model.spring_rest_length.numpy(), np.linalg.norm(ends, axis=1), 1e-6
+        )
+        compare("1/m", model.particle_inv_mass.numpy(), cloth.inverse_mass, 1e-6)
+        compare("gravity", model.gravity.numpy().reshape(-1), np.array(GRAVITY, f32))
+        compare("start", model.particle_q.numpy(), cloth.positions.astype(f32))
+        others = {
+            "triangles": model.tri_count,
+            "edges": model.edge_count,
+            "tetrahedra": model.tet_count,
+            "shapes": model.shape_count,
+            "bodies": model.body_count,
+            "particle hash grid": int(model.particle_grid is not None),
+        }
+        problems += [f"{count} {what}" for what, count in others.items() if count]
+        return problems
+
+    def runner(self, n: int) -> Runner:
+        """Newton from the scene's start: one ``solver.step`` per call (see the docstring)."""
+        wp = self.wp
+        _, model = self.build(n)
+        solver = self.newton.solvers.SolverSemiImplicit(model, enable_tri_contact=False)
+        states = (model.state(), model.state())
+        control = model.control()
+        h = STEP_BY_SIZE[n]
+        graphs: list[object] = []
+        done = [0]  # steps so far: the newest state is states[done % 2]
+
+        def advance(a: int) -> None:
+            states[a].clear_forces()
+            solver.step(states[a], states[1 - a], control, None, h)
+
+        def step() -> None:
+            a = done[0] % 2
+            if done[0] == 0:  # compiles Newton's kernels, then records both steps
+                advance(a)
+                try:
+                    for b in (0, 1):
+                        with wp.ScopedCapture(device="cpu") as capture:  # records, runs nothing
+                            advance(b)
+                        graphs.append(capture.graph)
+                except Exception:  # no CPU graphs in this Warp: launch directly
+                    graphs.clear()
+                self.captured = bool(graphs)
+            elif graphs:
+                wp.capture_launch(graphs[a])
+            else:
+                advance(a)
+            wp.synchronize()
+            done[0] += 1
+
+        def positions() -> np.ndarray:
+            return states[done[0] % 2].particle_q.numpy().astype(np.float64)
+
+        return step, positions
+
+
+def load_newton(directory: str | None) -> tuple[NewtonCloth | None, str]:
+    """The Newton peer, or None and the reason it is unavailable."""
+    try:
+        return NewtonCloth(directory), ""
+    except ImportError as error:
+        return None, f"not installed ({error})"
+    except Exception as error:  # a broken install or an unsupported feature: skip, say why
+        return None, f"unusable ({type(error).__name__}: {error})"
+
+
+# --------------------------------------------------------------------------------------------
 # visviva
 # --------------------------------------------------------------------------------------------
 
@@ -530,7 +699,18 @@ class Figure:
 PLAIN = f"plain Numba, {numba.config.NUMBA_NUM_THREADS} threads"
 PLAIN_ONE = "plain Numba, 1 thread"
 WARP = "Warp-CPU"
+NEWTON = "Newton semi-implicit (CPU)"
 VISVIVA = "visviva"
+
+
+@dataclass(frozen=True)
+class Peers:
+    """The optional peers (None where unavailable) and why each is missing."""
+
+    warp: WarpCloth | None
+    warp_why: str
+    newton: NewtonCloth | None
+    newton_why: str
 
 
 @dataclass(frozen=True)
@@ -540,18 +720,20 @@ class Contender:
     threads: int  # Numba threads while it runs (Warp and visviva: left at the default)
 
 
-def contenders(warp: WarpCloth | None) -> list[Contender]:
+def contenders(peers: Peers) -> list[Contender]:
     every = numba.config.NUMBA_NUM_THREADS
     plan = [Contender(PLAIN, numba_runner, every), Contender(PLAIN_ONE, numba_runner, 1)]
-    if warp is not None:
-        plan.append(Contender(WARP, warp.runner, every))
+    if peers.warp is not None:
+        plan.append(Contender(WARP, peers.warp.runner, every))
+    if peers.newton is not None:
+        plan.append(Contender(NEWTON, peers.newton.runner, every))
     plan.append(Contender(VISVIVA, visviva_runner, every))
     return plan
 
 
 def bench_step(
     args: argparse.Namespace,
-    warp: WarpCloth | None,
+    peers: Peers,
     bandwidth: dict[int, float],
     checks: Checks,
 ) -> list[Figure]:
@@ -561,7 +743,7 @@ def bench_step(
     lowest: dict[int, dict[str, float]] = {}  # the lowest point after the timed steps, by N
     for n in args.sizes:
         lowest[n] = {}
-        for contender in contenders(warp):
+        for contender in contenders(peers):
             label = contender.label
             numba.set_num_threads(contender.threads)
             step, positions = contender.factory(n)
@@ -601,13 +783,16 @@ def bench_step(
     )
     print("  h by N: " + ", ".join(f"{n}: {STEP_BY_SIZE[n]:g} s" for n in args.sizes))
     n = args.sizes[-1]
-    for contender in contenders(warp):
-        if contender.label in (WARP, VISVIVA):
+    for contender in contenders(peers):
+        if contender.label in (WARP, NEWTON, VISVIVA):
             share = cpu_share(contender.factory(n)[0])
             print(
                 f"  {contender.label}: process CPU time / wall time while stepping at N = {n}:"
                 f" {share:.2f} ({'one thread' if share < 1.3 else 'several threads'})"
             )
+    if peers.newton is not None and peers.newton.captured is not None:
+        how = "replayed as CPU graphs" if peers.newton.captured else "launched directly"
+        print(f"  {NEWTON}: its steps {how} (see the module docstring)")
     for n, heights in lowest.items():
         checks.check(
             all(HEIGHT - 1.0 < y < HEIGHT for y in heights.values()),
@@ -641,12 +826,15 @@ def summarise(args: argparse.Namespace, figures: list[Figure], bandwidth: dict[i
     rows = []
     for n in args.sizes:
         versus_warp = ratio(VISVIVA, WARP, n)
+        versus_newton = ratio(VISVIVA, NEWTON, n)
         fraction = of_triad(VISVIVA, n)
         rows.append(
             [
                 str(n),
                 times(versus_warp),
                 verdict(versus_warp, TARGET_VS_WARP),
+                times(versus_newton),
+                verdict(versus_newton, TARGET_VS_NEWTON),
                 times(ratio(VISVIVA, PLAIN, n)),
                 times(ratio(VISVIVA, PLAIN_ONE, n)),
                 times(ratio(PLAIN, WARP, n)),
@@ -661,6 +849,8 @@ def summarise(args: argparse.Namespace, figures: list[Figure], bandwidth: dict[i
             "N",
             "visviva ÷ Warp",
             f"≥ {TARGET_VS_WARP:g}×",
+            "visviva ÷ Newton",
+            f"≥ {TARGET_VS_NEWTON:g}×",
             "visviva ÷ Numba(2)",
             "visviva ÷ Numba(1)",
             "Numba(2) ÷ Warp",
@@ -671,9 +861,9 @@ def summarise(args: argparse.Namespace, figures: list[Figure], bandwidth: dict[i
         rows,
     )
     print(
-        f"  Numba(2), Numba(1): {PLAIN}, {PLAIN_ONE}; targets for visviva: ≥ {TARGET_VS_WARP:g}×"
-        f" Warp-CPU's springs/s, ≥ {TARGET_FRACTION:.0%} of the triad's bandwidth (GB/s as"
-        " counted in (b))"
+        f"  Numba(2), Numba(1): {PLAIN}, {PLAIN_ONE}; Newton: {NEWTON}, float32; targets for"
+        f" visviva: ≥ {TARGET_VS_WARP:g}× Warp-CPU's springs/s, ≥ {TARGET_VS_NEWTON:g}× Newton's,"
+        f" ≥ {TARGET_FRACTION:.0%} of the triad's bandwidth (GB/s as counted in (b))"
     )
     largest = args.sizes[-1]
     print(
@@ -689,12 +879,12 @@ def summarise(args: argparse.Namespace, figures: list[Figure], bandwidth: dict[i
 # --------------------------------------------------------------------------------------------
 
 
-def bench_agreement(warp: WarpCloth | None, checks: Checks) -> None:
+def bench_agreement(peers: Peers, checks: Checks) -> None:
     n, steps = CHECK_N, CHECK_STEPS
     heading(f"(c) Agreement after {steps} steps of {STEP_BY_SIZE[n]:g} s, N = {n} (max |Δx|)")
     numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     results = {"NumPy reference": numpy_reference(cloth_scene(n), STEP_BY_SIZE[n], steps)}
-    for contender in contenders(warp):
+    for contender in contenders(peers):
         if contender.label == PLAIN_ONE:
             continue  # the same kernels as PLAIN
         step, positions = contender.factory(n)
@@ -704,18 +894,36 @@ def bench_agreement(warp: WarpCloth | None, checks: Checks) -> None:
     plain = results.pop(PLAIN)
     sag = HEIGHT - plain[:, 1].min()
     print(f"  the cloth's lowest point fell {sag * 1e3:.3f} mm ({PLAIN})")
+    newton = results.pop(NEWTON, None)
     for label, positions in results.items():
         difference = float(np.abs(positions - plain).max())
         checks.check(
             difference <= CHECK_TOLERANCE,
             f"{PLAIN} vs {label}: {difference:.1e} m (≤ {CHECK_TOLERANCE:g} m)",
         )
+    if peers.newton is None or newton is None:
+        return
+    problems = peers.newton.scene_problems(n)
+    checks.check(
+        not problems,
+        f"{NEWTON}'s model holds the scene (spring ends, k, c, rest lengths, 1/m, gravity, start;"
+        " no triangles, edges, tetrahedra, shapes, bodies or contact grid)"
+        + (f": differs in {', '.join(problems)}" if problems else ""),
+    )
+    visviva = results[VISVIVA]
+    difference = float(np.abs(newton - visviva).max())
+    newton_sag = HEIGHT - newton[:, 1].min()
+    checks.check(
+        difference <= NEWTON_TOLERANCE,
+        f"{VISVIVA} vs {NEWTON}: {difference:.1e} m (≤ {NEWTON_TOLERANCE:g} m: float32, see"
+        f" NEWTON_TOLERANCE); its lowest point fell {newton_sag * 1e3:.3f} mm",
+    )
 
 
 # --------------------------------------------------------------------------------------------
 
 
-def print_header(args: argparse.Namespace, warp: WarpCloth | None, why: str) -> None:
+def print_header(args: argparse.Namespace, peers: Peers) -> None:
     print("visviva cloth benchmark" + ("  [--quick: smoke run]" if args.quick else ""))
     print(
         f"date:              {datetime.datetime.now().astimezone().isoformat(timespec='seconds')}"
@@ -725,10 +933,16 @@ def print_header(args: argparse.Namespace, warp: WarpCloth | None, why: str) -> 
     print(f"Python:            {platform.python_version()}")
     print(f"numpy / numba:     {np.__version__} / {numba.__version__}")
     print(f"visviva:           {vv.__version__} ({source_state()})")
-    if warp is None:
-        print(f"Warp:              {why}; see the module docstring")
+    if peers.warp is None:
+        print(f"Warp:              {peers.warp_why}; see the module docstring")
     else:
-        print(f"Warp:              {warp.version} (device cpu, float64)")
+        print(f"Warp:              {peers.warp.version} (device cpu, float64)")
+    if peers.newton is None:
+        print(f"Newton:            {peers.newton_why}; see the module docstring")
+    else:
+        print(
+            f"Newton:            {peers.newton.version} (device cpu, float32, SolverSemiImplicit)"
+        )
     print(f"Numba threads:     {numba.config.NUMBA_NUM_THREADS}, layer {numba.threading_layer()}")
     print(f"load average:      {load_average()} at start")
 
@@ -747,7 +961,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--peers",
         default=os.environ.get("VISVIVA_PEERS"),
-        help="directory holding warp (pip install --no-deps --target DIR warp-lang)",
+        help="directory holding warp, and newton unless --newton says otherwise (pip install"
+        " --no-deps --target DIR newton warp-lang)",
+    )
+    parser.add_argument(
+        "--newton",
+        default=os.environ.get("VISVIVA_NEWTON"),
+        help="directory holding newton (default: the --peers directory)",
     )
     args = parser.parse_args(argv)
     args.repeats = args.repeats or (3 if args.quick else 7)
@@ -756,18 +976,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     args.sizes = (16, 32) if args.quick else (64, 128, 256)
     PATIENCE["retries"] = max(0, args.retries)
     PATIENCE["quiet_wait"] = max(0.0, args.quiet_wait)
-    warp, why = load_warp(args.peers)
+    # Warp first: if Newton's directory holds another Warp, Newton runs on this one.
+    peers = Peers(*load_warp(args.peers), *load_newton(args.newton or args.peers))
     # Compile (or load from the cache) the Numba kernels before the header and the timings.
     numba_runner(min(STEP_BY_SIZE))[0]()
     tiny = np.zeros(3)
     triad(tiny, tiny, tiny, 1.0)
     started = time.perf_counter()
-    print_header(args, warp, why)
+    print_header(args, peers)
     checks = Checks()
     bandwidth = bench_bandwidth(args)
-    figures = bench_step(args, warp, bandwidth, checks)
+    figures = bench_step(args, peers, bandwidth, checks)
     summarise(args, figures, bandwidth)
-    bench_agreement(warp, checks)
+    bench_agreement(peers, checks)
     return finish(started, checks)
 
 
