@@ -1,6 +1,6 @@
 #!/usr/bin/env python
 """Implicit cloth benchmark: backward Euler at h = 1/60 s by projected Newton, visviva's CG
-against SciPy's.
+against SciPy's; and Liu et al.'s fast mass-spring step, with how far it is from converged.
 
 Run ``python benchmarks/bench_implicit_cloth.py`` (a few minutes on 2 cores) or add ``--quick``
 for a smoke run whose figures mean nothing.
@@ -21,7 +21,8 @@ The scene, the same for every runner, built through visviva's public API (float6
   relative residual of ``cg_rtol`` = 1e-2.
 
 Runners (each from the same cloth at rest: one warm-up step, which compiles, then the timed
-steps, 30 by default and 5 with ``--quick``, each ``sim.step()`` timed on its own):
+steps, 30 by default and 5 with ``--quick``, each ``sim.step()`` timed on its own; the three
+run one after the other at each N):
 
 * visviva: ``ProjectedNewton()`` with its defaults; its linear solve is ``block_cg``, Numba
   kernels running in parallel over block rows on every core;
@@ -35,31 +36,68 @@ steps, 30 by default and 5 with ``--quick``, each ``sim.step()`` timed on its ow
   stiffness; the SciPy runner detects that in its matrix product (one extra dot product per
   iteration) and stops likewise, so the two runners take the same Newton path (up to
   round-off: see the sanity checks) and differ only in the linear solver. SciPy's sparse
-  products run on one thread.
+  products run on one thread;
+* FastMassSprings: ``vv.integrators.FastMassSprings(iterations=10)``, Liu et al.'s (2013)
+  local/global solver of the same backward Euler step for the springs: each iteration sets
+  every spring's direction (a Numba kernel, parallel) and solves (M + h² L) x = M y + h² J d,
+  L the springs' stiffness-weighted graph Laplacian, with M + h² L factorized once per run
+  (SciPy's SuperLU, one thread; its first step, the warm-up, factorizes). It stops after 10
+  iterations whether converged or not, and it takes the springs' dampers explicitly, from the
+  start of the step, where ProjectedNewton takes them implicitly. It is the fast option, but it
+  does not compute what the Newton runners compute: how far its step is from theirs is the
+  accuracy table's.
 
 Figures per N and runner: wall time per step (mean = total ÷ steps, and the median), Newton
 iterations, linear solves, CG iterations and line-search halvings per step (work counts from
 ``sim.system.counters``), CG iterations per Newton iteration, and the wall time spent inside
-the integrator's ``_solve`` per step (assembling A, preconditioner set-up and CG). Then the
-ratios SciPy ÷ visviva for the whole step and for the linear solve, against the targets: at
-most 16 ms per step at N = 64 and 60 ms at N = 128 (the mean), and SciPy ÷ visviva ≥ 3 for
-the whole step; and the ratio of the linear solve's time per CG iteration, which does not
-depend on how many iterations each runner took.
+the integrator's ``_solve`` per step (assembling A, preconditioner set-up and CG); for
+FastMassSprings, in its own table after the Newton runners', the wall time per step (mean and
+median), its local/global iterations per step (counted as ``newton_iterations``, each a global
+solve), the warm-up step's time and, separately, the one-off construction and factorization of
+M + h² L (``_Global``, timed once on a fresh scene). Then the ratios SciPy ÷ visviva for the
+whole step and for the linear solve, against the targets: at most 16 ms per step at N = 64 and
+60 ms at N = 128 (the mean), and SciPy ÷ visviva ≥ 3 for the whole step; and the ratio of the
+linear solve's time per CG iteration, which does not depend on how many iterations each runner
+took. FastMassSprings' mean stands next to ProjectedNewton's against the same 16 ms / 60 ms,
+with its error from the accuracy table.
 
-Sanity checks: no NaN; after the warm-up step (one step from the same start) the two runners'
-positions agree within 1e-6 m; and after all the steps within 5 cm. The two runners solve the
-same equations to the same tolerances, and their CG iterates differ by round-off only, but
-round-off is enough to send the cloth down different paths: within the first ten steps it
-buckles, its incremental potential has more than one minimum, and a different Newton iteration
-count or line-search decision in one step picks another. Measured at N = 64 (default
-tolerances): the positions agree to 1e-16 m for two steps, 1e-7 m after six, then the runners
-part (steps 7–8, one Newton iteration more in one of them) and differ by up to 1.1 cm (step
-16), 2.6 mm after 31 steps. With the tolerances tightened (Newton's rtol 1e-9, atol 1e-10 m/s,
-``cg_rtol`` 1e-10) they still part at step 7 (126 against 96 Newton iterations in that step)
-and differ by up to 1.2 cm: the spread is the problem's, not the tolerances'. So the check
-at the end only guards against a runner solving a different problem (the cloth falls about
-1 m meanwhile); the strict one is after the first step. This is not a test: it prints figures
-and exits 1 only if a sanity check fails.
+The accuracy table, so that no one takes a truncated iteration for a converged one: from the
+runners' start (the cloth at rest) and from the cloth after 10 steps of ``ProjectedNewton()``
+(moving, about 3 cm per step, and buckled; at N ≤ 64, or every N with ``--all-accuracy``), ONE
+step of h by ``FastMassSprings(iterations=k)``, k = 5, 10, 20, 40, and one by ProjectedNewton
+converged tightly (the reference: rtol 1e-9, atol 1e-10 m/s, ``cg_rtol`` 1e-10, up to 1000
+Newton iterations so that the step is not halved), both starting their
+iteration at x_n + h v_n (the state's cached acceleration dropped). Reported: the largest
+distance of a point from the reference's position [m], and that as a share of the largest
+distance a point moves in the reference step. None of it is timed, and it runs on one Numba
+thread (see "Shared machines"). With the scene's dampers that includes their
+explicit treatment; the same starts are also stepped in the scene without dampers, where both
+methods solve the same minimization and what is left is truncation. Measured (quick sizes
+N = 16, 24, and one-off at N = 64): 10 iterations leave 47–60 % of the first step's
+displacement from rest undone (the cloth falls too slowly: M + h² L holds the flat cloth's
+transverse motion as stiffly as its stretching, where its true stiffness across is nearly
+zero) and 7–9 % of a moving step's; 40 iterations 39–51 % and 5–6 %. The dampers change these by
+less than the last digit shown. The iteration converges to the reference, slowly: at N = 16
+without dampers, 10,000 iterations come within 2e-5 m of it (rest) and 3e-6 m (moving). The
+reference itself is expensive where the cloth buckles: from the moving start at N = 128 it took
+291 Newton and 149,473 CG iterations (560 s on one thread while other processes ran), hence the
+moving start at N ≤ 64 by default.
+
+Sanity checks: no NaN (FastMassSprings' included); after the warm-up step (one step from the
+same start) the two Newton runners' positions agree within 1e-6 m; and after all the steps
+within 5 cm; every reference step of the accuracy table converged without being halved. The two
+Newton runners solve the same equations to the same tolerances, and their CG iterates differ by
+round-off only, but round-off is enough to send the cloth down different paths: within the
+first ten steps it buckles, its incremental potential has more than one minimum, and a
+different Newton iteration count or line-search decision in one step picks another. Measured at
+N = 64 (default tolerances): the positions agree to 1e-16 m for two steps, 1e-7 m after six,
+then the runners part (steps 7–8, one Newton iteration more in one of them) and differ by up to
+1.1 cm (step 16), 2.6 mm after 31 steps. With the tolerances tightened (Newton's rtol 1e-9,
+atol 1e-10 m/s, ``cg_rtol`` 1e-10) they still part at step 7 (126 against 96 Newton iterations
+in that step) and differ by up to 1.2 cm: the spread is the problem's, not the tolerances'. So
+the check at the end only guards against a runner solving a different problem (the cloth falls
+about 1 m meanwhile); the strict one is after the first step. This is not a test: it prints
+figures and exits 1 only if a sanity check fails.
 
 Shared machines: visviva's CG enters five parallel regions per iteration, and while other
 processes keep a core busy each may wait for a time slice. Measured here with another
@@ -100,7 +138,9 @@ from bench_integrators import (
     print_table,
     wait_for_quiet,
 )
+from visviva.integrators.fast_springs import _Global
 from visviva.integrators.projected_newton import _newton_blocks, _same_blocks
+from visviva.ode.state import State
 
 # --------------------------------------------------------------------------------------------
 # The scene
@@ -128,9 +168,32 @@ TARGET_RATIO = 3.0
 AGREEMENT_FIRST = 1e-6
 AGREEMENT_END = 0.05
 
+#: FastMassSprings: local/global iterations per step in its timed runs, and the counts whose
+#: single step the accuracy table compares with converged backward Euler.
+FAST_ITERATIONS = 10
+ACCURACY_ITERATIONS = (5, 10, 20, 40)
+#: Steps of ``ProjectedNewton()`` (defaults) from rest to the accuracy table's second start:
+#: the cloth moving and buckled.
+MOVING_AFTER = 10
+#: The accuracy table's reference: ``ProjectedNewton`` (its block CG) converged tightly, with
+#: room for the iterations so that the step is not halved: from the buckled cloth at N = 128
+#: it took 291 Newton and 149,473 CG iterations (measured; 560 s on one thread while other
+#: processes ran).
+REFERENCE = {
+    "rtol": 1e-9,
+    "atol": 1e-10,
+    "max_iterations": 1000,
+    "cg_rtol": 1e-10,
+    "cg_max_iterations": 5000,
+}
+#: The accuracy table's moving start is measured at N up to this (``--all-accuracy``: at every
+#: N); the start at rest at every N.
+MOVING_UP_TO = 64
 
-def cloth_scene(n: int) -> Any:
-    """The scene at N = n, built through the public API (the method is chosen per runner)."""
+
+def cloth_scene(n: int, damping: float = DAMPING) -> Any:
+    """The scene at N = n, built through the public API (the method is chosen per runner);
+    ``damping`` [N·s/m] along every spring (0 for the accuracy table's undamped variant)."""
     builder = vv.SceneBuilder(name=f"implicit cloth {n}x{n}")
     builder.set_world(gravity=GRAVITY)
     builder.set_integration(method="symplectic_euler", dt=STEP, duration=100.0)
@@ -139,7 +202,7 @@ def cloth_scene(n: int) -> Any:
         stretch=STRETCH,
         shear=SHEAR,
         bend=BEND,
-        damping=DAMPING,
+        damping=damping,
         density=DENSITY,
         origin=(0.0, HEIGHT, 0.0),
         along=(1.0, 0.0, 0.0),
@@ -150,7 +213,7 @@ def cloth_scene(n: int) -> Any:
 
 
 # --------------------------------------------------------------------------------------------
-# The two integrators: visviva's, and the same with SciPy's CG
+# The integrators: visviva's, the same with SciPy's CG, and FastMassSprings
 # --------------------------------------------------------------------------------------------
 
 
@@ -280,7 +343,18 @@ def scipy_cg(
 
 VISVIVA = "visviva"
 SCIPY = "SciPy CG"
+#: The Newton runners, compared with each other in (a) and (b).
 RUNNERS: dict[str, Callable[[], TimedNewton]] = {VISVIVA: TimedNewton, SCIPY: ScipyCGNewton}
+FAST = "FastMassSprings"
+
+
+def fast_springs(iterations: int = FAST_ITERATIONS) -> Any:
+    """Liu et al.'s local/global step with ``iterations`` iterations per step."""
+    return vv.integrators.FastMassSprings(iterations=iterations)
+
+
+#: Every timed runner: the Newton runners, then FastMassSprings.
+METHODS: dict[str, Callable[[], Any]] = {**RUNNERS, FAST: fast_springs}
 
 
 @dataclass
@@ -291,12 +365,13 @@ class Run:
     n: int
     times: list[float]  # wall time of each timed step [s]
     first: float  # the warm-up step [s]
-    solve_seconds: float  # inside the linear solve over the timed steps [s]
+    solve_seconds: float  # inside the linear solve over the timed steps [s] (Newton runners)
     setup_seconds: float  # of which CSR conversion and block inversion (SciPy only) [s]
     work: dict[str, int]  # counters over the timed steps
     start: np.ndarray  # (N², 3) positions [m] after the warm-up step
     positions: np.ndarray  # (N², 3) m after the warm-up and timed steps
     others: float | None  # other processes' share of the machine meanwhile
+    factorize: float | None = None  # FastMassSprings: building its factorized matrix once [s]
 
     @property
     def steps(self) -> int:
@@ -323,7 +398,7 @@ class Run:
 
 def run_once(label: str, n: int, steps: int, quiet_wait: float) -> Run:
     """One warm-up step, then ``steps`` timed steps of a fresh cloth."""
-    method = RUNNERS[label]()
+    method = METHODS[label]()
     simulation = vv.Simulation(cloth_scene(n), method=method)
     start = time.perf_counter()
     simulation.step()
@@ -331,7 +406,8 @@ def run_once(label: str, n: int, steps: int, quiet_wait: float) -> Run:
     positions_after_first = np.array(simulation.state["particle_position"])
     counters = simulation.system.counters
     before = counters.as_dict()
-    method.solve_seconds = 0.0
+    if isinstance(method, TimedNewton):
+        method.solve_seconds = 0.0
     if isinstance(method, ScipyCGNewton):
         method.setup_seconds = 0.0
     wait_for_quiet(quiet_wait)
@@ -348,7 +424,7 @@ def run_once(label: str, n: int, steps: int, quiet_wait: float) -> Run:
         n,
         times,
         first,
-        method.solve_seconds,
+        getattr(method, "solve_seconds", 0.0),
         getattr(method, "setup_seconds", 0.0),
         {key: after[key] - before[key] for key in after},
         positions_after_first,
@@ -380,8 +456,17 @@ def busy(others: float | None) -> str:
     return "?" if others is None else f"{100.0 * others:.0f}%"
 
 
+def factorize_seconds(n: int) -> float:
+    """Wall time [s] of building FastMassSprings' global matrix ``M + h² L`` and factorizing
+    it (``_Global``, as its first step does), once, on a fresh scene at N = n."""
+    network = cloth_scene(n).system().spring_network()
+    start = time.perf_counter()
+    _Global(network, STEP)
+    return time.perf_counter() - start
+
+
 def bench_runs(args: argparse.Namespace) -> dict[tuple[str, int], Run]:
-    """Every runner at every N; prints the per-runner table."""
+    """Every runner at every N; prints the Newton runners' table (FastMassSprings' is (c))."""
     heading(
         f"(a) Implicit cloth, h = 1/60 s, {args.steps} timed steps after 1 warm-up step:"
         f" N = {', '.join(map(str, args.sizes))}"
@@ -389,10 +474,13 @@ def bench_runs(args: argparse.Namespace) -> dict[tuple[str, int], Run]:
     runs = {}
     rows = []
     for n in args.sizes:
-        for label in RUNNERS:
+        for label in METHODS:
             result = run(label, n, args.steps, args)
             runs[label, n] = result
             print(f"  {label}, N = {n}: {sum(result.times):.2f} s of timed steps", flush=True)
+            if label == FAST:
+                result.factorize = factorize_seconds(n)
+                continue
             newton = result.work["newton_iterations"]
             krylov = result.work["krylov_iterations"]
             rows.append(
@@ -447,12 +535,21 @@ def largest_difference(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(a - b).max())
 
 
-def summarise(args: argparse.Namespace, runs: dict[tuple[str, int], Run], checks: Checks) -> None:
+def meets(seconds: float, target: float | None) -> str:
+    return "n/a" if target is None else ("met" if seconds <= target else "not met")
+
+
+def summarise(
+    args: argparse.Namespace,
+    runs: dict[tuple[str, int], Run],
+    errors: dict[int, list[Accuracy]],
+    checks: Checks,
+) -> None:
     """The ratios, the targets and the sanity checks."""
     heading("(b) SciPy ÷ visviva, targets and agreement")
     rows = []
     for n in args.sizes:
-        ours, theirs = runs[VISVIVA, n], runs[SCIPY, n]
+        ours, theirs, fast = runs[VISVIVA, n], runs[SCIPY, n], runs[FAST, n]
         step_ratio = theirs.mean / ours.mean
         target = TARGET_STEP.get(n)
         rows.append(
@@ -460,7 +557,10 @@ def summarise(args: argparse.Namespace, runs: dict[tuple[str, int], Run], checks
                 str(n),
                 milliseconds(ours.mean),
                 "n/a" if target is None else f"≤ {milliseconds(target)}",
-                "n/a" if target is None else ("met" if ours.mean <= target else "not met"),
+                meets(ours.mean, target),
+                milliseconds(fast.mean),
+                meets(fast.mean, target),
+                worst_error(errors[n], FAST_ITERATIONS),
                 f"{step_ratio:.2f}×",
                 "met" if step_ratio >= TARGET_RATIO else "not met",
                 f"{theirs.solve_mean / ours.solve_mean:.2f}×",
@@ -471,8 +571,9 @@ def summarise(args: argparse.Namespace, runs: dict[tuple[str, int], Run], checks
         )
     print()
     print_table(
-        ["N", "visviva ms/step", "target", "", "SciPy ÷ visviva: step", f"≥ {TARGET_RATIO:g}×"]
-        + ["linear solve", "per CG iteration", "max |Δx| [m]: 1 step", f"{1 + args.steps} steps"],
+        ["N", "visviva ms/step", "target", "", f"{FAST} ms/step", "", "its error (d)"]
+        + ["SciPy ÷ visviva: step", f"≥ {TARGET_RATIO:g}×", "linear solve", "per CG iteration"]
+        + ["max |Δx| [m]: 1 step", f"{1 + args.steps} steps"],
         rows,
     )
     print(
@@ -480,13 +581,22 @@ def summarise(args: argparse.Namespace, runs: dict[tuple[str, int], Run], checks
         " inside the linear solve per step, and of that time per CG iteration; max |Δx|: between"
         " the two runners' positions after the warm-up step and at the end"
     )
+    print(
+        f"  {FAST}: Liu et al.'s local/global step, {FAST_ITERATIONS} iterations per step, not"
+        f" iterated to convergence, dampers explicit (see (c)); its error: the largest distance"
+        f" of a point after one such step from converged backward Euler's (ProjectedNewton,"
+        f" implicit dampers), as a share of the step's largest displacement, the worst of the"
+        f" starts in (d) ((rest): the moving start not measured at that N). Its ms/step is for"
+        f" that truncated step, not for backward Euler solved to ProjectedNewton's tolerance"
+    )
     if args.quick:
         print("  --quick: the sizes are not the targets' (64, 128); no target applies")
     print()
     for n in args.sizes:
-        ours, theirs = runs[VISVIVA, n], runs[SCIPY, n]
+        ours, theirs, fast = runs[VISVIVA, n], runs[SCIPY, n], runs[FAST, n]
         finite = all(np.isfinite(r.positions).all() for r in (ours, theirs))
         checks.check(finite, f"N={n}: both runners' positions finite")
+        checks.check(bool(np.isfinite(fast.positions).all()), f"N={n}: {FAST}'s positions finite")
         first = largest_difference(ours.start, theirs.start)
         checks.check(
             first <= AGREEMENT_FIRST,
@@ -501,6 +611,254 @@ def summarise(args: argparse.Namespace, runs: dict[tuple[str, int], Run], checks
             f" (≤ {AGREEMENT_END:g} m: the cloth buckles, see the module docstring; its lowest"
             f" point fell {sag:.3f} m)",
         )
+
+
+# --------------------------------------------------------------------------------------------
+# FastMassSprings: its timing, and how far its step is from converged backward Euler
+# --------------------------------------------------------------------------------------------
+
+
+def print_fast(args: argparse.Namespace, runs: dict[tuple[str, int], Run]) -> None:
+    """FastMassSprings' timed runs (made in (a)'s loop, the same way)."""
+    heading(
+        f"(c) {FAST}(iterations={FAST_ITERATIONS}): the same scene, {args.steps} timed steps"
+        f" after 1 warm-up step"
+    )
+    rows = []
+    for n in args.sizes:
+        result = runs[FAST, n]
+        iterations = result.per_step("newton_iterations")
+        target = TARGET_STEP.get(n)
+        rows.append(
+            [
+                FAST,
+                str(n),
+                milliseconds(result.mean),
+                milliseconds(statistics.median(result.times)),
+                "n/a" if target is None else f"≤ {milliseconds(target)}",
+                meets(result.mean, target),
+                f"{iterations:.2f}",
+                f"{result.per_step('linear_solves'):.2f}",
+                f"{result.mean / iterations * 1e3:.2f}" if iterations else "n/a",
+                milliseconds(result.first),
+                "n/a" if result.factorize is None else milliseconds(result.factorize),
+                busy(result.others),
+            ]
+        )
+    print()
+    print_table(
+        ["runner", "N", "ms/step", "median", "target", "", "iterations", "solves"]
+        + ["ms/iteration", "warm-up ms", "factorize ms", "others' CPU"],
+        rows,
+    )
+    print(
+        "  ms/step: total wall time ÷ steps (median: of the single steps), the timed steps"
+        " reusing the factorization; iterations: local/global iterations per step (counted as"
+        " newton_iterations), each a global solve (solves: two triangular sweeps with the"
+        " prefactored M + h² L, for the three coordinates at once); ms/iteration: ms/step ÷"
+        " iterations (the step's force evaluation included)"
+    )
+    print(
+        "  warm-up ms: the first step, which builds M + h² L and factorizes it (SciPy's SuperLU,"
+        " one thread); factorize ms: that construction alone (``_Global``), timed once on a"
+        " fresh scene. Both are one-off costs, per run and step size"
+    )
+    print(
+        f"  What it computes: a fixed {FAST_ITERATIONS} iterations of block coordinate descent"
+        " on backward Euler's objective, not a converged step (error: (d)); the springs'"
+        " dampers act explicitly, from the start of the step, where ProjectedNewton treats"
+        " them implicitly"
+    )
+
+
+@dataclass
+class Accuracy:
+    """One step from one start: converged backward Euler (the reference) and FastMassSprings
+    at each of ``ACCURACY_ITERATIONS``."""
+
+    n: int
+    start: str  # "rest" or "moving"
+    damping: float  # along every spring [N·s/m]
+    displacement: float  # the reference step's largest displacement of a point [m]
+    newton: int  # the reference's Newton iterations
+    krylov: int  # the reference's CG iterations
+    splits: int  # the reference's halved steps (0: one step of h)
+    seconds: float  # the reference step's wall time [s]
+    errors: dict[int, float]  # iterations → largest distance of a point from the reference [m]
+    finite: bool  # FastMassSprings' positions finite at every count
+    failure: str | None = None  # why the reference did not converge, if it did not
+
+
+def snapshot(state: State) -> State:
+    """A copy of ``state`` without its cached derivative: ProjectedNewton's iteration then
+    starts at V = v (x = x_n + h v_n), where FastMassSprings' starts."""
+    return State(
+        state.t,
+        tuple(np.array(part) for part in state.parts),
+        state.layout,
+        {name: np.array(value) for name, value in state.carried.items()},
+    )
+
+
+def positions(state: State) -> np.ndarray:
+    return np.array(state["particle_position"])
+
+
+def largest_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """max over points of |a_i − b_i| [m] (a and b: (points, 3))."""
+    return float(np.linalg.norm(a - b, axis=1).max())
+
+
+def one_step(
+    n: int, start: str, state: State, damping: float, system: Any, fast: dict[int, Any]
+) -> Accuracy:
+    """One step of h from ``state`` by the reference and by each of ``fast``'s integrators."""
+    before = system.counters.as_dict()
+    begin = time.perf_counter()
+    failure = None
+    try:
+        step = vv.integrators.ProjectedNewton(**REFERENCE).step(system, state, STEP)
+        reference = positions(step)
+    except vv.NewtonConvergenceError as error:
+        failure, reference = str(error), np.full_like(positions(state), np.nan)
+    seconds = time.perf_counter() - begin
+    after = system.counters.as_dict()
+    stepped = {
+        iterations: positions(method.step(system, state, STEP))
+        for iterations, method in fast.items()
+    }
+    errors = {iterations: largest_distance(x, reference) for iterations, x in stepped.items()}
+    return Accuracy(
+        n,
+        start,
+        damping,
+        largest_distance(reference, positions(state)),
+        after["newton_iterations"] - before["newton_iterations"],
+        after["krylov_iterations"] - before["krylov_iterations"],
+        after["rejected_steps"] - before["rejected_steps"],
+        seconds,
+        errors,
+        all(np.isfinite(x).all() for x in stepped.values()),
+        failure,
+    )
+
+
+def measure_accuracy(args: argparse.Namespace) -> dict[int, list[Accuracy]]:
+    """At every N, from the cloth at rest and (at N ≤ ``MOVING_UP_TO``, or every N with
+    ``--all-accuracy``) after ``MOVING_AFTER`` steps of ``ProjectedNewton()``, in the scene and
+    in the same scene without dampers: one step. On one Numba thread: nothing here is timed,
+    and while other processes run, CG's parallel regions wait for time slices (see the module
+    docstring)."""
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        return accuracy_at_sizes(args)
+    finally:
+        numba.set_num_threads(threads)
+
+
+def accuracy_at_sizes(args: argparse.Namespace) -> dict[int, list[Accuracy]]:
+    """``measure_accuracy``'s work, at the current number of threads."""
+    results = {}
+    for n in args.sizes:
+        began = time.perf_counter()
+        simulation = vv.Simulation(cloth_scene(n), method=vv.integrators.ProjectedNewton())
+        starts = {"rest": snapshot(simulation.raw_state)}
+        if n <= MOVING_UP_TO or args.all_accuracy:
+            simulation.step(MOVING_AFTER)
+            starts["moving"] = snapshot(simulation.raw_state)
+        systems = {DAMPING: simulation.system, 0.0: cloth_scene(n, damping=0.0).system()}
+        results[n] = []
+        for damping, system in systems.items():
+            # One integrator per count, shared by the starts: one factorization each.
+            fast = {iterations: fast_springs(iterations) for iterations in ACCURACY_ITERATIONS}
+            for start, state in starts.items():
+                results[n].append(one_step(n, start, state, damping, system, fast))
+        print(
+            f"  accuracy, N = {n}: {time.perf_counter() - began:.1f} s (reference steps:"
+            f" {sum(result.seconds for result in results[n]):.1f} s)",
+            flush=True,
+        )
+    return results
+
+
+def error_cell(result: Accuracy, iterations: int) -> str:
+    if result.failure is not None:
+        return "n/a"
+    error = result.errors[iterations]
+    return f"{error:.1e} ({error / result.displacement:.0%})"
+
+
+def worst_error(results: list[Accuracy], iterations: int) -> str:
+    """The largest error of the ``iterations``-iteration step relative to the step's largest
+    displacement, over ``results``."""
+    if any(result.failure is not None for result in results):
+        return "n/a"
+    worst = max(r.errors[iterations] / r.displacement for r in results)
+    starts = {result.start for result in results}
+    return f"{worst:.0%}" + ("" if "moving" in starts else " (rest)")
+
+
+def print_accuracy(
+    args: argparse.Namespace, results: dict[int, list[Accuracy]], checks: Checks
+) -> None:
+    """The table of one step's errors, and its checks."""
+    heading(f"(d) One step of {FAST} against converged backward Euler")
+    rows = []
+    for n in args.sizes:
+        for result in results[n]:
+            rows.append(
+                [
+                    str(n),
+                    result.start,
+                    f"{result.damping:g}",
+                    f"{result.displacement:.1e}",
+                    f"{result.newton} / {result.krylov}"
+                    + (f" ({result.splits} split)" if result.splits else ""),
+                    f"{result.seconds:.2f}",
+                ]
+                + [error_cell(result, iterations) for iterations in ACCURACY_ITERATIONS]
+            )
+    print()
+    print_table(
+        ["N", "start", "dampers", "step [m]", "ref. Newton / CG", "ref. s"]
+        + [f"{iterations} iterations" for iterations in ACCURACY_ITERATIONS],
+        rows,
+    )
+    print(
+        f"  start: the cloth at rest (as the runners start), or after {MOVING_AFTER} steps of"
+        " ProjectedNewton() (moving and buckled); dampers: N·s/m along every spring, the scene's"
+        " or none (the same scene and start, without dampers); one step of h = 1/60 s from there."
+        + (
+            ""
+            if args.all_accuracy or all(n <= MOVING_UP_TO for n in args.sizes)
+            else f" The moving start only at N ≤ {MOVING_UP_TO} (--all-accuracy: at every N; its"
+            " reference step at N = 128 takes about 300 Newton iterations, minutes)"
+        )
+    )
+    print(
+        "  ref.: converged backward Euler, ProjectedNewton("
+        + ", ".join(f"{key}={value!r}" for key, value in REFERENCE.items())
+        + "), both methods starting their iteration at x_n + h v_n; step [m]: the"
+        " largest distance a point moves in the reference step; ref. Newton / CG: its Newton"
+        " and CG iterations (split: the step was halved, the reference then two steps of h/2,"
+        " a failed check); ref. s: its wall time"
+    )
+    print(
+        f"  k iterations: {FAST}(iterations=k)'s step, the largest distance of a point from"
+        " the reference's [m] (and as a share of step [m]). With dampers, part of it is the"
+        " dampers' treatment (explicit in FastMassSprings, implicit in the reference); without,"
+        " both solve the same backward Euler step and the rest is truncation"
+    )
+    for n in args.sizes:
+        for result in results[n]:
+            label = f"N={n}, {result.start}, dampers {result.damping:g}"
+            checks.check(
+                result.failure is None and result.splits == 0,
+                f"{label}: the reference converged in one step of h"
+                + ("" if result.failure is None else f" ({result.failure})"),
+            )
+            checks.check(result.finite, f"{label}: {FAST}'s steps finite")
 
 
 # --------------------------------------------------------------------------------------------
@@ -526,8 +884,8 @@ def print_header(args: argparse.Namespace) -> None:
 
 def warm_up() -> None:
     """Compile (or load from Numba's cache) every kernel the runners use, on a small cloth."""
-    for label in RUNNERS:
-        vv.Simulation(cloth_scene(8), method=RUNNERS[label]()).step()
+    for label in METHODS:
+        vv.Simulation(cloth_scene(8), method=METHODS[label]()).step()
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -535,6 +893,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="small sizes; figures mean nothing")
     parser.add_argument("--steps", type=int, default=None, help="timed steps per run")
     parser.add_argument("--retries", type=int, default=None, help="re-runs when contended")
+    parser.add_argument(
+        "--all-accuracy",
+        action="store_true",
+        help=f"the accuracy table's moving start at every N, not only N ≤ {MOVING_UP_TO}"
+        " (minutes more at N = 128)",
+    )
     parser.add_argument(
         "--quiet-wait",
         type=float,
@@ -551,7 +915,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     print_header(args)
     checks = Checks()
     runs = bench_runs(args)
-    summarise(args, runs, checks)
+    errors = measure_accuracy(args)
+    summarise(args, runs, errors, checks)
+    print_fast(args, runs)
+    print_accuracy(args, errors, checks)
     return finish(started, checks)
 
 
