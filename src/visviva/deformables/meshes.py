@@ -14,6 +14,10 @@ mesh. A particle sits at each vertex; springs rest at their lengths as built.
   needs diagonal springs. Each vertex weighs the density times a quarter of the volume of each
   tetrahedron around it, so the body weighs density × volume.
 
+A cloth mesh is drawn by its triangles as given (each one's front is the side it is
+counter-clockwise from); a soft mesh by its boundary, the faces in one tetrahedron only, wound
+outward (:func:`.surfaces.boundary_triangles`).
+
 A mesh is refused, at the triangle, tetrahedron or vertex at fault, when an index is past the
 vertices, a cell has no area or volume (or, for tetrahedra, is inside out: the standard
 orientation is (v1 − v0)·((v2 − v0) × (v3 − v0)) > 0), two cells have the same vertices, a
@@ -29,6 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
+from .surfaces import boundary_triangles
 from .topology import (
     _BEYOND_A_FLOAT,
     BEND,
@@ -55,9 +60,10 @@ def cloth_mesh(
     vertices: np.ndarray, triangles: np.ndarray, density: float, stretch: float, bend: float
 ) -> SpringNetwork:
     """Cloth on the triangle mesh ``vertices`` ``(n, 3)`` [m], ``triangles`` ``(T, 3)``
-    (indices into ``vertices``; orientation does not matter), of areal ``density`` [kg/m²]:
-    :data:`STRETCH` springs of ``stretch`` [N/m] on every edge, then :data:`BEND` springs of
-    ``bend`` [N/m] across every edge two triangles share (none if 0).
+    (indices into ``vertices``; their orientation only chooses the front drawn), of areal
+    ``density`` [kg/m²]: :data:`STRETCH` springs of ``stretch`` [N/m] on every edge, then
+    :data:`BEND` springs of ``bend`` [N/m] across every edge two triangles share (none if 0);
+    drawn by ``triangles``.
 
     Raises:
         DeformableError: At ``triangles`` (and the triangle) for an index past the vertices,
@@ -106,7 +112,7 @@ def cloth_mesh(
             cells.reshape(-1), weights=np.repeat(double_area, 3), minlength=vertices.shape[0]
         )
     )
-    return _network(vertices, mass, families)
+    return _network(vertices, mass, families, faces=cells)
 
 
 @_overflow_judged_later
@@ -115,7 +121,8 @@ def soft_mesh(
 ) -> SpringNetwork:
     """A soft body on the tetrahedral mesh ``vertices`` ``(n, 3)`` [m], ``tetrahedra``
     ``(T, 4)`` (indices into ``vertices``, each with (v1 − v0)·((v2 − v0) × (v3 − v0)) > 0), of
-    ``density`` [kg/m³]: a :data:`STRETCH` spring of ``stiffness`` [N/m] on every edge.
+    ``density`` [kg/m³]: a :data:`STRETCH` spring of ``stiffness`` [N/m] on every edge; drawn
+    by the boundary triangles, wound outward.
 
     Raises:
         DeformableError: At ``tetrahedra`` (and the tetrahedron) for an index past the
@@ -150,7 +157,8 @@ def soft_mesh(
             cells.reshape(-1), weights=np.repeat(six_volume, 4), minlength=vertices.shape[0]
         )
     )
-    return _network(vertices, mass, [_springs(edges[:, 0], edges[:, 1], stiffness, STRETCH)])
+    springs = [_springs(edges[:, 0], edges[:, 1], stiffness, STRETCH)]
+    return _network(vertices, mass, springs, faces=boundary_triangles(cells))
 
 
 def _cells(

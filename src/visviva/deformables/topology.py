@@ -24,7 +24,7 @@ springs join.
 
 Every spring rests at the distance of its points as built — a network starts unstressed —
 unless a spring graph is given rest lengths. Triangle and tetrahedral meshes are in
-:mod:`.meshes`.
+:mod:`.meshes`; the triangles that draw a sheet's or a soft body's surface, in :mod:`.surfaces`.
 
 References:
     K.-J. Choi, H.-S. Ko, "Stable but responsive cloth", SIGGRAPH 2002.
@@ -35,12 +35,13 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ..errors import ModelError
+from .surfaces import box_triangles, grid_triangles, no_triangles
 
 __all__ = [
     "BEND",
@@ -78,7 +79,7 @@ class DeformableError(ModelError):
 
 @dataclass(frozen=True)
 class SpringNetwork:
-    """Particles and the springs between them.
+    """Particles, the springs between them, and the surface that draws them.
 
     Attributes:
         points: ``(n, 3)`` positions [m].
@@ -89,6 +90,10 @@ class SpringNetwork:
             :data:`TORSION`.
         given_rest_length: ``(S,)`` rest lengths [m] chosen for the springs, or ``None``: each
             spring rests at its length as built.
+        faces: ``(F, 3)`` int64 indices of the particles of each triangle of the body's
+            surface, counter-clockwise seen from outside (a soft body) or from the front (a
+            cloth); ``(0, 3)`` for ropes, hair and spring graphs. Drawn only: no force acts on
+            them (see :mod:`.surfaces`).
     """
 
     points: np.ndarray
@@ -97,6 +102,7 @@ class SpringNetwork:
     stiffness: np.ndarray
     family: np.ndarray
     given_rest_length: np.ndarray | None = None
+    faces: np.ndarray = field(default_factory=no_triangles)
 
     def rest_length(self) -> np.ndarray:
         """``(S,)`` each spring's rest length [m]: the given one, or its length as built.
@@ -260,7 +266,9 @@ def cloth_grid(
     """A sheet of ``nu × nv`` points (``resolution``) spanning the parallelogram ``origin +
     s·along + t·across``, ``s, t ∈ [0, 1]`` [m]; point ``(i, j)`` (``i`` along, ``j`` across)
     has index ``j·nu + i``. Areal ``density`` [kg/m²]; ``stretch``, ``shear`` and ``bend``
-    stiffness [N/m] of each family (a family of stiffness 0 is left out)."""
+    stiffness [N/m] of each family (a family of stiffness 0 is left out). Its surface is two
+    triangles per cell; their front is the side ``across × along`` points to (up for a sheet
+    along +x and across +z, the scene's default)."""
     nu, nv = resolution
     s = np.arange(nu) / (nu - 1)
     t = np.arange(nv) / (nv - 1)
@@ -284,7 +292,8 @@ def cloth_grid(
     if bend > 0.0:
         families.append(_springs(index[:, :-2], index[:, 2:], bend, BEND))
         families.append(_springs(index[:-2, :], index[2:, :], bend, BEND))
-    return _network(points, mass, families)
+    # Columns across, rows along: the triangles face across × along.
+    return _network(points, mass, families, faces=grid_triangles(index.T))
 
 
 @_overflow_judged_later
@@ -300,7 +309,8 @@ def soft_lattice(
     """A box of ``nx × ny × nz`` points (``resolution``) from the corner ``origin`` with edge
     lengths ``size`` [m]; point ``(i, j, k)`` has index ``(k·ny + j)·nx + i``. ``density``
     [kg/m³]; ``stretch``, ``shear`` and ``diagonal`` stiffness [N/m] of the structural,
-    face-diagonal and body-diagonal springs (a family of stiffness 0 is left out)."""
+    face-diagonal and body-diagonal springs (a family of stiffness 0 is left out). Its surface
+    is the box's six faces, two triangles per cell face, wound outward."""
     nx, ny, nz = resolution
     axes = [np.arange(n) / (n - 1) for n in (nx, ny, nz)]
     k, j, i = np.meshgrid(axes[2], axes[1], axes[0], indexing="ij")
@@ -320,7 +330,8 @@ def soft_lattice(
     ):
         if stiffness > 0.0:
             families += [_offset_springs(index, o, stiffness, family) for o in offsets]
-    return _network(points, density * cell * share.reshape(-1), families)
+    mass = density * cell * share.reshape(-1)
+    return _network(points, mass, families, faces=box_triangles(index))
 
 
 def _offset_springs(
@@ -366,8 +377,11 @@ def _network(
     mass: np.ndarray,
     families: Sequence[tuple[np.ndarray, ...]],
     rest: np.ndarray | None = None,
+    *,
+    faces: np.ndarray | None = None,
 ) -> SpringNetwork:
-    """The network of ``families`` (``(pairs, stiffness, family)`` each, in this order)."""
+    """The network of ``families`` (``(pairs, stiffness, family)`` each, in this order), drawn
+    with the triangles ``faces`` (none if ``None``)."""
     if not (np.isfinite(points).all() and np.isfinite(mass).all() and (mass > 0.0).all()):
         raise ModelError(_BEYOND_A_FLOAT)
     return SpringNetwork(
@@ -377,4 +391,5 @@ def _network(
         np.concatenate([f[1] for f in families]) if families else np.zeros(0),
         np.concatenate([f[2] for f in families]) if families else np.zeros(0, np.int8),
         rest,
+        no_triangles() if faces is None else faces,
     )

@@ -13,9 +13,12 @@ from contextlib import contextmanager
 import numba
 import numpy as np
 
+from ..deformables.topology import STRETCH
 from ..forces.springs import Springs
 from ..model.builder import SceneBuilder
 from ..model.model import Model
+from ..model.parts import spring_network
+from ..model.scene_bodies import BODIES
 from ..simulation.recording import Recording
 from ..simulation.simulation import Simulation
 
@@ -66,6 +69,18 @@ def spring_pairs(model: Model) -> tuple[np.ndarray, np.ndarray]:
         np.concatenate([s.pairs for s in springs]),
         np.concatenate([s.rest_length for s in springs]),
     )
+
+
+def stretch_pairs(model: Model) -> np.ndarray:
+    """The particles ``(S, 2)`` of every body's stretch springs (a cloth's structural springs,
+    a soft body's edges): the springs whose strain is the fabric's or the body's stretch."""
+    starts = {g.entity: g.start for g in model.particle_groups}
+    pairs = [np.zeros((0, 2), dtype=np.int64)]
+    for index, entity in enumerate(model.scene.entities):
+        if isinstance(entity, BODIES):
+            network = spring_network(entity)
+            pairs.append(network.pairs[network.family == STRETCH] + starts[index])
+    return np.concatenate(pairs)
 
 
 def spring_forces(model: Model, x: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -14,8 +14,18 @@ Per frame (:func:`frame_fields`), following the recording convention of
     color                 (P, 3)       with colour ramps: sRGB colours in [0, 1]
 
 Once (:func:`static_fields`): the radii and colours that do not change, particle masses, and
-the edges to draw between points: the stretch springs of the deformable bodies, then the
-systems' links (point indices, shifted past the particles).
+what to draw between points (point indices, the systems' shifted past the particles):
+
+    faces   (F, 3) int64  the surfaces of cloth and soft bodies (see
+                          :mod:`visviva.deformables.surfaces`)
+    edges   (E, 2) int64  the stretch springs of the bodies without a surface (ropes, hair,
+                          spring graphs), then the systems' links
+
+A body with a surface is drawn by it alone, not by its springs too. The video draws lines
+1.5 px wide whatever the mesh: on a 20 × 20 cloth they made a clear wireframe, but on a 1 m
+cloth of 64 × 64 points framed as in the ``cloth-hang`` demo at 960 × 540 (cells of about
+3 px) they covered the fabric in a dark mat that hid its shading and folds. The USD and glTF
+exports would also repeat every spring beside the mesh, as curves and lines.
 """
 
 from __future__ import annotations
@@ -24,7 +34,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..deformables.topology import STRETCH
 from ..particles.emitters import ramp_values
+from .parts import spring_network
 from .scene_bodies import BODIES
 from .systems import SYSTEMS
 
@@ -128,7 +140,8 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
             )
         if not _varying_color(model) and (model.emitters or np.any(model.particle_color != 1.0)):
             static["color"] = np.concatenate([_colors(model, start), np.ones((extra, 3))])
-    edges, first = _spring_edges(model), count
+    edges, faces = _body_topology(model)
+    first = count
     for system, points in zip(
         [s for s in model.systems if SYSTEMS[s.system].draw is not None],
         _system_points(model, start),
@@ -140,21 +153,27 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
         first += points.shape[0]
     if edges:
         static["edges"] = np.concatenate(edges)
+    if faces:
+        static["faces"] = np.concatenate(faces)
     return static
 
 
-def _spring_edges(model: Model) -> list[np.ndarray]:
-    """The stretch springs of each deformable body (a rope's or hair's segments, a cloth's
-    structural springs or mesh edges, a soft body's edges, every spring of a ``springs``
-    entity), as pairs of point indices (the other families are not drawn: they cross the
-    fabric or the body)."""
-    from ..deformables.topology import STRETCH
-    from .parts import spring_network
+def _body_topology(model: Model) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Each deformable body's drawing, in the scene's point indices: its surface triangles
+    (:attr:`~visviva.deformables.SpringNetwork.faces`) if it has a surface (cloth, soft
+    bodies), else its stretch springs as edges (a rope's or hair's segments, every spring of a
+    ``springs`` entity; bend and torsion springs are not drawn: they skip points).
 
+    Returns:
+        The edge arrays ``(E_b, 2)`` and the triangle arrays ``(F_b, 3)`` of the bodies.
+    """
     starts = {g.entity: g.start for g in model.particle_groups}
-    edges = []
+    edges, faces = [], []
     for index, entity in enumerate(model.scene.entities):
         if isinstance(entity, BODIES):
-            network = spring_network(entity)
-            edges.append(network.pairs[network.family == STRETCH] + starts[index])
-    return edges
+            network, first = spring_network(entity), starts[index]
+            if network.faces.shape[0]:
+                faces.append(network.faces + first)
+            else:
+                edges.append(network.pairs[network.family == STRETCH] + first)
+    return edges, faces

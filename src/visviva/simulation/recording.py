@@ -13,7 +13,8 @@ convention, read back by :meth:`Recording.geometry`:
     static/radius           float64 (P,) [m]: point radii (optional)
     static/edges            int64 (E, 2): pairs of point indices drawn as lines (optional)
     static/faces            int64 (F, 3): triangles of point indices, counter-clockwise seen
-                            from outside (optional)
+                            from outside (optional); their points are drawn as the surface's
+                            vertices, not as spheres (:meth:`Geometry.off_faces`)
     static/color            float64 (P, 3): sRGB colour of each point, in [0, 1] (optional)
     static/display_radius   float64 (P,) [m]: the radius to draw instead of the physical one,
                             where true sizes would be invisible (planets at the scale of their
@@ -119,6 +120,18 @@ class Geometry:
         if self.radius is not None:
             return np.asarray(self.radius, dtype=np.float64)
         return np.full(self.points.shape[1], self.default_radius())
+
+    def off_faces(self) -> np.ndarray:
+        """Indices of the points on no face, int64 ``(n,)``: the points every output draws as
+        spheres (or a point cloud). A point on a face is a vertex of the surface, drawn by it:
+        a cloth of 64 × 64 points 1.6 cm apart would otherwise hide under spheres of its 1 cm
+        particle radius."""
+        count = self.points.shape[1]
+        if self.faces is None:
+            return np.arange(count, dtype=np.int64)
+        on_face = np.zeros(count, dtype=bool)
+        on_face[np.asarray(self.faces, dtype=np.int64).ravel()] = True
+        return np.flatnonzero(~on_face).astype(np.int64)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper corners [m] of the box holding every live point of every frame

@@ -9,7 +9,7 @@ then takes the steps:
 2. each layer casts its shadow onto the ground, along a light from above;
 3. the ground is copied with those shadows, then faces, edges and spheres are drawn into the
    colour and depth buffers (spheres far to near, so their anti-aliased rims blend over what
-   lies behind);
+   lies behind; only the points on no face are spheres, the others are the faces' vertices);
 4. the time label ``t = 1.234 s`` is stamped in the top-left corner.
 
 A geometry kind is a *layer*: an object with ``cast_shadows`` and ``draw``. Rigid bodies will
@@ -200,13 +200,24 @@ class _Layer(Protocol):
 
 
 class _Spheres:
-    def __init__(self) -> None:
+    """The points on no face (:meth:`Geometry.off_faces`; ``points``, or ``None`` for all)."""
+
+    def __init__(self, points: np.ndarray | None) -> None:
+        self.points = points
         self.material = np.array(MATERIAL)
+
+    def _shown(self, frame: _Frame) -> np.ndarray | None:
+        """Indices of the spheres this frame draws (its live points of ``points``), or
+        ``None``: every point."""
+        if self.points is None or frame.live is None:
+            return frame.live if self.points is None else self.points
+        return np.intersect1d(frame.live, self.points, assume_unique=True)
 
     def cast_shadows(self, stage: _Stage, frame: _Frame, shadows: _ShadowMap) -> None:
         positions, radius = frame.positions, frame.radius
-        if frame.live is not None:
-            positions, radius = positions[frame.live], radius[frame.live]
+        shown = self._shown(frame)
+        if shown is not None:
+            positions, radius = positions[shown], radius[shown]
         height = positions[:, 1] - stage.ground_y
         weight = 1.0 / (1.0 + SHADOW_FADE * np.maximum(height, 0.0) / stage.scene)
         ground.splat_discs(
@@ -224,10 +235,11 @@ class _Spheres:
             # Apparent radius of a sphere centred on the axis: f·r / sqrt(z² − r²).
             size = stage.focal * radius / np.sqrt(z * z - radius * radius)
         size[~(z - radius > stage.near) | np.isnan(frame.screen[:, 0])] = np.nan
-        if frame.live is None:
+        shown = self._shown(frame)
+        if shown is None:
             order = np.argsort(-z, kind="stable")
-        else:  # dead points are neither in the order nor of any size
-            order = frame.live[np.argsort(-z[frame.live], kind="stable")]
+        else:  # dead points and face vertices are not in the order
+            order = shown[np.argsort(-z[shown], kind="stable")]
         raster.draw_spheres(
             color,
             depth,
@@ -385,7 +397,10 @@ class FramePainter:
             self.layers.append(_Edges(geometry.edges, self.height))
         if trail > 0.0:
             self.layers.append(_Trails(geometry.points, times, trail, look, self.height))
-        self.layers.append(_Spheres())
+        spheres = geometry.off_faces()
+        if spheres.size:
+            whole = spheres.size == geometry.points.shape[1]
+            self.layers.append(_Spheres(None if whole else spheres))
         self.span = float(times[-1] - times[0]) if times.size else 0.0
         shape = (self.height, self.width)
         self.background = np.empty((*shape, 3), dtype=np.float32)

@@ -26,8 +26,10 @@ them.
 
 Each kind of geometry is one *layer* with its own encoder here and its own builder in
 ``viewer.js`` (``LAYERS``): ``points`` (moving spheres), ``edges`` (lines between points) and
-``faces`` (triangles between points). A new kind (rigid bodies: a position and a quaternion per
-body per frame) is a new encoder and a new builder, with nothing else changed.
+``faces`` (triangles between points). With faces, the points layer's ``spheres`` lists the
+points drawn as spheres (``uint32``): those on no face (:meth:`Geometry.off_faces`). A new
+kind (rigid bodies: a position and a quaternion per body per frame) is a new encoder and a new
+builder, with nothing else changed.
 """
 
 from __future__ import annotations
@@ -93,6 +95,9 @@ def _points_layer(geometry: Geometry, shown: np.ndarray, trail_frames: int) -> d
         layer["frame_colors"] = _differences_u8(_held_values(look.color, shown, held))
     elif look.color is not None:
         layer["colors"] = _base64(np.round(255 * look.color), "u1")
+    spheres = geometry.off_faces()
+    if spheres.size < count:  # the points on faces are drawn by the faces
+        layer["spheres"] = _base64(spheres, "<u4")
     if look.alive is not None:
         alive = look.alive[shown]
         changed = alive.copy()

@@ -243,20 +243,28 @@
   const LAYERS = {
     /* Spheres of the recorded radii: one instanced mesh, a matrix per point per frame. When
      * points are born and die, the live ones of a frame fill the first instances (mesh.count),
-     * each with its radius and colour in that frame. */
+     * each with its radius and colour in that frame. With faces, only the points on no face
+     * (layer.spheres) are spheres: the others are the surface's vertices. */
     points(layer) {
       const radius = layer.radius ? decode(layer.radius, Float32Array) : null;
-      // The finest sphere whose triangles, over all points, fit the budget.
-      let around = SPHERE_SEGMENTS.find((n) => pointCount * n * n <= SPHERE_TRIANGLE_BUDGET);
+      const onFaces = layer.spheres !== undefined; // "" when every point is on a face
+      const sphere = new Uint8Array(pointCount).fill(onFaces ? 0 : 1);
+      if (onFaces) for (const i of decode(layer.spheres, Uint32Array)) sphere[i] = 1;
+      const sphereCount = sphere.reduce((sum, s) => sum + s, 0);
+      // The finest sphere whose triangles, over all spheres, fit the budget.
+      let around = SPHERE_SEGMENTS.find((n) => sphereCount * n * n <= SPHERE_TRIANGLE_BUDGET);
       if (around === undefined) around = SPHERE_SEGMENTS[SPHERE_SEGMENTS.length - 1];
-      const sphere = new THREE.SphereGeometry(1, around, around / 2 + 1);
+      const ball = new THREE.SphereGeometry(1, around, around / 2 + 1);
       const coloured = Boolean(layer.colors || frameColours);
       const material = new THREE.MeshLambertMaterial({
         color: coloured ? 0xffffff : POINT_COLOUR }); // white: instance colours multiply
-      const mesh = new THREE.InstancedMesh(sphere, material, pointCount);
+      const mesh = new THREE.InstancedMesh(ball, material, pointCount);
       const staticRgb = layer.colors ? decode(layer.colors, Uint8Array) : null;
-      // Colours move with their points between instances when points die, or change per frame.
-      const recolour = coloured && Boolean(alive || frameColours);
+      // Instance n is point n unless points die or are on faces: then the instances drawn
+      // are packed, and radii and colours move with their points.
+      const packed = Boolean(alive) || onFaces;
+      // Colours move with their points between instances when packed, or change per frame.
+      const recolour = coloured && Boolean(packed || frameColours);
       if (staticRgb && !recolour) { // per-point sRGB colours of the recording, set once
         for (let i = 0; i < pointCount; i++) mesh.setColorAt(i, srgb(staticRgb, i));
       }
@@ -278,9 +286,9 @@
         const rgb = recolour ? coloursAt(frame, staticRgb) : null;
         let n = 0; // instances drawn
         for (let i = 0; i < pointCount; i++) {
-          if (alive && !alive[base + i]) continue;
+          if (!sphere[i] || (alive && !alive[base + i])) continue;
           const m = 16 * n;
-          if (alive || frameRadii) {
+          if (packed || frameRadii) {
             const r = frameRadii ? frameRadii[base + i] : radius[i];
             matrices[m] = matrices[m + 5] = matrices[m + 10] = r;
           }
