@@ -1,17 +1,17 @@
-"""Conjugate gradients on block-sparse matrices of 3×3 blocks, preconditioned by their diagonal
-blocks: the linear solver of implicit steps on particle systems.
+"""Conjugate gradients on block-sparse matrices of 3×3 blocks: the linear solver of implicit
+steps on particle systems.
 
 A scene's Newton matrix ``A = M − h D − h² K`` has one 3×3 block per pair of particles that a
-force couples (BSR storage: ``indptr``, ``indices``, ``data`` of shape ``(blocks, 3, 3)``).
-Where it is symmetric positive definite — springs with their stiffness projected (see
-:meth:`~visviva.forces.Springs.add_definite_jacobian`) — CG solves it with one matrix–vector
-product per iteration and ``O(N)`` memory. The preconditioner inverts each particle's diagonal
-block, which removes the spread of the masses and of each particle's own stiffness.
+force couples (BSR storage, :mod:`.bsr`). Where it is symmetric positive definite — springs with
+their stiffness projected (see :meth:`~visviva.forces.Springs.add_definite_jacobian`) — CG
+solves it with one matrix–vector product per iteration and ``O(N)`` memory. The preconditioner
+is an aggregation multigrid cycle (:mod:`.multigrid`), or the inverted diagonal blocks alone
+(block Jacobi: which removes the spread of the masses and of each particle's own stiffness,
+but not the coupling across a stiff cloth).
 
-Both kernels run in parallel over block rows (each thread owns its rows: no races, and the sums
-run in a fixed order). A direction of non-positive curvature (``pᵀAp ≤ 0``: the matrix is not
-positive definite) ends the iteration with the iterate so far — the truncated-Newton rule, so an
-unprojected indefinite matrix still gives a usable step — and says so.
+A direction of non-positive curvature (``pᵀAp ≤ 0``: the matrix is not positive definite) ends
+the iteration with the iterate so far — the truncated-Newton rule, so an unprojected indefinite
+matrix still gives a usable step — and says so.
 
 References:
     D. Baraff, A. Witkin, "Large steps in cloth simulation", SIGGRAPH 1998, §5.3 (filtering
@@ -28,71 +28,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["block_cg", "block_product", "diagonal_inverse"]
+from .bsr import block_product
+from .multigrid import Cycle, jacobi, vcycle
 
-
-@njit(cache=True, parallel=True)
-def block_product(indptr, indices, data, x, out):  # pragma: no cover - compiled
-    """``out ← A x`` for ``A`` in BSR form; ``x`` and ``out`` ``(rows, 3)``."""
-    for r in prange(indptr.shape[0] - 1):
-        s0 = s1 = s2 = 0.0
-        for b in range(indptr[r], indptr[r + 1]):
-            c = indices[b]
-            x0, x1, x2 = x[c, 0], x[c, 1], x[c, 2]
-            s0 += data[b, 0, 0] * x0 + data[b, 0, 1] * x1 + data[b, 0, 2] * x2
-            s1 += data[b, 1, 0] * x0 + data[b, 1, 1] * x1 + data[b, 1, 2] * x2
-            s2 += data[b, 2, 0] * x0 + data[b, 2, 1] * x1 + data[b, 2, 2] * x2
-        out[r, 0] = s0
-        out[r, 1] = s1
-        out[r, 2] = s2
-
-
-@njit(cache=True, parallel=True)
-def diagonal_inverse(indptr, indices, data, out):  # pragma: no cover - compiled
-    """``out[r]`` ← the inverse of block ``(r, r)`` (the identity where that block is missing
-    or singular: such a row is left unpreconditioned)."""
-    for r in prange(indptr.shape[0] - 1):
-        for a in range(3):
-            for b in range(3):
-                out[r, a, b] = 1.0 if a == b else 0.0
-        for b in range(indptr[r], indptr[r + 1]):
-            if indices[b] == r:
-                _invert(data[b], out[r])
-
-
-@njit(cache=True, inline="always")
-def _invert(m, out):  # pragma: no cover - compiled
-    """``out ← m⁻¹`` for a 3×3 ``m`` by cofactors; ``out`` unchanged if ``m`` is singular."""
-    c00 = m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1]
-    c01 = m[1, 2] * m[2, 0] - m[1, 0] * m[2, 2]
-    c02 = m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]
-    det = m[0, 0] * c00 + m[0, 1] * c01 + m[0, 2] * c02
-    if det == 0.0 or not np.isfinite(det):
-        return
-    f = 1.0 / det
-    out[0, 0] = c00 * f
-    out[1, 0] = c01 * f
-    out[2, 0] = c02 * f
-    out[0, 1] = (m[0, 2] * m[2, 1] - m[0, 1] * m[2, 2]) * f
-    out[1, 1] = (m[0, 0] * m[2, 2] - m[0, 2] * m[2, 0]) * f
-    out[2, 1] = (m[0, 1] * m[2, 0] - m[0, 0] * m[2, 1]) * f
-    out[0, 2] = (m[0, 1] * m[1, 2] - m[0, 2] * m[1, 1]) * f
-    out[1, 2] = (m[0, 2] * m[1, 0] - m[0, 0] * m[1, 2]) * f
-    out[2, 2] = (m[0, 0] * m[1, 1] - m[0, 1] * m[1, 0]) * f
-
-
-@njit(cache=True, parallel=True)
-def _precondition(inverse, r, z):  # pragma: no cover - compiled
-    """``z ← P r`` with ``P`` the block-diagonal ``inverse``; returns ``r · z``."""
-    total = 0.0
-    for i in prange(r.shape[0]):
-        r0, r1, r2 = r[i, 0], r[i, 1], r[i, 2]
-        z0 = inverse[i, 0, 0] * r0 + inverse[i, 0, 1] * r1 + inverse[i, 0, 2] * r2
-        z1 = inverse[i, 1, 0] * r0 + inverse[i, 1, 1] * r1 + inverse[i, 1, 2] * r2
-        z2 = inverse[i, 2, 0] * r0 + inverse[i, 2, 1] * r1 + inverse[i, 2, 2] * r2
-        z[i, 0], z[i, 1], z[i, 2] = z0, z1, z2
-        total += r0 * z0 + r1 * z1 + r2 * z2
-    return total
+__all__ = ["block_cg"]
 
 
 @njit(cache=True, parallel=True)
@@ -137,7 +76,19 @@ def _new_direction(beta, z, p):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _cg(indptr, indices, data, inverse, normals, b, x, rtol, max_iterations):  # pragma: no cover
+def _precondition(cycle, normals, r, z):  # pragma: no cover - compiled
+    """``z ← B r`` (filtered across ``normals`` if any); returns ``r · z``."""
+    indptr, indices, blocks, inverses, aggregates, factor, residuals, corrections, scratch = cycle
+    vcycle(
+        indptr, indices, blocks, inverses, aggregates, factor, residuals, corrections, scratch, r, z
+    )
+    if normals.shape[0] > 0:
+        _filter(normals, z)
+    return _dot(r, z)
+
+
+@njit(cache=True)
+def _cg(indptr, indices, data, cycle, normals, b, x, rtol, max_iterations):  # pragma: no cover
     rows = b.shape[0]
     filtered = normals.shape[0] > 0
     r = np.empty((rows, 3))
@@ -153,10 +104,7 @@ def _cg(indptr, indices, data, inverse, normals, b, x, rtol, max_iterations):  #
     residual = _dot(r, r)
     if residual <= goal or residual == 0.0:
         return 0, True, True
-    rz = _precondition(inverse, r, z)
-    if filtered:
-        _filter(normals, z)
-        rz = _dot(r, z)
+    rz = _precondition(cycle, normals, r, z)
     p = z.copy()
     for iteration in range(1, max_iterations + 1):
         block_product(indptr, indices, data, p, ap)
@@ -168,10 +116,7 @@ def _cg(indptr, indices, data, inverse, normals, b, x, rtol, max_iterations):  #
         residual = _axpy_pair(rz / curvature, p, ap, x, r)
         if residual <= goal:
             return iteration, True, True
-        rz_new = _precondition(inverse, r, z)
-        if filtered:
-            _filter(normals, z)
-            rz_new = _dot(r, z)
+        rz_new = _precondition(cycle, normals, r, z)
         _new_direction(rz_new / rz, z, p)
         rz = rz_new
     return max_iterations, False, True
@@ -186,6 +131,7 @@ def block_cg(
     rtol: float,
     max_iterations: int,
     normals: np.ndarray | None = None,
+    preconditioner: Cycle | None = None,
 ) -> tuple[int, bool, bool]:
     """Solve ``A x = b`` by preconditioned CG, starting from (and overwriting) ``x``; with
     ``normals``, in the subspace where each row ``x_i`` is orthogonal to ``normals[i]``.
@@ -201,12 +147,13 @@ def block_cg(
             are free): CG then solves ``S A S x = S b`` with ``S`` the projection across the
             normals (Baraff & Witkin's filtered PCG for constrained particles), the residual
             measured after filtering. ``x`` must start in that subspace.
+        preconditioner: The multigrid cycle of ``A`` (:meth:`.multigrid.Hierarchy.cycle`);
+            block Jacobi if not given.
 
     Returns:
         ``(iterations, converged, positive)``: ``positive`` is false if a direction of
         non-positive curvature stopped the iteration.
     """
-    inverse = np.empty((b.shape[0], 3, 3))
-    diagonal_inverse(indptr, indices, data, inverse)
+    cycle = preconditioner if preconditioner is not None else jacobi(indptr, indices, data)
     held = np.zeros((0, 3)) if normals is None else normals
-    return _cg(indptr, indices, data, inverse, held, b, x, rtol, max_iterations)
+    return _cg(indptr, indices, data, cycle.arrays, held, b, x, rtol, max_iterations)

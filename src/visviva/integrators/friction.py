@@ -60,7 +60,7 @@ class LaggedFriction:
         e = self.slip
         f0 = np.where(u >= e, u, -(u**3) / (3 * e * e) + u * u / e + e / 3)
         f0[~np.any(self.normals != 0.0, axis=1)] = 0.0
-        return float(np.dot(self.weight, f0))
+        return float((self.weight * f0).sum())  # not np.dot: see projected_newton._inner
 
     def gradient(self, v: np.ndarray) -> np.ndarray:
         """The friction impulse's negative, ``μ J f₁(u) t`` [N·s], flat ``(3N,)``: what the
