@@ -522,8 +522,8 @@ def bench_runs(args: argparse.Namespace) -> dict[tuple[str, int], Run]:
         " the linear solve (assembling A, preconditioner, CG) per step"
     )
     print(
-        "  solves > Newton: where CG meets negative curvature in the exact (unprojected) matrix,"
-        " the adaptive projection solves again with the definite one"
+        '  solves > Newton: only with projection="adaptive" (not the default), where CG meets'
+        " negative curvature in the exact matrix and solves again with the definite one"
     )
     for n in args.sizes:
         scipy_run = runs[SCIPY, n]
