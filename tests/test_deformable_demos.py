@@ -92,13 +92,23 @@ def test_flag_leans_where_the_wind_and_its_weight_balance(tmp_path):
     assert np.array_equal(staff, np.broadcast_to(staff[0], staff.shape))
 
 
-def test_hair_swings_from_fixed_roots_with_the_period_of_a_hanging_chain(tmp_path):
-    run_demo("hair", tmp_path)  # its full 6 s: five swings of the longest strand
+def test_hair_swings_from_the_turning_head_with_the_period_of_a_hanging_chain(tmp_path):
+    run_demo("hair", tmp_path)  # its full 8 s: the turn, then four swings of the longest strand
     recording = outputs(tmp_path, "hair")
     data = summary(tmp_path)
-    assert data["roots_bit_identical"] is True
-    roots = recording["points"][:, [0, 8, 18, 30, 44]]
-    assert np.array_equal(roots, np.broadcast_to(roots[0], roots.shape))
+    # The roots ride the head: on the hairline circle, turned together, still before and
+    # after the turn, and turned by exactly the head's angle.
+    roots = data["roots"]
+    assert roots["off_hairline_m"] <= roots["tolerance_m"]
+    assert roots["turn_spread_rad"] < 1e-12 and roots["turn_error_rad"] < 1e-12
+    assert roots["still_before_turn"] is True and roots["still_after_stop"] is True
+    t, velocities = recording.time, recording["velocities"][:, [0, 8, 18, 30, 44]]
+    turn = data["head_turn"]
+    during = (t > turn["start"] + turn["ramp"]) & (t < turn["stop"] - turn["ramp"])
+    # At full speed each root moves at ω R along the hairline, and before and after, not at all.
+    speed = np.linalg.norm(velocities, axis=-1)
+    assert speed[during] == pytest.approx(turn["angular_velocity"] * 0.1, rel=1e-12)
+    assert not speed[(t < turn["start"]) | (t >= turn["stop"])].any()
     # Suddenly loaded: at most twice the static stretch (plus the swing's pull).
     stretch = data["largest_stretch"]
     assert stretch["static"] < stretch["measured"] <= stretch["bound_2_static_1_plus_amplitude2"]

@@ -2,23 +2,29 @@
 
 Five strands (Selle, Lentine & Fedkiw 2008: edge springs between neighbours, bending springs
 between points two apart, torsion springs between points three apart) hang from roots on the
-hairline behind a head, 8 to 16 points 4 cm apart (28 to 60 cm). Moving handles are not a
-feature yet, so the head's motion is given to the hair: the head has turned and stopped, and
-each strand starts turning about its root at ``Ω`` (a point ``s`` below its root moves sideways
-at ``Ω s``), while its root stays pinned. Stepped by symplectic Euler with substeps well below
-the stability advisor's limit, so the swing is hardly damped by the method.
+hairline behind a head, 8 to 16 points 4 cm apart (28 to 60 cm). Each strand's root is pinned
+to the head by a handle (:mod:`visviva.particles.handles`): the head turns by
+:data:`TURN_ANGLE` about the vertical through :data:`HEAD` between :data:`TURN_START` and
+:data:`TURN_STOP`, speeding up and slowing down over :data:`TURN_RAMP`, and then holds still;
+the strands are dragged round with it and swing after it stops. Stepped by symplectic Euler
+with substeps well below the stability advisor's limit, so the swing is hardly damped by the
+method.
 
 Checks against physics:
 
-* the roots stay where they are, bit for bit, in every frame;
+* the roots move with the head and only with it: at every frame on the hairline circle (radius
+  :data:`HAIRLINE_RADIUS` about the head's axis, at its height) to round-off, all turned by the
+  same angle, bit for bit where they were before the turn, bit for bit still after it, turned
+  by exactly :data:`TURN_ANGLE`;
 * the strands start unstretched, so gravity loads their springs at once: a suddenly loaded
   spring overshoots to at most twice its static stretch (dampers only lower it), and the
   swing's centripetal pull adds about ``θ₀²`` of the weight at an amplitude ``θ₀``: no edge
   stretches beyond ``2 ε (1 + θ₀²)``, ``ε`` the largest static stretch. A vertical strand's
   springs all lie along it, so its statics is linear: ``K y = −m g`` with ``K`` the 1-D
   stiffness of the three families (solved exactly here);
-* the swing's period at small amplitude. A straight strand's bending and torsion springs lie
-  along it and give no stiffness against a small sideways bend; each spring under tension
+* the swing's period at small amplitude, once the head has stopped (its offsets measured
+  along the hairline's tangent at the root). A straight strand's bending and torsion springs
+  lie along it and give no stiffness against a small sideways bend; each spring under tension
   ``f`` resists a sideways offset of its ends by ``f/l`` only. The strand swings like a
   hanging chain, whose slowest mode is computed exactly from the static tensions
   (:func:`chain_period`; the measured period is within :data:`PERIOD_TOLERANCE` of it). For
@@ -52,7 +58,7 @@ from ._deformables import GRAVITY, one_thread, spring_pairs, strain
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-DURATION = 6.0  # [s]: five swings of the longest strand
+DURATION = 8.0  # [s]: the turn, then four swings of the longest strand
 DT = 1.0 / 60.0  # [s]
 SUBSTEPS = 30  # h = 0.56 ms; the advisor's limit for these strands is 1.56 ms
 METHOD = "symplectic_euler"
@@ -66,14 +72,21 @@ DAMPING = 0.002  # [N·s/m]
 HEAD = (0.0, 1.5, 0.0)  # [m]: centre of the hairline
 HAIRLINE_RADIUS = 0.1  # [m]
 HAIRLINE_ANGLES = (-60.0, -30.0, 0.0, 30.0, 60.0)  # [degrees] round the back of the head
-TURN = 0.4  # Ω [rad/s]: the head's turn, given to the hair
+TURN_ANGLE = 0.8  # [rad]: how far the head turns (46°), about the vertical through HEAD
+TURN_START, TURN_STOP = 1.0, 2.2  # [s]: after gravity's first pull on the strands has rung out
+TURN_RAMP = 0.4  # [s]: the head speeds up, and slows down, over this long
+#: The head's angular velocity at full speed [rad/s]: each ramp gains half its length.
+TURN_RATE = TURN_ANGLE / (TURN_STOP - TURN_START - TURN_RAMP)
+#: The roots' largest distance from the hairline circle and from the turned positions [m]:
+#: round-off of positions of order 1 m.
+ROOT_TOLERANCE = 1e-12
 #: The measured period may differ this much (relative) from the hanging chain's: the method's
 #: error (ωh)²/24 is 1e-6, the amplitude's θ₀²/16 is 3e-4; the higher modes shift the
 #: crossings that the period is read from.
 PERIOD_TOLERANCE = 0.01
 #: ... and from the compound pendulum's, which is 2 % stiffer than a chain of the same length.
 COMPOUND_TOLERANCE = 0.05
-DESCRIPTION = "five strands of hair, 28 to 60 cm, swinging from their pinned roots"
+DESCRIPTION = "five strands of hair, 28 to 60 cm, swinging after the head turns and stops"
 
 
 def strand_points(count: int, angle: float) -> np.ndarray:
@@ -84,15 +97,24 @@ def strand_points(count: int, angle: float) -> np.ndarray:
     return root - np.outer(SPACING * np.arange(count), [0.0, 1.0, 0.0])
 
 
+HEAD_TURN = {
+    "pivot": HEAD,
+    "axis": (0.0, 1.0, 0.0),
+    "angular_velocity": TURN_RATE,
+    "start": TURN_START,
+    "stop": TURN_STOP,
+    "ramp": TURN_RAMP,
+}
+
+
 def build_scene(duration: float = DURATION) -> SceneBuilder:
-    """The five strands, each turning about its root at ``TURN``."""
+    """The five strands, their roots on the turning head (:data:`HEAD_TURN`)."""
     builder = SceneBuilder(name="hair", description=DESCRIPTION)
     builder.set_world(gravity=(0.0, -GRAVITY, 0.0))
     builder.set_integration(
         method=METHOD, dt=DT, substeps=SUBSTEPS, duration=duration, record_every=1
     )
     for index, (count, angle) in enumerate(zip(POINTS, HAIRLINE_ANGLES, strict=True)):
-        sideways = TURN * SPACING * np.arange(count)  # Ω s along x
         builder.add_hair(
             strand_points(count, angle),
             mass=MASS,
@@ -100,7 +122,7 @@ def build_scene(duration: float = DURATION) -> SceneBuilder:
             bending=BENDING,
             torsion=TORSION,
             damping=DAMPING,
-            velocities=np.outer(sideways, [1.0, 0.0, 0.0]),
+            handle=HEAD_TURN,
             radius=0.004,
             color=(0.35, 0.2, 0.1),
             name=f"strand{index}",
@@ -168,6 +190,33 @@ def measured_period(t: np.ndarray, sideways: np.ndarray) -> float:
     return float(2.0 * (crossing[-1] - crossing[0]) / (crossing.size - 1))
 
 
+def root_motion(t: np.ndarray, roots: np.ndarray) -> dict[str, Any]:
+    """How the recorded ``roots`` ``(frames, strands, 3)`` [m] at times ``t`` [s] followed the
+    head: the largest distance [m] from the hairline circle, the largest spread [rad] of their
+    turn angles at a frame, whether they held still (bit for bit) before the turn and after it,
+    and the largest error [rad] of the final turn against :data:`TURN_ANGLE`."""
+    offset = roots - np.array(HEAD)
+    radius = np.hypot(offset[..., 0], offset[..., 2])
+    off_circle = np.maximum(np.abs(radius - HAIRLINE_RADIUS), np.abs(offset[..., 1]))
+    # The angle turned (right-handed about +y) since the first frame.
+    start = np.arctan2(offset[0, :, 0], offset[0, :, 2])
+    turned = np.angle(np.exp(1j * (np.arctan2(offset[..., 0], offset[..., 2]) - start)))
+    before, after = t < TURN_START, t >= TURN_STOP
+    return {
+        "off_hairline_m": float(off_circle.max()),
+        "turn_spread_rad": float(np.ptp(turned, axis=1).max()),
+        "still_before_turn": bool(
+            np.array_equal(roots[before], np.broadcast_to(roots[0], roots[before].shape))
+        ),
+        "still_after_stop": bool(
+            np.array_equal(roots[after], np.broadcast_to(roots[-1], roots[after].shape))
+        ),
+        "turn_rad": TURN_ANGLE,
+        "turn_error_rad": float(np.abs(turned[-1] - TURN_ANGLE).max()),
+        "tolerance_m": ROOT_TOLERANCE,
+    }
+
+
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
     model = build_scene(duration).build()
     simulation = Simulation(model)
@@ -179,21 +228,21 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     roots = points[:, model.particle_pinned]
     pairs, _ = spring_pairs(model)
     stretch = strain(model, points, pairs[np.abs(pairs[:, 1] - pairs[:, 0]) == 1])
+    after = t >= TURN_STOP
     strands = []
     for group, count in zip(model.particle_groups, POINTS, strict=True):
         first = group.start
-        offset = points[:, first + 1 : first + count, 0] - points[0, first + 1 : first + count, 0]
+        swing = sideways(points[:, first : first + count])
         length = SPACING * (count - 1)
-        amplitude = float(np.abs(offset[:, -1]).max()) / length
         strands.append(
             {
                 "points": count,
                 "length_m": length,
-                "period_s": measured_period(t, offset.mean(axis=1)),
+                "period_s": measured_period(t[after], swing[after].mean(axis=1)),
                 "hanging_chain_period_s": chain_period(count),
                 "compound_pendulum_period_s": compound_pendulum_period(count),
                 "uniform_rod_period_s": float(2 * np.pi * np.sqrt(2 * length / (3 * GRAVITY))),
-                "amplitude_rad": amplitude,
+                "amplitude_rad": float(np.abs(swing[after, -1]).max()) / length,
                 "static_stretch": float(static_stretch(count)[0].max()),
             }
         )
@@ -205,7 +254,8 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
         "dt": DT,
         "substeps": SUBSTEPS,
         "advisor_largest_stable_step_s": advised,
-        "roots_bit_identical": bool(np.array_equal(roots, np.broadcast_to(roots[0], roots.shape))),
+        "head_turn": HEAD_TURN,
+        "roots": root_motion(t, roots),
         "largest_stretch": {
             "measured": float(stretch.max()),
             "bound_2_static_1_plus_amplitude2": 2.0 * largest_static * (1.0 + amplitude**2),
@@ -217,21 +267,35 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     }
 
 
+def sideways(strand: np.ndarray) -> np.ndarray:
+    """The offsets [m] of a strand's points from its root, ``(frames, count − 1)``, along the
+    hairline's tangent at the root (the direction the head turns it) in each frame: how far
+    the strand lags behind the turning head, and its swing after the head stops."""
+    root = strand[:, :1]
+    radial = root - np.array(HEAD)
+    tangent = np.cross([0.0, 1.0, 0.0], radial)
+    tangent /= np.linalg.norm(tangent, axis=-1, keepdims=True)
+    return np.einsum(
+        "fpk,fpk->fp", strand[:, 1:] - root, np.broadcast_to(tangent, strand[:, 1:].shape)
+    )
+
+
 def _figure(model: Model, t: np.ndarray, points: np.ndarray, strands: list[dict]) -> Figure:
-    """Each strand's sideways swing, and the periods against the chain and the rigid rod."""
+    """Each strand's swing along the hairline, and the periods against the chain and the
+    rigid rod."""
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(12, 4.6), layout="constrained")
     swing, periods = figure.subplots(1, 2)
+    swing.axvspan(TURN_START, TURN_STOP, color="0.9", label="the head turns")
     for group, strand in zip(model.particle_groups, strands, strict=True):
-        tip = group.start + strand["points"] - 1
-        swing.plot(t, 100 * (points[:, tip, 0] - points[0, tip, 0]), lw=1.0,
-                   label=f"{100 * strand['length_m']:.0f} cm")  # fmt: skip
+        offsets = sideways(points[:, group.start : group.start + strand["points"]])
+        swing.plot(t, 100 * offsets[:, -1], lw=1.0, label=f"{100 * strand['length_m']:.0f} cm")
     swing.set_xlabel("t [s]")
-    swing.set_ylabel("tip's sideways offset [cm]")
-    swing.set_title("The swing of each strand's tip")
+    swing.set_ylabel("tip's offset from the root along the hairline [cm]")
+    swing.set_title("The head turns, stops, and the strands swing")
     swing.margins(y=0.3)
-    swing.legend(fontsize=8, ncols=5, loc="upper center")
+    swing.legend(fontsize=8, ncols=3, loc="upper right")
     length = np.array([s["length_m"] for s in strands])
     span = np.linspace(0.9 * length.min(), 1.05 * length.max(), 50)
     periods.plot(span, 2 * np.pi * np.sqrt(2 * span / (3 * GRAVITY)), "k:",
@@ -251,7 +315,8 @@ def _figure(model: Model, t: np.ndarray, points: np.ndarray, strands: list[dict]
 register_demo(
     Demo(
         "hair",
-        "hair strands swing after the head turns: roots fixed, stretch bounded, chain periods",
+        "hair strands swing after the head turns and stops: roots on the head, stretch "
+        "bounded, chain periods",
         DURATION,
         run,
         picture=True,

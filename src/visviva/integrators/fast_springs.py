@@ -19,9 +19,10 @@ Laplacian) and ``J d = Σ k (e_j − e_i) dᵀ``. Alternating
 never increases the objective (block coordinate descent), so each step is stable whatever the
 stiffness, and converges to the backward Euler step. A fixed number of ``iterations`` per step
 trades accuracy for speed (the method's point: a few iterations look right); the iterations are
-counted as ``newton_iterations``. Pinned particles keep their positions (their rows are taken
-out of the solve). The springs' dampers and every other force act explicitly, from the start of
-the step; colliders act after it (the collision stage).
+counted as ``newton_iterations``. Pinned particles keep their positions, and those on a moving
+handle take its position at the step's end (their rows are taken out of the solve). The
+springs' dampers and every other force act explicitly, from the start of the step; colliders
+act after it (the collision stage).
 
 References:
     T. Liu, A. W. Bargteil, J. F. O'Brien, L. Kavan, "Fast simulation of mass-spring systems",
@@ -55,7 +56,8 @@ class FastMassSprings(Integrator):
 
     It steps any system that offers its springs as one network (``system.spring_network()``:
     ``mass`` and ``pinned`` per point, ``first``/``second``/``rest_length``/``stiffness`` per
-    spring and ``elastic(t, x)``, as a scene of particles does); any other system is stepped by
+    spring, ``elastic(t, x)`` and ``held_positions(t, x)``, as a scene of particles does); any
+    other system is stepped by
     :class:`~visviva.integrators.BackwardEuler` instead.
     """
 
@@ -99,10 +101,11 @@ class FastMassSprings(Integrator):
         other = system.force(t, q, v).reshape(count, 3) - network.elastic(t, x_n)
         target = x_n + dt * v_n + (dt * dt) * other / network.mass[:, None]
         x = x_n + dt * v_n
+        held = network.held_positions(t + dt, x_n)  # the pinned where the step ends
         directions = np.empty((network.pairs.shape[0], 3))
         for _ in range(self.iterations):
             _directions(network.first, network.second, network.rest_length, x, directions)
-            x = solver.solve(target, directions, x_n)
+            x = solver.solve(target, directions, held)
             system.counters.newton_iterations += 1
         system.counters.linear_solves += self.iterations
         system.counters.f_evaluations += 1
@@ -143,14 +146,14 @@ class _Global:
             options={"SymmetricMode": True},
         )
 
-    def solve(self, target: np.ndarray, directions: np.ndarray, x_n: np.ndarray) -> np.ndarray:
+    def solve(self, target: np.ndarray, directions: np.ndarray, held: np.ndarray) -> np.ndarray:
         """``x`` with ``(M + h² L) x = M y + h² J d`` on the free particles, the pinned ones
-        held at ``x_n``."""
+        at their rows of ``held``."""
         rhs = self.mass[:, None] * target + self.h2 * (self.jacobi @ directions)
-        x = x_n.copy()
+        x = held.copy()
         free = rhs[self.free]
         if self.held.shape[0]:
-            free = free - self.coupling @ x_n[self.held]
+            free = free - self.coupling @ held[self.held]
         x[self.free] = self.factor.solve(np.asfortranarray(free))
         return x
 

@@ -3,9 +3,10 @@
 :func:`load_scene` reads a file, refuses what is not a scene (too large, not UTF-8, a syntax
 error with its line and column), validates it against :mod:`~visviva.model.scene` and
 reports each validation problem as ``path: message (got X)`` with the line where it can be
-found and a did-you-mean for misspelt keys. :func:`dump_scene` writes a scene back; floats are
-written with ``repr`` (the shortest text that reads back to the same double), so a
-dump → load round trip is bit-identical.
+found and a did-you-mean for misspelt keys; the files a scene names (a cloth mesh's
+``path``) are taken relative to the scene file's folder. :func:`dump_scene` writes a scene
+back; floats are written with ``repr`` (the shortest text that reads back to the same double),
+so a dump → load round trip is bit-identical.
 """
 
 from __future__ import annotations
@@ -36,7 +37,8 @@ MAX_DEPTH = 16
 
 
 def load_scene(path: str | os.PathLike[str]) -> tuple[Scene, str]:
-    """Read and validate a scene file (``.toml`` or ``.json``).
+    """Read and validate a scene file (``.toml`` or ``.json``); the relative paths of the files
+    it names are made relative to its folder.
 
     Returns:
         The scene and the file's text.
@@ -66,7 +68,20 @@ def load_scene(path: str | os.PathLike[str]) -> tuple[Scene, str]:
             ],
             source,
         ) from None
-    return parse_scene(text, "json" if file.suffix.lower() == ".json" else "toml", source), text
+    scene = parse_scene(text, "json" if file.suffix.lower() == ".json" else "toml", source)
+    return _relative_to(scene, Path(os.path.abspath(file)).parent), text
+
+
+def _relative_to(scene: Scene, folder: Path) -> Scene:
+    """``scene`` with the relative paths of the files its entities name (a cloth mesh's
+    ``path``) made relative to ``folder`` (absolute: the scene may be built elsewhere)."""
+    entities, moved = list(scene.entities), False
+    for index, entity in enumerate(entities):
+        path = getattr(entity, "path", None)
+        if isinstance(path, str) and not os.path.isabs(path):
+            entities[index] = entity.model_copy(update={"path": str(folder / path)})
+            moved = True
+    return scene.model_copy(update={"entities": entities}) if moved else scene
 
 
 def _read_limited(file: Path, source: str) -> bytes:

@@ -37,9 +37,9 @@ def locate_toml(text: str, path: tuple[Any, ...]) -> int | None:
                 name = _split_key(header.group(2))
                 if header.group(1) == "[[":
                     counts[name] = counts.get(name, -1) + 1
-                    table = (*name, counts[name])
+                    table = (*_within(name[:-1], counts), name[-1], counts[name])
                 else:
-                    table = name
+                    table = _within(name, counts)
                 found.setdefault(table, number)
                 continue
             key = _KEY.match(line)
@@ -50,6 +50,17 @@ def locate_toml(text: str, path: tuple[Any, ...]) -> int | None:
         if path[:end] in found:
             return found[path[:end]]
     return None
+
+
+def _within(name: tuple[str, ...], counts: dict[tuple[Any, ...], int]) -> tuple[Any, ...]:
+    """The path of table ``name``, inside the latest element of each array of tables it
+    names (``[entities.handle]`` after the third ``[[entities]]``: ``entities, 2, handle``)."""
+    path: list[Any] = []
+    for end in range(1, len(name) + 1):
+        path.append(name[end - 1])
+        if name[:end] in counts and end < len(name):
+            path.append(counts[name[:end]])
+    return tuple(path)
 
 
 def _bracket_balance(line: str) -> int:

@@ -4,10 +4,12 @@ from .build import build_model
 from .builder import SceneBuilder
 from .model import Integration, Model, ParticleGroup, SystemInstance
 from .scene import Scene
+from .scene_handles import Handle
 from .systems import SYSTEMS
 
 __all__ = [
     "SYSTEMS",
+    "Handle",
     "Integration",
     "Model",
     "ParticleGroup",

@@ -1,16 +1,19 @@
 """From a validated :class:`~visviva.model.scene.Scene` to the frozen :class:`Model`.
 
-The schema checks each field on its own; this module checks what spans fields and entities —
+Mesh files are read first (:mod:`.scene_meshes`). The schema checks each field on its own;
+this module checks what spans fields and entities —
 list lengths that must agree, unique names, targets that name existing entities, the total
 particle count and step count — and reports every problem at once as a
 :class:`~visviva.errors.SceneError`. Only then does it allocate the entity arrays and make the
 pieces the run needs: the particle forces (world gravity first), the named systems' problems,
-the collision stage and the emission stage (:mod:`.parts`).
+and the stages in their order — the bodies' handles, the collisions, the emission
+(:mod:`.parts`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -23,6 +26,7 @@ from .parts import (
     collision_stage,
     emitter_specs,
     force_objects,
+    handle_stage,
     particle_arrays,
     penalty_forces,
     spring_forces,
@@ -38,6 +42,7 @@ from .scene import (
     System,
 )
 from .scene_bodies import BODIES, POINT_BODIES, Body, Hair, Rope, SpringGraph
+from .scene_meshes import with_mesh_files
 from .systems import SYSTEMS
 
 __all__ = ["build_model", "entity_names"]
@@ -61,6 +66,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     Raises:
         SceneError: Listing every problem found.
     """
+    scene = with_mesh_files(scene)  # mesh files read: from here on, every mesh is arrays
     problems = _check(scene)
     if problems:
         raise SceneError(problems)
@@ -91,11 +97,14 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     h = settings.dt / settings.substeps
     try:
         systems = _systems(scene, names)
+        stages: list[Any] = []
+        handles = handle_stage(scene, groups, arrays)
+        if handles is not None:
+            stages.append(handles)
         with np.errstate(all="ignore"):  # overflowing values are judged by the start check
             forces = force_objects(scene, groups, arrays["mass"])
             forces += penalty_forces(scene, groups, arrays, h)
             forces += spring_forces(scene, groups, count)
-        stages = []
         collisions = collision_stage(scene, groups, arrays["pinned"], h)
         if collisions is not None:
             stages.append(collisions)

@@ -5,10 +5,19 @@ The builder holds the same validated scene description a file would
 the same Model, and ``vv.io.dump_scene(builder.scene)`` writes the file that reproduces it. Each
 ``add_*`` validates its entity at once (typed keywords; an argument left at ``None`` takes the
 scene file's default) and returns the entity's index in the scene.
+
+Every deformable body's ``pinned`` points stay where they are, unless its ``handle`` — a
+:class:`~visviva.model.Handle` or a dict of its fields, as in a scene file's
+``[entities.handle]`` table — moves them (:mod:`visviva.particles.handles`)::
+
+    builder.add_hair(points, mass=5e-4, stiffness=200.0, bending=20.0,
+                     handle={"pivot": (0, 1.5, 0), "angular_velocity": 1.6,
+                             "start": 1.0, "stop": 2.0, "ramp": 0.25})
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -32,6 +41,8 @@ from .scene import (
 )
 from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, SpringGraph
 from .scene_errors import scene_problems
+from .scene_handles import Handle
+from .scene_meshes import with_mesh_file
 
 __all__ = ["SceneBuilder"]
 
@@ -146,6 +157,7 @@ class SceneBuilder:
         damping: float | None = None,
         bending: float | None = None,
         pinned: Sequence[int] | None = None,
+        handle: Handle | Mapping[str, Any] | None = None,
         velocities: Any = None,
         radius: float | None = None,
         color: Vector | None = None,
@@ -155,7 +167,7 @@ class SceneBuilder:
         ``mass`` [kg] (one value or one per point), joined in order by springs of
         ``stiffness`` [N/m] and ``damping`` [N·s/m] at rest at the points' distances;
         ``bending`` [N/m] > 0 adds springs between points two apart; the points ``pinned``
-        (indices) stay where they are."""
+        (indices) stay where they are, or follow the ``handle``'s motion."""
         return self._add(Rope, "rope", _given(locals()))
 
     def add_hair(
@@ -168,6 +180,7 @@ class SceneBuilder:
         torsion: float | None = None,
         damping: float | None = None,
         pinned: Sequence[int] | None = None,
+        handle: Handle | Mapping[str, Any] | None = None,
         velocities: Any = None,
         radius: float | None = None,
         color: Vector | None = None,
@@ -179,7 +192,8 @@ class SceneBuilder:
         points, bending springs of ``bending`` [N/m] between points two apart and torsion
         springs of ``torsion`` [N/m] (default none) between points three apart, each with
         ``damping`` [N·s/m]; the points ``pinned`` (default: the root, ``[0]``; ``[]`` for a
-        free strand) stay where they are. Selle et al.'s altitude springs are left out (see
+        free strand) stay where they are, or follow the ``handle``'s motion (a moving head).
+        Selle et al.'s altitude springs are left out (see
         :mod:`visviva.deformables.topology`)."""
         return self._add(Hair, "hair", _given(locals()))
 
@@ -193,6 +207,7 @@ class SceneBuilder:
         rest_length: float | Sequence[float] | None = None,
         damping: float | None = None,
         pinned: Sequence[int] | None = None,
+        handle: Handle | Mapping[str, Any] | None = None,
         velocities: Any = None,
         radius: float | None = None,
         color: Vector | None = None,
@@ -203,7 +218,7 @@ class SceneBuilder:
         (indices into ``points``, each unordered pair once), of ``stiffness`` [N/m] and
         ``rest_length`` [m] (each one value or one per spring; rest lengths by default the
         springs' lengths as built) and ``damping`` [N·s/m]; the points ``pinned`` stay where
-        they are."""
+        they are, or follow the ``handle``'s motion."""
         return self._add(SpringGraph, "springs", _given(locals()))
 
     def add_cloth(
@@ -219,6 +234,7 @@ class SceneBuilder:
         bend: float | None = None,
         damping: float | None = None,
         pinned: Sequence[int] | None = None,
+        handle: Handle | Mapping[str, Any] | None = None,
         velocity: Vector | None = None,
         radius: float | None = None,
         color: Vector | None = None,
@@ -228,7 +244,7 @@ class SceneBuilder:
         + t·across`` [m], of areal ``density`` [kg/m²], with structural springs of ``stretch``
         [N/m], shear springs of ``shear`` (default ``stretch``) and bend springs of ``bend``
         (default none), each with ``damping`` [N·s/m]; point (i, j) has index j·nu + i, and
-        the points ``pinned`` stay where they are."""
+        the points ``pinned`` stay where they are, or follow the ``handle``'s motion."""
         given = _given(locals())
         given["resolution"] = tuple(given["resolution"])
         return self._add(Cloth, "cloth", given)
@@ -245,6 +261,7 @@ class SceneBuilder:
         diagonal: float | None = None,
         damping: float | None = None,
         pinned: Sequence[int] | None = None,
+        handle: Handle | Mapping[str, Any] | None = None,
         velocity: Vector | None = None,
         radius: float | None = None,
         color: Vector | None = None,
@@ -254,21 +271,24 @@ class SceneBuilder:
         from the corner ``origin`` with edge lengths ``size`` [m], of ``density`` [kg/m³],
         with structural springs of ``stretch`` [N/m] and face- and body-diagonal springs of
         ``shear`` and ``diagonal`` (default ``stretch``), each with ``damping`` [N·s/m];
-        point (i, j, k) has index (k·ny + j)·nx + i."""
+        point (i, j, k) has index (k·ny + j)·nx + i; the points ``pinned`` stay where they
+        are, or follow the ``handle``'s motion."""
         given = _given(locals())
         given["resolution"] = tuple(given["resolution"])
         return self._add(SoftLattice, "soft_lattice", given)
 
     def add_cloth_mesh(
         self,
-        vertices: Any,
-        triangles: Any,
+        vertices: Any = None,
+        triangles: Any = None,
         *,
+        path: str | os.PathLike[str] | None = None,
         density: float,
         stretch: float,
         bend: float | None = None,
         damping: float | None = None,
         pinned: Sequence[int] | None = None,
+        handle: Handle | Mapping[str, Any] | None = None,
         velocity: Vector | None = None,
         radius: float | None = None,
         color: Vector | None = None,
@@ -280,8 +300,21 @@ class SceneBuilder:
         ``stretch`` [N/m] on every edge and bend springs of ``bend`` [N/m] (default none)
         between the vertices facing each other across every edge two triangles share, each
         with ``damping`` [N·s/m]. A triangle resists shear by itself: there is no shear
-        family. The vertices ``pinned`` stay where they are."""
-        return self._add(ClothMesh, "cloth_mesh", _given(locals()))
+        family. The vertices ``pinned`` stay where they are, or follow the ``handle``'s
+        motion.
+
+        Instead of ``vertices`` and ``triangles``, ``path`` names a mesh file (OBJ, STL, PLY,
+        OFF, glTF; relative to the working directory), read at once: its vertices are those
+        of :func:`visviva.deformables.mesh_files.read_triangle_mesh`, which ``pinned`` indexes.
+        """
+        given = _given(locals())
+        if "path" in given:
+            given["path"] = os.fspath(given["path"])
+        index = len(self._scene.entities)
+        where = f"entities[{index}]"
+        entity = _validated(ClothMesh, where, **(given | {"type": "cloth_mesh"}))
+        self._replace(entities=[*self._scene.entities, with_mesh_file(entity, where)])
+        return index
 
     def add_soft_mesh(
         self,
@@ -292,6 +325,7 @@ class SceneBuilder:
         stiffness: float,
         damping: float | None = None,
         pinned: Sequence[int] | None = None,
+        handle: Handle | Mapping[str, Any] | None = None,
         velocity: Vector | None = None,
         radius: float | None = None,
         color: Vector | None = None,
@@ -302,7 +336,7 @@ class SceneBuilder:
         quarter of the volume of each of its ``tetrahedra`` ``(T, 4)`` (vertex indices
         [a, b, c, d] with (b − a)·((c − a) × (d − a)) > 0), and a spring of ``stiffness``
         [N/m] and ``damping`` [N·s/m] on every edge; the vertices ``pinned`` stay where they
-        are."""
+        are, or follow the ``handle``'s motion."""
         return self._add(SoftMesh, "soft_mesh", _given(locals()))
 
     def add_system(
@@ -428,6 +462,8 @@ def _given(arguments: dict[str, Any]) -> dict[str, Any]:
 
 
 def _plain(value: Any) -> Any:
+    if isinstance(value, BaseModel):  # a table given as its schema (a Handle): validated again
+        return _plain(value.model_dump(exclude_none=True))
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):
@@ -444,7 +480,7 @@ def _validated(schema: type[Any], where: str, /, **fields: Any) -> Any:
     try:
         return schema.model_validate(fields)
     except ValidationError as exc:
-        problems = scene_problems(exc, fields, lambda path: None)
+        problems = scene_problems(exc, fields, lambda path: None, schema)
         for i, problem in enumerate(problems):
             path = f"{where}.{problem.path}" if problem.path else where
             problems[i] = type(problem)(path, problem.message, problem.got)

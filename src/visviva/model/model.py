@@ -138,13 +138,13 @@ class Model:
         particle_radius: Initial radii [m], shape ``(particle_count,)``.
         particle_color: sRGB colours in [0, 1], shape ``(particle_count, 3)``.
         particle_alive: Which slots hold a particle at the start, ``(particle_count,)``.
-        particle_pinned: Which particles are held where they start (no force moves them),
-            ``(particle_count,)``.
+        particle_pinned: Which particles are held — where they start, or on their body's
+            handle's path (no force moves them), ``(particle_count,)``.
         particle_groups: Which entity each range of particle slots came from.
         systems: The named systems, whose coordinates follow the particles' in the state.
         forces: The forces on particles, world gravity first.
         emitters: The emitters (their slots are among the particles').
-        stages: The post-step stages, in order (collisions, then emission).
+        stages: The post-step stages, in order (handles, collisions, then emission).
         output_formats: Extra outputs the scene asks ``visviva run`` for.
         output_fps: Frame rate of videos, viewer and exports [1/s].
         output_speed: Simulated seconds per second of their playback.

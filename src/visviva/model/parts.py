@@ -1,5 +1,5 @@
 """The pieces a Model is made of, each from its scene entities: particle arrays, emitters,
-forces, the collision stage.
+forces, the handles and the collision stage.
 
 Every builder here takes the already-checked scene (:mod:`.build` runs the cross-entity checks
 first) and refuses what only the physics code can judge — a mesh that is not closed, a
@@ -39,6 +39,7 @@ from ..forces import (
 )
 from ..mechanics.gravity import GRAVITATIONAL_CONSTANT
 from ..particles.emitters import SHAPES, EmitterSpec, unit_vector, value_range
+from ..particles.handles import HandleMotion, Handles
 from .model import ParticleGroup
 from .scene import MAX_PARTICLES, Collider, Emitter, ForceField, ParticleCloud, Particles, Scene
 from .scene_bodies import (
@@ -58,6 +59,7 @@ __all__ = [
     "collision_stage",
     "emitter_specs",
     "force_objects",
+    "handle_stage",
     "particle_arrays",
     "penalty_forces",
 ]
@@ -219,6 +221,62 @@ def particle_arrays(
     arrays["alive"] = arrays["alive"].astype(bool)
     arrays["pinned"] = arrays["pinned"].astype(bool)
     return arrays, groups
+
+
+def handle_stage(
+    scene: Scene, groups: Sequence[ParticleGroup], arrays: dict[str, np.ndarray]
+) -> Handles | None:
+    """The handles of the scene's bodies (``None`` if none has one); the handled particles'
+    ``position`` and ``velocity`` in ``arrays`` are set (in place) to their handles' at t = 0.
+
+    Raises:
+        Located: For a handle whose path leaves the range of a float within the run.
+    """
+    starts = {g.entity: g.start for g in groups}
+    motions, particles = [], []
+    for index, entity in enumerate(scene.entities):
+        if not isinstance(entity, BODIES) or entity.handle is None:
+            continue
+        held = starts[index] + np.array(sorted(set(entity.pinned)), dtype=np.int64)
+        where = f"entities[{index}].handle"
+        motion = _motion(entity.handle, arrays["position"][held], where)
+        travel, turn, spin = motion.largest_extent(scene.integration.duration)
+        reach = float(np.abs(arrays["position"][held] - motion.pivot).max()) + travel
+        if not all(math.isfinite(v) and v < 1e300 for v in (reach, turn, spin * reach)):
+            raise Located(
+                where,
+                "this motion takes the points beyond the range of a float within the run's "
+                f"duration ({scene.integration.duration!r} s): use smaller speeds or other units",
+            )
+        motions.append(motion)
+        particles.append(held)
+    if not motions:
+        return None
+    stage = Handles(motions, particles, [arrays["position"][p] for p in particles])
+    arrays["position"][stage.indices], arrays["velocity"][stage.indices] = stage.place(0.0)
+    return stage
+
+
+def _motion(handle: Any, points: np.ndarray, where: str) -> HandleMotion:
+    """A handle's schema in numbers (the pivot by default at its ``points``' centroid)."""
+    pivot = points.mean(axis=0) if handle.pivot is None else np.array(handle.pivot, dtype=float)
+    axis = np.array([0.0, 1.0, 0.0])
+    if handle.turns:
+        try:
+            axis = unit_vector("axis", handle.axis)
+        except ModelError as error:
+            raise Located(f"{where}.axis", str(error)) from None
+    return HandleMotion(
+        pivot=pivot,
+        velocity=np.array(handle.velocity, dtype=np.float64),
+        axis=axis,
+        angular_velocity=handle.angular_velocity,
+        amplitude=handle.amplitude,
+        frequency=handle.frequency,
+        start=handle.start,
+        stop=math.inf if handle.stop is None else handle.stop,
+        ramp=handle.ramp,
+    )
 
 
 def _targets(entity: ForceField | Collider, groups: Sequence[ParticleGroup], count: int) -> Targets:

@@ -6,8 +6,9 @@ Curves: ``rope`` (seed 002) and ``hair`` (Selle, Lentine & Fedkiw 2008). Sheets:
 grid, Choi & Ko 2002) and ``cloth_mesh`` (any triangle mesh). Solids: ``soft_lattice`` (a
 lattice, seed 004) and ``soft_mesh`` (any tetrahedral mesh). Any graph: ``springs``. Every
 body's particles enter the state in the order of its points (or vertices), its ``pinned``
-points stay where they are, and every spring rests at its length as built (a ``springs``
-entity may give its own rest lengths).
+points stay where they are — or, with a ``handle`` (:mod:`.scene_handles`), follow its
+prescribed motion — and every spring rests at its length as built (a ``springs`` entity may
+give its own rest lengths).
 
 The schema checks each field (types, signs, finite numbers) and the pins; what only the
 geometry can tell — points that coincide, a triangle without area, a tetrahedron turned inside
@@ -27,6 +28,7 @@ from pydantic import Field, model_validator
 from pydantic_core import PydanticCustomError
 
 from .scene_fields import Color, Index, Name, NonNegative, Positive, Strict, Vector
+from .scene_handles import Handle
 
 __all__ = [
     "BODIES",
@@ -43,6 +45,10 @@ __all__ = [
 
 #: Indices of the points held fixed.
 Pins = list[Index]
+#: A file's path (relative: to the scene file's folder, or the working directory).
+FilePath = Annotated[
+    str, Field(strict=True, min_length=1, max_length=4096, pattern=r"^[^\x00-\x1f]*$")
+]
 #: One value, or one per point (or per spring).
 PositiveEach = Positive | Annotated[list[Positive], Field(min_length=1)]
 
@@ -59,11 +65,15 @@ def _check_pins(pinned: list[int], count: int, body: str) -> None:
 
 
 class _Body(Strict):
-    """What every deformable body's schema shares: its pins must be among its points."""
+    """What every deformable body's schema shares: its pins must be among its points, and a
+    handle moves its pins."""
 
     #: The body's name in messages.
     noun: ClassVar[str]
     pinned: Pins
+    handle: Handle | None = Field(
+        None, description="a prescribed rigid motion of the pinned points (default: they stay)"
+    )
 
     @property
     def point_count(self) -> int:
@@ -72,7 +82,15 @@ class _Body(Strict):
 
     @model_validator(mode="after")
     def _pins_on_the_body(self) -> Self:
-        _check_pins(self.pinned, self.point_count, self.noun)
+        if self.point_count is not None:  # a mesh file's pins are checked once it is read
+            _check_pins(self.pinned, self.point_count, self.noun)
+        if self.handle is not None and not self.pinned:
+            raise PydanticCustomError(
+                "handle_without_pins",
+                "a handle moves the pinned points, and this {body} has none: list the points "
+                "it should move in `pinned`",
+                {"body": self.noun},
+            )
         return self
 
 
@@ -235,22 +253,29 @@ class Cloth(_Body):
 
 
 class ClothMesh(_Body):
-    """``type = "cloth_mesh"``: cloth from any triangle mesh. A particle at each of the
-    ``vertices`` [m], weighing the areal ``density`` [kg/m²] times a third of the area of each
-    triangle around it (so the cloth weighs density × area); *stretch* springs of ``stretch``
-    [N/m] on every edge of the mesh and *bend* springs of ``bend`` [N/m] between the two
-    vertices facing each other across every edge two triangles share; every spring with
-    ``damping`` c [N·s/m]. A triangle resists shear by itself, so a mesh has no shear family.
-    The mesh must be manifold (no edge in three triangles) with every vertex in a triangle."""
+    """``type = "cloth_mesh"``: cloth from any triangle mesh, given as ``vertices`` and
+    ``triangles`` or read from the mesh file at ``path`` (OBJ, STL, PLY, OFF, glTF: see
+    :mod:`visviva.deformables.mesh_files`; in a scene file, a relative path is relative to the
+    scene file's folder). A particle at each vertex [m], weighing the areal ``density``
+    [kg/m²] times a third of the area of each triangle around it (so the cloth weighs
+    density × area); *stretch* springs of ``stretch`` [N/m] on every edge of the mesh and
+    *bend* springs of ``bend`` [N/m] between the two vertices facing each other across every
+    edge two triangles share; every spring with ``damping`` c [N·s/m]. A triangle resists
+    shear by itself, so a mesh has no shear family. The mesh must be manifold (no edge in three
+    triangles) with every vertex in a triangle. A mesh file is read when the scene is built;
+    the built model's scene holds its vertices and triangles instead of the path."""
 
     type: Literal["cloth_mesh"]
     noun: ClassVar[str] = "cloth mesh"
     name: Name | None = None
-    vertices: Annotated[list[Vector], Field(min_length=3)] = Field(
-        description="positions of the mesh's vertices, one particle each [m]"
+    path: FilePath | None = Field(
+        None, description="a mesh file to read the vertices and triangles from"
     )
-    triangles: Annotated[list[tuple[Index, Index, Index]], Field(min_length=1)] = Field(
-        description="the triangles: three indices into `vertices` each"
+    vertices: Annotated[list[Vector], Field(min_length=3)] | None = Field(
+        None, description="positions of the mesh's vertices, one particle each [m]"
+    )
+    triangles: Annotated[list[tuple[Index, Index, Index]], Field(min_length=1)] | None = Field(
+        None, description="the triangles: three indices into `vertices` each"
     )
     density: Positive = Field(description="mass per area [kg/m²]")
     stretch: Positive = Field(description="stiffness of the springs on the edges [N/m]")
@@ -264,9 +289,28 @@ class ClothMesh(_Body):
     color: Color = Field((1.0, 1.0, 1.0), description="sRGB colour in [0, 1]")
 
     @property
-    def point_count(self) -> int:
-        """The mesh's particles, one per vertex."""
-        return len(self.vertices)
+    def point_count(self) -> int | None:  # type: ignore[override]
+        """The mesh's particles, one per vertex (``None`` until its file is read)."""
+        return None if self.vertices is None else len(self.vertices)
+
+    @model_validator(mode="after")
+    def _one_mesh(self) -> Self:
+        given = self.vertices is not None or self.triangles is not None
+        if self.path is not None and given:
+            raise PydanticCustomError(
+                "path_and_arrays",
+                "give the mesh either as `path` (a mesh file) or as `vertices` and "
+                "`triangles`, not both",
+            )
+        if self.path is None and (self.vertices is None or self.triangles is None):
+            missing = "`triangles`" if self.vertices is not None else "`vertices`"
+            raise PydanticCustomError(
+                "no_mesh",
+                "{missing} missing: give the mesh as `vertices` and `triangles`, or as `path` "
+                "(a mesh file)",
+                {"missing": missing if given else "the mesh is"},
+            )
+        return self
 
 
 class SoftLattice(_Body):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from typing import Any
+from typing import Any, get_args
 
 from pydantic import BaseModel, ValidationError
 
@@ -32,9 +32,13 @@ _TABLES: dict[str, type[BaseModel]] = {
 
 
 def scene_problems(
-    exc: ValidationError, raw: dict[str, Any], line_of: Callable[[tuple[Any, ...]], Any]
+    exc: ValidationError,
+    raw: dict[str, Any],
+    line_of: Callable[[tuple[Any, ...]], Any],
+    schema: type[BaseModel] | None = None,
 ) -> list[SceneProblem]:
-    """One problem per field: pydantic reports each branch of a union; keep the telling one."""
+    """One problem per field: pydantic reports each branch of a union; keep the telling one.
+    ``raw`` is the data validated: a whole scene, or one table of ``schema`` (an entity)."""
     chosen: dict[tuple[Any, ...], Any] = {}
     for error in exc.errors(include_url=False):
         path = _field_path(error["loc"])
@@ -54,7 +58,7 @@ def scene_problems(
                 path = (*path, field)
         if error["type"] == "extra_forbidden":
             key = str(path[-1])
-            allowed = _allowed_keys(path[:-1], raw)
+            allowed = _allowed_keys(path[:-1], raw, schema)
             message = f"unknown key.{did_you_mean(key, allowed)} Allowed: {', '.join(allowed)}"
             got = None
         elif error["type"] == "missing":
@@ -81,17 +85,35 @@ def _field_path(loc: tuple[Any, ...]) -> tuple[Any, ...]:
     return tuple(path)
 
 
-def _allowed_keys(path: tuple[Any, ...], raw: dict[str, Any]) -> list[str]:
-    model: type[BaseModel] | None = Scene
-    if len(path) == 1:
-        model = _TABLES.get(str(path[0]))
-    elif len(path) == 2 and path[0] == "entities":
+def _allowed_keys(
+    path: tuple[Any, ...], raw: dict[str, Any], schema: type[BaseModel] | None = None
+) -> list[str]:
+    """The keys allowed in the table at ``path`` of ``raw`` (a scene, or a table of
+    ``schema``)."""
+    model, rest = schema, path
+    if schema is None and path and path[0] != "entities":
+        model, rest = _TABLES.get(str(path[0])), path[1:]
+    elif schema is None and len(path) >= 2:
         entities = raw.get("entities")
         entity = entities[path[1]] if isinstance(entities, list) else None
         model = ENTITY_TYPES.get(str(entity.get("type"))) if isinstance(entity, dict) else None
-    elif path:
-        model = None
+        rest = path[2:]
+    elif schema is None:
+        model = None if path else Scene
+    for key in rest:  # a table inside the entity (a body's `handle`)
+        model = _table_of(model, key)
     return list(model.model_fields) if model is not None else []
+
+
+def _table_of(model: type[BaseModel] | None, key: Any) -> type[BaseModel] | None:
+    """The schema of the table at ``key`` of ``model`` (``None`` if it is not a table)."""
+    field = None if model is None else model.model_fields.get(str(key))
+    if field is None:
+        return None
+    for kind in (field.annotation, *get_args(field.annotation)):
+        if isinstance(kind, type) and issubclass(kind, BaseModel):
+            return kind
+    return None
 
 
 def _dotted(path: tuple[Any, ...]) -> str:

@@ -15,6 +15,11 @@ the mass matrix is diagonal (each particle's mass on its three coordinates, and 
 systems, which give accelerations); the Jacobian, when every piece has an analytic one, is the
 block-diagonal of the particle forces' sparse Jacobian and the systems' dense ones. A scene
 made of a first-order system alone (Dahlquist's test equation) is that system, part ``y``.
+
+Pinned particles feel no force (their rows of the force and of its Jacobians are zero). Those on
+a handle (:mod:`visviva.particles.handles`) are moreover put where their handle holds them at
+the time of each evaluation — positions and velocities — before the forces are summed, so every
+integrator's springs pull from the handle's true place at every stage of a step.
 """
 
 from __future__ import annotations
@@ -34,6 +39,7 @@ from ..ode.mass import Mass
 from ..ode.problems import Problem, SecondOrderProblem
 from ..ode.state import Layout, PartView, State
 from ..ode.system import FirstOrderSystem, SecondOrderSystem
+from ..particles.handles import Handles
 
 if TYPE_CHECKING:
     from ..ode.system import System
@@ -113,19 +119,28 @@ def scene_system(model: Model) -> System:
 
     # Pinned particles feel no net force, so they keep their place (and zero velocity) under
     # every integrator, explicit or implicit: their rows and columns of the Jacobians are
-    # zero too, which takes them out of Newton's linear systems.
+    # zero too, which takes them out of Newton's linear systems. Those on a handle are put on
+    # its path first (`placed`): nothing then depends on their integrated values, so the zero
+    # columns are exact.
     held = np.flatnonzero(np.repeat(model.particle_pinned, 3))
     held_blocks = None
     if held.shape[0] and forces.has_jacobian:
         pinned = model.particle_pinned
         block_rows = np.repeat(np.arange(count), np.diff(forces.indptr))
         held_blocks = np.flatnonzero(pinned[block_rows] | pinned[forces.indices])
+    handles = next((s for s in model.stages if isinstance(s, Handles)), None)
+
+    def placed(t: float, q: np.ndarray, v: np.ndarray | None) -> tuple[Any, Any]:
+        """The particles' positions and velocities ``(count, 3)`` from ``q`` and ``v``, those
+        on handles where their handles hold them at ``t``."""
+        x = q[:n].reshape(count, 3)
+        u = None if v is None else v[:n].reshape(count, 3)
+        return (x, u) if handles is None else handles.hold(t, x, u)
 
     def force(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         out = np.zeros_like(q)
         if count:
-            shape = (count, 3)
-            forces.accumulate(t, q[:n].reshape(shape), v[:n].reshape(shape), out[:n].reshape(shape))
+            forces.accumulate(t, *placed(t, q, v), out[:n].reshape(count, 3))
             out[held] = 0.0
         for a, b, piece in pieces:
             out[a:b] = piece.acceleration(t, q[a:b], v[a:b])
@@ -136,8 +151,7 @@ def scene_system(model: Model) -> System:
 
         stiffness, damping = [], []
         if count:
-            shape = (count, 3)
-            x, u = q[:n].reshape(shape), v[:n].reshape(shape)
+            x, u = placed(t, q, v)
             dfdx, dfdv = forces.jacobian(t, x, u, form)
             if dfdv is None and velocity_dependent:
                 dfdv = sp.bsr_matrix(
@@ -171,7 +185,7 @@ def scene_system(model: Model) -> System:
         return total
 
     def potential(t: float, q: np.ndarray) -> float:
-        return forces.potential(t, q[:n].reshape(count, 3))
+        return forces.potential(t, placed(t, q, None)[0])
 
     velocity_dependent = forces.velocity_dependent or any(p.velocity_dependent for *_, p in pieces)
     analytic = forces.has_jacobian and all(p.has_jacobian for *_, p in pieces)
@@ -183,12 +197,12 @@ def scene_system(model: Model) -> System:
         energy=energy,
         layout=names,
     )
-    if count and not pieces and forces.gradient_form:
+    if count and not pieces and forces.gradient_form and not _damped_handles(model, handles):
         system.potential = potential
     system.contact_constraints = _contact_constraints(model)
     springs = [f for f in model.forces if isinstance(f, Springs)]
     if springs and not pieces:
-        network = SpringView(model.particle_mass, model.particle_pinned, tuple(springs))
+        network = SpringView(model.particle_mass, model.particle_pinned, tuple(springs), handles)
         system.spring_network = lambda: network
     return system
 
@@ -200,13 +214,20 @@ class SpringView:
 
     Attributes:
         mass: ``(N,)`` particle masses [kg].
-        pinned: ``(N,)`` which particles are held.
+        pinned: ``(N,)`` which particles are held (in place, or by a handle).
         forces: The scene's :class:`~visviva.forces.Springs`.
+        handles: The scene's handles, if it has any.
     """
 
     mass: np.ndarray
     pinned: np.ndarray
     forces: tuple[Springs, ...]
+    handles: Handles | None = None
+
+    def held_positions(self, t: float, x: np.ndarray) -> np.ndarray:
+        """The positions ``x`` ``(N, 3)`` [m] with the particles on handles where their handles
+        hold them at ``t`` [s]: ``x`` itself if the scene has no handles, else a copy."""
+        return x if self.handles is None else self.handles.hold(t, x)[0]
 
     @cached_property
     def pairs(self) -> np.ndarray:
@@ -238,6 +259,22 @@ class SpringView:
         for force in self.forces:
             force.accumulate(t, x, still, out)
         return out
+
+
+def _damped_handles(model: Model, handles: Handles | None) -> bool:
+    """True if a damped spring ends on a handled particle. Its damper then pulls the other end
+    by the handle's velocity, a force that depends on positions but is no gradient: the scene's
+    force is no longer ``−∇U + D v``, and implicit steps must not minimize an incremental
+    potential."""
+    if handles is None:
+        return False
+    on_handle = np.zeros(model.particle_count, dtype=bool)
+    on_handle[handles.indices] = True
+    return any(
+        bool((on_handle[f.pairs].any(axis=1) & (f.damping > 0.0)).any())
+        for f in model.forces
+        if isinstance(f, Springs)
+    )
 
 
 def _contact_constraints(
@@ -340,8 +377,9 @@ def as_problem(model: Model) -> Problem:
     """
     if model.stages:
         raise ModelError(
-            "this scene has collisions or emitters, which change its state between steps: run "
-            "it with vv.Simulation or visviva run (a plain problem has only smooth dynamics)"
+            "this scene has collisions, emitters or moving handles, which change its state "
+            "between steps: run it with vv.Simulation or visviva run (a plain problem has only "
+            "smooth dynamics)"
         )
     if len(model.systems) == 1 and not model.particle_count:
         return model.systems[0].problem

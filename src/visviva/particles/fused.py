@@ -25,7 +25,10 @@ passes:
    (:func:`visviva.collision.response.resolve`), the emission stage's ageing and death
    (:func:`visviva.particles.emission.age_one`);
 
-then the step's births (:meth:`~visviva.particles.emission.Emission.give_birth`). The results
+then the step's births (:meth:`~visviva.particles.emission.Emission.give_birth`) and the
+handles' particles put on their paths at the step's end (:class:`~.handles.Handles`; pinned in
+the passes above, they keep their start values there, where the previous step put them —
+on their paths at the step's start, as the springs' forces need them). The results
 are those of the generic pipeline to round-off (the order of the force sum differs), which
 ``tests/test_fused.py`` checks.
 
@@ -52,6 +55,7 @@ from ..forces.fields import Attractor, Damping, Drag, QuadraticDrag, UniformGrav
 from ..forces.laws import attractor_force, quadratic_drag_force, vortex_air_velocity
 from ..forces.springs import Springs, spring_forces, spring_incidence
 from .emission import Emission, age_one
+from .handles import Handles
 
 if TYPE_CHECKING:
     from ..forces.base import Force
@@ -106,6 +110,7 @@ class FusedParticles:
             self.law_masks[force.targets.indices] |= np.uint64(1) << np.uint64(k)
         self.collisions = next((s for s in stages if isinstance(s, ParticleCollisions)), None)
         self.emission = next((s for s in stages if isinstance(s, Emission)), None)
+        self.handles = next((s for s in stages if isinstance(s, Handles)), None)
         self._collision, contacts = _collision_arguments(self.collisions)
         # Which particles take the kernel's pass 2 (none can without emitters, fields by law,
         # and colliders other than a first plane without time of impact).
@@ -128,16 +133,18 @@ class FusedParticles:
     def of(cls, model: Any, method: str) -> FusedParticles | None:
         """The fused step of ``model`` for ``method``, or ``None`` if it has none: the method
         must be symplectic Euler, the scene made only of particles, every force a field or
-        springs (gravitation and penalty contact are not), every stage collisions or
+        springs (gravitation and penalty contact are not), every stage handles, collisions or
         emission."""
         if method != "symplectic_euler" or model.systems or not model.particle_count:
             return None
         if not all(isinstance(f, (*_FIELDS, Springs)) for f in model.forces):
             return None
         # A stage that declares no compiled form keeps the generic pipeline; of those that
-        # do, the fused step knows how to take the collisions' and the emission's place.
+        # do, the fused step knows how to take the handles', the collisions' and the
+        # emission's place.
         if not all(
-            s.compiled and isinstance(s, (ParticleCollisions, Emission)) for s in model.stages
+            s.compiled and isinstance(s, (Handles, ParticleCollisions, Emission))
+            for s in model.stages
         ):
             return None
         laws = [
@@ -197,6 +204,10 @@ class FusedParticles:
         if emission is not None:
             born = emission.give_birth(state.t, t_after, self._x.T, self._v.T, carried)
             self._end = max(self._end, born)
+        if self.handles is not None:
+            position, velocity = self.handles.place(t_after)
+            self._x[:, self.handles.indices] = position.T
+            self._v[:, self.handles.indices] = velocity.T
         self._current = state.from_parts(t_after, state.parts)
         self._settled = False
         return self._current, suspects != 0
