@@ -24,6 +24,7 @@ import io
 import os
 import stat
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -139,7 +140,9 @@ def _load(name: str, data: bytes, kind: str) -> object:
     """trimesh's reading of ``data`` as ``kind`` (a mesh, a scene, points ...)."""
     import trimesh
 
-    options = {"maintain_order": True, "skip_materials": True} if kind == "obj" else {}
+    options: dict[str, Any] = (
+        {"maintain_order": True, "skip_materials": True} if kind == "obj" else {}
+    )
     try:
         return trimesh.load(io.BytesIO(data), file_type=kind, process=False, **options)
     except Exception as exc:  # a parser of untrusted bytes fails in many ways (and kinds)
