@@ -17,8 +17,7 @@ from ..deformables.topology import STRETCH
 from ..forces.springs import Springs
 from ..model.builder import SceneBuilder
 from ..model.model import Model
-from ..model.parts import spring_network
-from ..model.scene_bodies import BODIES
+from ..model.parts import body_networks
 from ..simulation.recording import Recording
 from ..simulation.simulation import Simulation
 
@@ -74,12 +73,9 @@ def spring_pairs(model: Model) -> tuple[np.ndarray, np.ndarray]:
 def stretch_pairs(model: Model) -> np.ndarray:
     """The particles ``(S, 2)`` of every body's stretch springs (a cloth's structural springs,
     a soft body's edges): the springs whose strain is the fabric's or the body's stretch."""
-    starts = {g.entity: g.start for g in model.particle_groups}
     pairs = [np.zeros((0, 2), dtype=np.int64)]
-    for index, entity in enumerate(model.scene.entities):
-        if isinstance(entity, BODIES):
-            network = spring_network(entity)
-            pairs.append(network.pairs[network.family == STRETCH] + starts[index])
+    for network, first in body_networks(model.scene, model.particle_groups):
+        pairs.append(network.pairs[network.family == STRETCH] + first)
     return np.concatenate(pairs)
 
 

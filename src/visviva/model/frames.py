@@ -36,8 +36,7 @@ import numpy as np
 
 from ..deformables.topology import STRETCH
 from ..particles.emitters import ramp_values
-from .parts import spring_network
-from .scene_bodies import BODIES
+from .parts import body_networks
 from .systems import SYSTEMS
 
 if TYPE_CHECKING:
@@ -167,13 +166,10 @@ def _body_topology(model: Model) -> tuple[list[np.ndarray], list[np.ndarray]]:
     Returns:
         The edge arrays ``(E_b, 2)`` and the triangle arrays ``(F_b, 3)`` of the bodies.
     """
-    starts = {g.entity: g.start for g in model.particle_groups}
     edges, faces = [], []
-    for index, entity in enumerate(model.scene.entities):
-        if isinstance(entity, BODIES):
-            network, first = spring_network(entity), starts[index]
-            if network.faces.shape[0]:
-                faces.append(network.faces + first)
-            else:
-                edges.append(network.pairs[network.family == STRETCH] + first)
+    for network, first in body_networks(model.scene, model.particle_groups):
+        if network.faces.shape[0]:
+            faces.append(network.faces + first)
+        else:
+            edges.append(network.pairs[network.family == STRETCH] + first)
     return edges, faces

@@ -9,7 +9,7 @@ quaternion that is not a rotation — by raising :class:`Located` with the entit
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from typing import Any
 
 import numpy as np
@@ -372,6 +372,17 @@ def _placed_by(entity: Body) -> str:
     if isinstance(entity, (ClothMesh, SoftMesh)):
         return "vertices"
     return "points"
+
+
+def body_networks(
+    scene: Scene, groups: Sequence[ParticleGroup]
+) -> Iterator[tuple[SpringNetwork, int]]:
+    """Each deformable body's network and the index of its first particle in the scene (a
+    body's point ``i`` is the scene's ``first + i``)."""
+    starts = {g.entity: g.start for g in groups}
+    for index, entity in enumerate(scene.entities):
+        if isinstance(entity, BODIES):
+            yield spring_network(entity), starts[index]
 
 
 def spring_network(entity: Body) -> SpringNetwork:
