@@ -94,6 +94,11 @@ class Hierarchy:
             level = _coarse_pattern(rows, columns, aggregate, coarse)
             self.levels.append(level)
             rows, columns = level[1], level[2]
+        # What every cycle of this pattern shares, made once: the levels' patterns and the
+        # V-cycle's work space (scratch: nothing in it outlives a cycle's application).
+        self._rows = List([self._pattern[0], *(level[1] for level in self.levels)])
+        self._columns = List([self._pattern[1], *(level[2] for level in self.levels)])
+        self._work = _work_space(self._rows)
 
     def matches(self, indptr: np.ndarray, indices: np.ndarray) -> bool:
         """Whether this hierarchy was built for that pattern."""
@@ -105,13 +110,9 @@ class Hierarchy:
         """The V-cycle for the matrix with blocks ``data`` on this pattern — or plain block
         Jacobi if the coarsest level is not positive definite (then neither is the matrix, and
         CG is to find a direction of negative curvature, not to converge fast)."""
-        cycle = self._cycle(data, self.levels)
-        return cycle if cycle is not None else self._cycle(data, [])
-
-    def _cycle(self, data: np.ndarray, levels: list) -> Cycle | None:
-        indptr, indices = List([self._pattern[0]]), List([self._pattern[1]])
+        indptr, indices = self._rows, self._columns
         blocks, aggregates = List([data]), List.empty_list(numba.int64[::1])
-        for level, (aggregate, rows, columns, block_map) in enumerate(levels):
+        for level, (aggregate, rows, columns, block_map) in enumerate(self.levels):
             if level == 0:
                 # Points held by pins have rows without coupling: keep them out.
                 aggregate, block_map = _without_loose(
@@ -119,8 +120,6 @@ class Hierarchy:
                 )
             coarse = np.empty((columns.shape[0], 3, 3))
             _sum_blocks(block_map, blocks[-1], rows, columns, coarse)
-            indptr.append(rows)
-            indices.append(columns)
             blocks.append(coarse)
             aggregates.append(aggregate)
         inverses = List()
@@ -133,8 +132,8 @@ class Hierarchy:
             try:
                 factor = np.linalg.cholesky(_dense(indptr[-1], indices[-1], blocks[-1]))
             except np.linalg.LinAlgError:
-                return None
-        return Cycle(indptr, indices, blocks, inverses, aggregates, factor)
+                return jacobi(self.indptr, self.indices, data)
+        return Cycle(indptr, indices, blocks, inverses, aggregates, factor, self._work)
 
 
 class Cycle:
@@ -150,12 +149,9 @@ class Cycle:
         inverses: List,
         aggregates: List,
         factor: np.ndarray,
+        work: tuple[List, List, List],
     ) -> None:
-        def space() -> List:
-            return List([np.empty((rows.shape[0] - 1, 3)) for rows in indptr])
-
-        self.arrays = (indptr, indices, blocks, inverses, aggregates, factor)
-        self.arrays += (space(), space(), space())
+        self.arrays = (indptr, indices, blocks, inverses, aggregates, factor, *work)
 
     @property
     def levels(self) -> int:
@@ -174,7 +170,13 @@ def jacobi(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray) -> Cycle:
     diagonal_inverse(indptr, indices, data, inverse)
     rows, columns = List([indptr.astype(np.int64)]), List([indices.astype(np.int64)])
     aggregates = List.empty_list(numba.int64[::1])
-    return Cycle(rows, columns, List([data]), List([inverse]), aggregates, np.empty((0, 0)))
+    blocks, inverses = List([data]), List([inverse])
+    return Cycle(rows, columns, blocks, inverses, aggregates, np.empty((0, 0)), _work_space(rows))
+
+
+def _work_space(indptr: List) -> tuple[List, List, List]:
+    """The V-cycle's residuals, corrections and scratch, ``(n_l, 3)`` per level."""
+    return tuple(List([np.empty((rows.shape[0] - 1, 3)) for rows in indptr]) for _ in range(3))  # type: ignore[return-value]
 
 
 @njit(cache=True)
