@@ -72,8 +72,8 @@ def test_fused_step_is_taken_only_where_it_applies():
 
 @pytest.mark.parametrize("steps", [1, 400])
 def test_fused_cloth_with_pins_and_colliders_agrees_with_the_generic_step(steps):
-    """Springs join the fused step (each spring's force in one pass, gathered by each particle
-    in the next), pinned points take pass 2 and stay where they are: the same cloth as the
+    """Springs join the fused step (a lattice's by its stencil, see test_lattice_springs.py),
+    pinned points take pass 2 and stay where they are: the same cloth as the
     generic pipeline's to round-off, falling onto a floor and a ball in light wind."""
     builder = vv.SceneBuilder(name="fused cloth")
     builder.set_integration(method="symplectic_euler", dt=1e-4, duration=1.0)

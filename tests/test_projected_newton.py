@@ -13,10 +13,9 @@ import scipy.sparse as sp
 
 import visviva as vv
 from visviva.errors import ModelError, NewtonConvergenceError
-from visviva.integrators import ProjectedNewton
+from visviva.integrators import ProjectedNewton, projected_newton
 from visviva.integrators.block_cg import block_cg
 from visviva.integrators.bsr import block_product
-from visviva.integrators import projected_newton
 from visviva.integrators.projected_newton import _Merit, _newton_blocks
 from visviva.model.scene_system import initial_state, scene_system
 

@@ -94,6 +94,10 @@ class SpringNetwork:
             surface, counter-clockwise seen from outside (a soft body) or from the front (a
             cloth); ``(0, 3)`` for ropes, hair and spring graphs. Drawn only: no force acts on
             them (see :mod:`.surfaces`).
+        lattice: The lattice's sizes, fastest first, if the points are one and point
+            ``(i, j[, k])`` is ``(k n1 + j) n0 + i`` (a cloth grid's ``(nu, nv)``, a soft
+            lattice's ``(nx, ny, nz)``); ``None`` otherwise. Springs on a lattice are summed
+            by a stencil (:mod:`visviva.forces.lattice_springs`).
     """
 
     points: np.ndarray
@@ -103,6 +107,7 @@ class SpringNetwork:
     family: np.ndarray
     given_rest_length: np.ndarray | None = None
     faces: np.ndarray = field(default_factory=no_triangles)
+    lattice: tuple[int, ...] | None = None
 
     def rest_length(self) -> np.ndarray:
         """``(S,)`` each spring's rest length [m]: the given one, or its length as built.
@@ -293,7 +298,7 @@ def cloth_grid(
         families.append(_springs(index[:, :-2], index[:, 2:], bend, BEND))
         families.append(_springs(index[:-2, :], index[2:, :], bend, BEND))
     # Columns across, rows along: the triangles face across × along.
-    return _network(points, mass, families, faces=grid_triangles(index.T))
+    return _network(points, mass, families, faces=grid_triangles(index.T), lattice=(nu, nv))
 
 
 @_overflow_judged_later
@@ -331,7 +336,7 @@ def soft_lattice(
         if stiffness > 0.0:
             families += [_offset_springs(index, o, stiffness, family) for o in offsets]
     mass = density * cell * share.reshape(-1)
-    return _network(points, mass, families, faces=box_triangles(index))
+    return _network(points, mass, families, faces=box_triangles(index), lattice=(nx, ny, nz))
 
 
 def _offset_springs(
@@ -379,9 +384,11 @@ def _network(
     rest: np.ndarray | None = None,
     *,
     faces: np.ndarray | None = None,
+    lattice: tuple[int, ...] | None = None,
 ) -> SpringNetwork:
     """The network of ``families`` (``(pairs, stiffness, family)`` each, in this order), drawn
-    with the triangles ``faces`` (none if ``None``)."""
+    with the triangles ``faces`` (none if ``None``), its points a ``lattice`` of these sizes
+    (if not ``None``)."""
     if not (np.isfinite(points).all() and np.isfinite(mass).all() and (mass > 0.0).all()):
         raise ModelError(_BEYOND_A_FLOAT)
     return SpringNetwork(
@@ -392,4 +399,5 @@ def _network(
         np.concatenate([f[2] for f in families]) if families else np.zeros(0, np.int8),
         rest,
         no_triangles() if faces is None else faces,
+        lattice,
     )

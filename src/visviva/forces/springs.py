@@ -32,6 +32,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..errors import ModelError
+from .lattice_springs import SpringStencil
 
 __all__ = ["Springs", "spring_forces", "spring_incidence"]
 
@@ -45,6 +46,10 @@ class Springs:
         stiffness: ``(S,)`` ``k`` [N/m], ≥ 0.
         damping: ``(S,)`` ``c`` [N·s/m], ≥ 0.
         count: Number of particles ``N`` in the scene.
+        lattice: ``(shape, start)`` if the springs join the points of a lattice of ``shape``
+            (two or three sizes, fastest first) whose first point is particle ``start``: the
+            force is then summed by a stencil (:class:`~.lattice_springs.SpringStencil`) if
+            the springs are those of a few offsets, each of one stiffness and damping.
 
     Raises:
         ModelError: Naming the first bad spring: an index out of range, a spring joining a
@@ -64,6 +69,7 @@ class Springs:
         stiffness: np.ndarray,
         damping: np.ndarray,
         count: int,
+        lattice: tuple[tuple[int, ...], int] | None = None,
     ) -> None:
         pairs = np.asarray(pairs)
         if pairs.ndim != 2 or pairs.shape[1] != 2 or not np.issubdtype(pairs.dtype, np.integer):
@@ -90,6 +96,16 @@ class Springs:
             np.diff(self._as_first[0]) + np.diff(self._as_second[0])
         ).astype(np.int64)
         self._columns = np.empty((6, count))  # x, y, z, vx, vy, vz of every particle
+        # The springs as a stencil, if they are a lattice's (see :mod:`.lattice_springs`),
+        # and its force on each of the lattice's points.
+        self.stencil = (
+            None
+            if lattice is None
+            else SpringStencil.of(
+                self.pairs, self.rest_length, self.stiffness, self.damping, *lattice
+            )
+        )
+        self._point_force = np.empty((3, 0 if self.stencil is None else self.stencil.points))
         # An undamped set of springs is conservative (instances may differ from the class).
         self.conservative = not np.any(self.damping)  # type: ignore[misc]
         self.velocity_dependent = bool(np.any(self.damping))  # type: ignore[misc]
@@ -101,10 +117,14 @@ class Springs:
         """Add every spring's force [N] on its two particles to ``out``: each spring's force
         in one parallel pass, then each particle's sum in another (no two threads write the
         same particle, and the sums run in a fixed order: the result does not depend on the
-        thread count)."""
-        fx, fy, fz = self._spring_force
+        thread count); or, on a lattice, each point's sum by the stencil."""
         columns = self._columns
         _columns(x, v, columns)
+        if self.stencil is not None:
+            self.stencil.forces(columns[:3], columns[3:], self._point_force)
+            _add_rows(self._point_force, self.stencil.start, out)
+            return
+        fx, fy, fz = self._spring_force
         spring_forces(
             self._first, self._second, self.rest_length, self.stiffness, self.damping,
             *columns, fx, fy, fz,
@@ -252,6 +272,14 @@ def spring_forces(
         fx[s] = magnitude * ux
         fy[s] = magnitude * uy
         fz[s] = magnitude * uz
+
+
+@njit(cache=True, parallel=True)
+def _add_rows(columns, start, out):  # pragma: no cover - compiled
+    """``out[start + p] += columns[:, p]`` (``out`` ``(N, 3)``, ``columns`` ``(3, n)``)."""
+    for p in prange(columns.shape[1]):
+        for a in range(3):
+            out[start + p, a] += columns[a, p]
 
 
 @njit(cache=True, parallel=True)

@@ -361,7 +361,8 @@ def spring_forces(scene: Scene, groups: Sequence[ParticleGroup], count: int) -> 
             raise _located(index, error, _placed_by(entity)) from None
         first = starts[index]
         pairs = network.pairs + first
-        forces.append(Springs(pairs, rest, network.stiffness, entity.damping, count))
+        lattice = None if network.lattice is None else (network.lattice, first)
+        forces.append(Springs(pairs, rest, network.stiffness, entity.damping, count, lattice))
     return forces
 
 

@@ -4,11 +4,13 @@ A scene of particles under field forces and springs, with colliders, emitters an
 by symplectic Euler (the scenes' default), is bound by memory traffic: the generic pipeline
 reads and writes the particle arrays once for each force, for the integrator's kick and drift,
 for each stage and for the divergence watch. This module takes the whole step in place, on
-every core (``prange``). With springs, a first pass computes each spring's force on its first
-end (:func:`~visviva.forces.springs.spring_forces`, vectorized over springs), and each particle
-sums its springs' forces through its CSR lists in pass 1 below (that pass is then not
-vectorized: a loop per particle; plain particle scenes compile without it). Then, in two
-passes:
+every core (``prange``). With springs, a first pass sums them: the springs of a lattice (a
+cloth grid, a soft lattice) at each point by their stencil
+(:mod:`~visviva.forces.lattice_springs`, vectorized over a row of points), any others by each
+spring's force on its first end (:func:`~visviva.forces.springs.spring_forces`, vectorized
+over springs), which each particle sums through its CSR lists in pass 1 below (that pass is
+then not vectorized: a loop per particle; plain particle scenes and lattices compile without
+it). Then, in two passes:
 
 1. a pass over every particle that the compiler vectorizes (AVX-512: eight particles at a
    time), since every particle takes the same path, with no loop, no call and no conditional
@@ -114,8 +116,12 @@ class FusedParticles:
         self._collision, contacts = _collision_arguments(self.collisions)
         # Which particles take the kernel's pass 2 (none can without emitters, fields by law,
         # and colliders other than a first plane without time of impact).
-        self._springs = _spring_arguments(springs, count)
-        # Each spring's force on its first particle, one array per component.
+        # Springs on lattices are summed per point by their stencils, into ``_point_force``
+        # (zero where no lattice is); the others by a pass over springs into
+        # ``_spring_force`` (each spring's force on its first particle) and the CSR gather.
+        self._stencils = [f.stencil for f in springs if f.stencil is not None]
+        self._point_force = np.zeros((3, count if self._stencils else 0))
+        self._springs = _spring_arguments([f for f in springs if f.stencil is None], count)
         self._spring_force = np.empty(
             (3, 0 if self._springs[0] is None else len(self._springs[0][0]))
         )
@@ -178,6 +184,9 @@ class FusedParticles:
         springs, lists = self._springs
         if springs is not None:
             spring_forces(*springs, *self._x, *self._v, *self._spring_force)
+        for stencil in self._stencils:
+            start = stencil.start
+            stencil.forces(self._x, self._v, self._point_force[:, start : start + stencil.points])
         suspects = _fused(
             *self._x,
             *self._v,
@@ -199,6 +208,7 @@ class FusedParticles:
             self._special,
             None if springs is None else self._spring_force,
             lists,
+            self._point_force if self._stencils else None,
             self.pinned,
         )
         if emission is not None:
@@ -446,11 +456,13 @@ def _fused(
     alive, radius, age, lifetime, size, slot_emitter, size_ramps, slot_ramped, end,
     collider_masks, common_mask, floor, floor_bit, e, mu, rests, near_planes, impact_planes,
     restitution, friction, resting, toi, planes, rows, others, everything,
-    limit, special, spring_force, lists, pinned,
+    limit, special, spring_force, lists, point_force, pinned,
 ):  # pragma: no cover - compiled
     """The step of the module docstring for every particle, in place (positions ``x, y, z``
     and velocities ``vx, vy, vz``, one array per component; ``special`` is scratch, ``None``
-    if no particle can need pass 2); returns how many particles may be beyond ``limit`` or
+    if no particle can need pass 2; the springs' forces come per spring, ``spring_force``
+    summed through ``lists``, and per particle, ``point_force``, each ``None`` if there are
+    none); returns how many particles may be beyond ``limit`` or
     not finite."""
     # fmt: on
     beyond = np.uint64(min(planes, UNROLLED_PLANES))  # mask bits from here on: other colliders
@@ -473,6 +485,10 @@ def _fused(
             ux += h * w * fx
             uy += h * w * fy
             uz += h * w * fz
+        if point_force is not None:
+            ux += h * w * point_force[0, i]
+            uy += h * w * point_force[1, i]
+            uz += h * w * point_force[2, i]
         px, py, pz = sx + h * ux, sy + h * uy, sz + h * uz
         r = radius[i]
         mask = common_mask if collider_masks is None else collider_masks[i]
@@ -544,6 +560,10 @@ def _fused(
             ax += w * fx
             ay += w * fy
             az += w * fz
+        if point_force is not None:
+            ax += w * point_force[0, i]
+            ay += w * point_force[1, i]
+            az += w * point_force[2, i]
         if kinds is not None:
             bits = law_masks[i]
             for k in range(kinds.shape[0]):
