@@ -29,7 +29,7 @@ run one after the other at each N):
 * visviva, block Jacobi: the same with ``preconditioner="jacobi"`` (A's inverted 3×3 diagonal
   blocks), which separates what the preconditioner gains from what the kernels gain;
 * SciPy CG: the block-Jacobi integrator with only its linear solve replaced (``ScipyCGNewton``). It
-  assembles A's blocks with the same Numba kernel as visviva (``_newton_blocks``), converts the
+  assembles A's blocks with the same Numba kernel as visviva (``newton_blocks``), converts the
   BSR matrix to CSR, inverts A's 3×3 diagonal blocks with ``np.linalg.inv`` and solves with
   ``scipy.sparse.linalg.cg`` (x0 = 0, ``rtol=cg_rtol``, ``atol=0``, ``maxiter`` =
   ``cg_max_iterations``), the inverted blocks as its preconditioner. The stopping rule is the
@@ -141,7 +141,7 @@ from bench_integrators import (
     wait_for_quiet,
 )
 from visviva.integrators.fast_springs import _Global
-from visviva.integrators.projected_newton import _newton_blocks, _same_blocks
+from visviva.integrators.newton_solve import newton_blocks, same_blocks
 from visviva.ode.state import State
 
 # --------------------------------------------------------------------------------------------
@@ -260,13 +260,13 @@ class ScipyCGNewton(TimedNewton):
         extra: np.ndarray | None = None,
     ) -> tuple[np.ndarray, bool]:
         """Solve (M − h D − h² K) d = rhs as visviva's ``_solve`` does, with SciPy's CG."""
-        if normals is not None or extra is not None or not _same_blocks(stiffness, damping):
+        if normals is not None or extra is not None or not same_blocks(stiffness, damping):
             raise NotImplementedError("only a free cloth's 3×3-block Newton matrix is handled")
         # The Newton matrix's blocks, exactly as in ProjectedNewton._solve.
         data = np.empty_like(stiffness.data)
         damping_data = stiffness.data[:0] if damping is None else damping.data
         indptr, indices = stiffness.indptr, stiffness.indices
-        _newton_blocks(indptr, indices, stiffness.data, damping_data, mass.reshape(-1, 3), h, data)
+        newton_blocks(indptr, indices, stiffness.data, damping_data, mass.reshape(-1, 3), h, data)
         start = time.perf_counter()
         matrix = sp.bsr_matrix((data, indices, indptr), shape=stiffness.shape).tocsr()
         preconditioner = block_jacobi(indptr, indices, data)

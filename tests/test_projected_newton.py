@@ -16,7 +16,8 @@ from visviva.errors import ModelError, NewtonConvergenceError
 from visviva.integrators import ProjectedNewton, projected_newton
 from visviva.integrators.block_cg import block_cg
 from visviva.integrators.bsr import block_product
-from visviva.integrators.projected_newton import _Merit, _newton_blocks
+from visviva.integrators.newton_solve import newton_blocks
+from visviva.integrators.projected_newton import _Merit
 from visviva.model.scene_system import initial_state, scene_system
 
 H = 1.0 / 60.0
@@ -119,7 +120,7 @@ def test_newton_matrix_is_the_residuals_jacobian():
     mass = system.mass.diagonal()
     stiffness, damping = system.force_jacobian(0.0, q + H * v, v, form="symmetric")
     blocks = np.empty_like(stiffness.data)
-    _newton_blocks(
+    newton_blocks(
         stiffness.indptr, stiffness.indices, stiffness.data, damping.data,
         mass.reshape(-1, 3), H, blocks,
     )  # fmt: skip

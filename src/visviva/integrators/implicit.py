@@ -30,6 +30,7 @@ import numpy as np
 
 from .base import Integrator
 from .newton import NewtonOptions, identity_minus, linear_solve, mass_minus, solve_stage
+from .newton_solve import BlockNewtonSolve
 from .runge_kutta import ButcherTableau, initial_rate
 
 if TYPE_CHECKING:
@@ -148,7 +149,7 @@ class ImplicitMidpoint(ImplicitOneStage):
         )
 
 
-class LinearlyImplicitEuler(Integrator):
+class LinearlyImplicitEuler(BlockNewtonSolve, Integrator):
     """Backward Euler with one Newton iteration: Baraff & Witkin's implicit cloth step.
 
     The force is linearized at the start of the step, ``F(q + Δq, v + Δv) ≈ F + K Δq + D Δv``
@@ -164,6 +165,20 @@ class LinearlyImplicitEuler(Integrator):
     the force is far from linear over a step (first order still). ``K`` is the forces'
     definite Jacobian where the system has one (springs without a compressed spring's negative
     stiffness), which keeps the matrix positive definite when a cloth buckles.
+
+    On a scene's particles (3×3 block-sparse Jacobians) the system is solved as
+    :class:`~.projected_newton.ProjectedNewton` solves each of its Newton iterations (see
+    :mod:`.newton_solve`): by CG with a multigrid preconditioner unless asked otherwise, to a
+    tighter ``cg_rtol`` by default (1e-3, not 1e-2), since no later iteration corrects what CG
+    leaves: on ``benchmarks/bench_implicit_cloth.py``'s 64² cloth after 21 steps of 1/60 s, the
+    lowest point is 0.2 mm from where CG at 1e-4 puts it and 8 mm from converged backward
+    Euler's (the linearization's error). Other systems take a direct solve.
+
+    Args:
+        linear_solver: ``"cg"`` or ``"direct"`` (a sparse LU factorization).
+        preconditioner: CG's: ``"multigrid"`` or ``"jacobi"``.
+        cg_rtol: Relative residual CG reaches.
+        cg_max_iterations: CG iterations allowed per step.
     """
 
     name = "linearly_implicit_euler"
@@ -173,6 +188,16 @@ class LinearlyImplicitEuler(Integrator):
     cost = "1 f-evaluation, 1 Jacobian and 1 linear solve"
     reference = "D. Baraff, A. Witkin, Large steps in cloth simulation, SIGGRAPH 1998, §3"
     summary = "backward Euler linearized once per step (Baraff & Witkin): no Newton iterations"
+
+    def __init__(
+        self,
+        *,
+        linear_solver: str = "cg",
+        preconditioner: str = "multigrid",
+        cg_rtol: float = 1e-3,
+        cg_max_iterations: int = 1000,
+    ) -> None:
+        self._configure_solve(linear_solver, preconditioner, cg_rtol, cg_max_iterations)
 
     def stability_function(self, z: Any) -> np.ndarray:
         return 1.0 / (1.0 - np.asarray(z, dtype=complex))
@@ -190,9 +215,17 @@ class LinearlyImplicitEuler(Integrator):
         # Definite: a buckling spring's negative stiffness would make the matrix indefinite
         # and the linearized step blow up (Baraff & Witkin; Choi & Ko 2002).
         stiffness, damping = system.force_jacobian(t, q, v, force, form="definite")
-        matrix = mass_minus(system.mass, damping, stiffness, dt, v.shape)
         rhs = dt * (force + dt * _product(stiffness, v))
-        v_new = v + linear_solve(system, matrix, rhs)
+        mass = system.mass
+        if mass is None or mass.kind == "diagonal":
+            diagonal = np.ones_like(v) if mass is None else mass.diagonal()
+            change, _ = self._solve(
+                system, np.broadcast_to(diagonal, v.shape), stiffness, damping, dt, rhs
+            )
+        else:
+            matrix = mass_minus(mass, damping, stiffness, dt, v.shape)
+            change = linear_solve(system, matrix, rhs)
+        v_new = v + change
         return state.from_parts(t + dt, (q + dt * v_new, v_new))
 
 

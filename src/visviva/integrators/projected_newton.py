@@ -58,17 +58,15 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from .._validation import real_number, whole_number
 from ..errors import ModelError, NewtonConvergenceError
-from .block_cg import block_cg
 from .bsr import block_product
 from .contact_set import hold_contacts
 from .friction import LaggedFriction
 from .implicit import BackwardEuler, Trapezoidal
-from .multigrid import Hierarchy
-from .newton import NewtonOptions, linear_solve, mass_minus
+from .newton import NewtonOptions
+from .newton_solve import BlockNewtonSolve, same_blocks
 
 if TYPE_CHECKING:
     from ..ode.state import State
@@ -78,8 +76,6 @@ __all__ = ["ProjectedNewton", "ProjectedTrapezoidal"]
 
 #: When the Newton matrix uses the forces' definite (projected) stiffness.
 PROJECTIONS = ("adaptive", "always", "never")
-#: CG's preconditioners.
-PRECONDITIONERS = ("multigrid", "jacobi")
 #: Times a step whose Newton iteration does not converge may be halved (down to h/8).
 SPLITS = 3
 #: Armijo's fraction of the predicted decrease a step must achieve.
@@ -90,7 +86,7 @@ HALVINGS = 12
 ROUNDOFF = 1e-13
 
 
-class ProjectedNewton(BackwardEuler):
+class ProjectedNewton(BlockNewtonSolve, BackwardEuler):
     """Backward Euler solved as an energy minimization (see the module docstring).
 
     Args:
@@ -148,20 +144,9 @@ class ProjectedNewton(BackwardEuler):
                 f"`projection` must be one of {', '.join(map(repr, PROJECTIONS))} "
                 f"(got {projection!r})"
             )
-        if linear_solver not in ("cg", "direct"):
-            raise ModelError(f"`linear_solver` must be 'cg' or 'direct' (got {linear_solver!r})")
-        if preconditioner not in PRECONDITIONERS:
-            raise ModelError(
-                f"`preconditioner` must be one of {', '.join(map(repr, PRECONDITIONERS))} "
-                f"(got {preconditioner!r})"
-            )
-        self.preconditioner = preconditioner
-        self._hierarchy: Hierarchy | None = None  # the multigrid levels of the last pattern
+        self._configure_solve(linear_solver, preconditioner, cg_rtol, cg_max_iterations)
         self.projection = projection
         self.line_search = bool(line_search)
-        self.linear_solver = linear_solver
-        self.cg_rtol = real_number("cg_rtol", cg_rtol, positive=True)
-        self.cg_max_iterations = whole_number("cg_max_iterations", cg_max_iterations, minimum=1)
 
     def step(self, system: System, state: State, dt: float) -> State:
         if not _takes(system, state):
@@ -293,72 +278,6 @@ class ProjectedNewton(BackwardEuler):
             update_norm=norm,
         )
 
-    def _solve(
-        self,
-        system: System,
-        mass: np.ndarray,
-        stiffness: Any,
-        damping: Any,
-        h: float,
-        rhs: np.ndarray,
-        normals: np.ndarray | None = None,
-        extra: np.ndarray | None = None,
-    ) -> tuple[np.ndarray, bool]:
-        """The Newton direction ``d`` with ``(M − h D − h² K + E) d = rhs``, ``E`` the
-        block-diagonal ``extra`` ``(N, 3, 3)`` if given (friction), across ``normals`` if given
-        (see :func:`~.block_cg.block_cg`), and whether the matrix was found positive definite
-        along the way (CG only; a direct solve says yes)."""
-        blocked = _same_blocks(stiffness, damping) and rhs.size % 3 == 0
-        if not blocked:
-            matrix = mass_minus(system.mass, damping, stiffness, h, rhs.shape)
-            return linear_solve(system, matrix, rhs), True
-        data = np.empty_like(stiffness.data)
-        damping_data = stiffness.data[:0] if damping is None else damping.data
-        _newton_blocks(
-            stiffness.indptr, stiffness.indices, stiffness.data, damping_data,
-            mass.reshape(-1, 3), h, data,
-        )  # fmt: skip
-        if extra is not None:
-            _add_diagonal(stiffness.indptr, stiffness.indices, data, extra)
-        if self.linear_solver == "direct":
-            import scipy.sparse as sp
-
-            matrix = sp.bsr_matrix((data, stiffness.indices, stiffness.indptr), stiffness.shape)
-            if normals is not None:
-                # S A S + (I − S), S the projection across the normals: the held components
-                # of d solve to 0, the free ones see A restricted to them.
-                across = np.eye(3) - normals[:, :, None] * normals[:, None, :]
-                rows = np.arange(normals.shape[0] + 1, dtype=np.int32)
-                s = sp.bsr_matrix((across, rows[:-1], rows), stiffness.shape)
-                matrix = s @ matrix @ s + sp.identity(rhs.size) - s
-            return linear_solve(system, matrix.tocsc(), rhs), True
-        system.counters.linear_solves += 1
-        direction = np.zeros((rhs.size // 3, 3))
-        iterations, _, positive = block_cg(
-            stiffness.indptr,
-            stiffness.indices,
-            data,
-            rhs.reshape(-1, 3),
-            direction,
-            self.cg_rtol,
-            self.cg_max_iterations,
-            normals,
-            self._multigrid(stiffness.indptr, stiffness.indices, data),
-        )
-        system.counters.krylov_iterations += iterations
-        # Not converged within the iterations, or stopped by negative curvature: the iterate is
-        # still a descent direction from CG; the line search and Newton's stopping rule judge it.
-        return direction.reshape(rhs.shape), positive
-
-    def _multigrid(self, indptr: np.ndarray, indices: np.ndarray, data: np.ndarray) -> Any:
-        """The multigrid cycle of the Newton matrix (``None`` for block Jacobi); the levels
-        are built once per pattern."""
-        if self.preconditioner != "multigrid":
-            return None
-        if self._hierarchy is None or not self._hierarchy.matches(indptr, indices):
-            self._hierarchy = Hierarchy(indptr, indices)
-        return self._hierarchy.cycle(data)
-
 
 class ProjectedTrapezoidal(ProjectedNewton):
     """The trapezoidal rule solved like :class:`ProjectedNewton`: half a step of explicit
@@ -403,7 +322,7 @@ def _product(matrix: Any, v: np.ndarray) -> np.ndarray:
     """``matrix @ v`` for a 3×3 block-sparse ``matrix`` (``0`` for ``None``)."""
     if matrix is None:
         return np.zeros_like(v)
-    if not _same_blocks(matrix, None):
+    if not same_blocks(matrix, None):
         return np.asarray(matrix @ v)
     out = np.empty((v.size // 3, 3))
     block_product(matrix.indptr, matrix.indices, matrix.data, v.reshape(-1, 3), out)
@@ -460,50 +379,6 @@ class _Merit:
             step *= 0.5
             self.system.counters.line_search_steps += 1
         return step
-
-
-def _same_blocks(stiffness: Any, damping: Any) -> bool:
-    """Both Jacobians block-sparse with 3×3 blocks on one pattern (a scene's particles)."""
-    import scipy.sparse as sp
-
-    def blocked(matrix: Any) -> bool:
-        return sp.isspmatrix_bsr(matrix) and matrix.blocksize == (3, 3)
-
-    if not blocked(stiffness):
-        return False
-    return damping is None or (
-        blocked(damping)
-        and np.array_equal(damping.indptr, stiffness.indptr)
-        and np.array_equal(damping.indices, stiffness.indices)
-    )
-
-
-@njit(cache=True, parallel=True)
-def _add_diagonal(indptr, indices, data, extra):  # pragma: no cover - compiled
-    """``data``'s block ``(r, r)`` += ``extra[r]`` for every block row ``r``."""
-    for r in prange(indptr.shape[0] - 1):
-        for b in range(indptr[r], indptr[r + 1]):
-            if indices[b] == r:
-                for a in range(3):
-                    for c in range(3):
-                        data[b, a, c] += extra[r, a, c]
-
-
-@njit(cache=True, parallel=True)
-def _newton_blocks(indptr, indices, k, d, mass, h, out):  # pragma: no cover - compiled
-    """``out ← M − h D − h² K`` block by block (``D`` may be empty: no damping)."""
-    damped = d.shape[0] > 0
-    for r in prange(indptr.shape[0] - 1):
-        for b in range(indptr[r], indptr[r + 1]):
-            for a in range(3):
-                for c in range(3):
-                    value = -h * h * k[b, a, c]
-                    if damped:
-                        value -= h * d[b, a, c]
-                    out[b, a, c] = value
-            if indices[b] == r:
-                for a in range(3):
-                    out[b, a, a] += mass[r, a]
 
 
 def _decrement_ratio(
