@@ -1,6 +1,7 @@
 #!/usr/bin/env python
-"""Implicit cloth benchmark: backward Euler at h = 1/60 s by projected Newton, visviva's CG
-against SciPy's; and Liu et al.'s fast mass-spring step, with how far it is from converged.
+"""Implicit cloth benchmark: backward Euler at h = 1/60 s by projected Newton and by Baraff &
+Witkin's one linearized solve, visviva's CG against SciPy's; and Liu et al.'s fast mass-spring
+step; with how far the fast steps are from converged.
 
 Run ``python benchmarks/bench_implicit_cloth.py`` (a few minutes on 2 cores) or add ``--quick``
 for a smoke run whose figures mean nothing.
@@ -13,15 +14,27 @@ The scene, the same for every runner, built through visviva's public API (float6
 * areal density 0.1 kg/m²; structural springs k = 1000 N/m, shear 100 N/m, bend 1 N/m, each
   with damping 0.01 N·s/m along it, resting at their initial lengths;
 * the two corners of the first row (points 0 and N − 1) pinned;
-* gravity (0, −9.81, 0) m/s²; steps of h = 1/60 s by ``vv.integrators.ProjectedNewton``:
-  backward Euler solved by Newton's method on the incremental potential, with each spring's
-  stiffness projected to be definite (``projection="always"``, the default), a backtracking
-  line search, and each Newton system A d = −g, A = M − h D − h² K (3×3 blocks), solved by
-  preconditioned conjugate gradients to a relative residual of ``cg_rtol`` = 1e-2.
+* gravity (0, −9.81, 0) m/s²; steps of h = 1/60 s.
+
+The implicit methods, whose linear systems share one matrix, A = M − h D − h² K (3×3 blocks; D
+the dampers', K the springs' stiffness projected to be definite), and one solver
+(``BlockNewtonSolve``: preconditioned conjugate gradients):
+
+* converged backward Euler, ``vv.integrators.ProjectedNewton``: Newton's method on the
+  incremental potential, with each spring's stiffness projected (``projection="always"``, the
+  default), a backtracking line search, and each Newton system A d = −g solved to a relative
+  residual of ``cg_rtol`` = 1e-2;
+* Baraff & Witkin's step, ``vv.integrators.LinearlyImplicitEuler`` (D. Baraff, A. Witkin,
+  "Large steps in cloth simulation", SIGGRAPH 1998): backward Euler with the force linearized
+  once, at the start of the step, which leaves one linear system per step, A Δv = h (F + h K v),
+  v' = v + Δv, x' = x + h v', solved to ``cg_rtol`` = 1e-3 (its default: no later iteration
+  corrects what CG leaves). Nothing to converge and no line search: one solve, the issue's fast
+  option. What it gives up, the linearization's error, is the accuracy table's.
 
 Runners (each from the same cloth at rest: one warm-up step, which compiles, then the timed
-steps, 30 by default and 5 with ``--quick``, each ``sim.step()`` timed on its own; the three
-run one after the other at each N):
+steps, 30 by default and 5 with ``--quick``, each ``sim.step()`` timed on its own; all run one
+after the other at each N; the linear solve is timed by overriding ``_solve``, in the mixin
+``TimedSolve``):
 
 * visviva: ``ProjectedNewton()`` with its defaults; its linear solve is ``block_cg``, Numba
   kernels running in parallel over block rows on every core, preconditioned by an aggregation
@@ -39,6 +52,15 @@ run one after the other at each N):
   (up to round-off: see the sanity checks) and differs only in the linear solver; the
   multigrid runner's CG iterates differ, and so does its path after a few steps. SciPy's sparse
   products run on one thread;
+* visviva, Baraff–Witkin: ``LinearlyImplicitEuler()`` with its defaults: ``block_cg`` with the
+  multigrid V-cycle, as visviva's, to ``cg_rtol`` = 1e-3;
+* SciPy CG, Baraff–Witkin: the same step with only its linear solve replaced by the same code
+  as SciPy CG's (the mixin ``ScipyCGSolve``: block Jacobi, rtol = the integrator's ``cg_rtol``,
+  1e-3). Its first step from rest, the warm-up, is free fall for both runners: the flat cloth's
+  springs rest at their lengths, their definite stiffness has nothing across the cloth, so
+  across it A is M alone, CG solves it in one iteration and the pins hold no neighbour. From
+  the second step on the two CGs' iterates differ (multigrid against block Jacobi), and so do
+  the runners' positions, by about CG's tolerance;
 * FastMassSprings: ``vv.integrators.FastMassSprings(iterations=10)``, Liu et al.'s (2013)
   local/global solver of the same backward Euler step for the springs: each iteration sets
   every spring's direction (a Numba kernel, parallel) and solves (M + h² L) x = M y + h² J d,
@@ -50,48 +72,65 @@ run one after the other at each N):
   accuracy table's.
 
 Figures per N and runner: wall time per step (mean = total ÷ steps, and the median), Newton
-iterations, linear solves, CG iterations and line-search halvings per step (work counts from
-``sim.system.counters``), CG iterations per Newton iteration, and the wall time spent inside
-the integrator's ``_solve`` per step (assembling A, preconditioner set-up and CG); for
-FastMassSprings, in its own table after the Newton runners', the wall time per step (mean and
-median), its local/global iterations per step (counted as ``newton_iterations``, each a global
-solve), the warm-up step's time and, separately, the one-off construction and factorization of
-M + h² L (``_Global``, timed once on a fresh scene). Then the ratios SciPy ÷ visviva for the
-whole step and for the linear solve, against the targets: at most 16 ms per step at N = 64 and
-60 ms at N = 128 (the mean), and SciPy ÷ visviva ≥ 3 for the whole step; and the ratio of the
-linear solve's time per CG iteration, which does not depend on how many iterations each runner
-took. FastMassSprings' mean stands next to ProjectedNewton's against the same 16 ms / 60 ms,
-with its error from the accuracy table.
+iterations (Baraff–Witkin: 1, its one solve), linear solves, CG iterations and line-search
+halvings per step (work counts from ``sim.system.counters``), CG iterations per Newton
+iteration, and the wall time spent inside the integrator's ``_solve`` per step (assembling A,
+preconditioner set-up and CG); for FastMassSprings, in its own table after the others', the
+wall time per step (mean and median), its local/global iterations per step (counted as
+``newton_iterations``, each a global solve), the warm-up step's time and, separately, the
+one-off construction and factorization of M + h² L (``_Global``, timed once on a fresh scene).
+
+Then the issue's targets: "Implicit cloth at h = 1/60: 64×64 ≤ 16 ms per step (60 fps) and
+128×128 ≤ 60 ms on this class of machine, and ≥ 3× faster than the same Newton step solved with
+SciPy's sparse CG in the same run". Each visviva runner, converged Newton (visviva) and
+Baraff–Witkin, is judged on its own, the mean against 16 ms at N = 64 and 60 ms at N = 128 with
+a yes/no verdict (``--quick``'s sizes have no target), and against the same step with SciPy's
+CG (SciPy CG; SciPy CG, Baraff–Witkin): SciPy ÷ visviva for the whole step (target ≥ 3), for
+the linear solve, and per CG iteration, which does not depend on how many iterations each
+runner took. FastMassSprings' mean stands next to them against the same 16 ms / 60 ms. The
+fast steps' errors from the accuracy table stand next to their times: they do not compute what
+converged Newton computes.
 
 The accuracy table, so that no one takes a truncated iteration for a converged one: from the
 runners' start (the cloth at rest) and from the cloth after 10 steps of ``ProjectedNewton()``
 (moving, about 3 cm per step, and buckled; at N ≤ 64, or every N with ``--all-accuracy``), ONE
-step of h by ``FastMassSprings(iterations=k)``, k = 5, 10, 20, 40, and one by ProjectedNewton
-converged tightly (the reference: rtol 1e-9, atol 1e-10 m/s, ``cg_rtol`` 1e-10, up to 1000
-Newton iterations so that the step is not halved), both starting their
+step of h by ``FastMassSprings(iterations=k)``, k = 5, 10, 20, 40, one by
+``LinearlyImplicitEuler()`` (Baraff–Witkin, as timed), and one by ProjectedNewton converged
+tightly (the reference: rtol 1e-9, atol 1e-10 m/s, ``cg_rtol`` 1e-10, up to 1000 Newton
+iterations so that the step is not halved), the reference and FastMassSprings starting their
 iteration at x_n + h v_n (the state's cached acceleration dropped). Reported: the largest
 distance of a point from the reference's position [m], and that as a share of the largest
 distance a point moves in the reference step. None of it is timed, and it runs on one Numba
-thread (see "Shared machines"). With the scene's dampers that includes their
-explicit treatment; the same starts are also stepped in the scene without dampers, where both
-methods solve the same minimization and what is left is truncation. Measured (quick sizes
+thread (see "Shared machines"). With the scene's dampers FastMassSprings' error includes their
+explicit treatment (Baraff–Witkin's, like the reference, are implicit); the same starts are
+also stepped in the scene without dampers, where FastMassSprings and the reference solve the
+same minimization and what is left is truncation. Measured (quick sizes
 N = 16, 24, and one-off at N = 64): 10 iterations leave 47–60 % of the first step's
 displacement from rest undone (the cloth falls too slowly: M + h² L holds the flat cloth's
 transverse motion as stiffly as its stretching, where its true stiffness across is nearly
 zero) and 7–9 % of a moving step's; 40 iterations 39–51 % and 5–6 %. The dampers change these by
 less than the last digit shown. The iteration converges to the reference, slowly: at N = 16
-without dampers, 10,000 iterations come within 2e-5 m of it (rest) and 3e-6 m (moving). The
+without dampers, 10,000 iterations come within 2e-5 m of it (rest) and 3e-6 m (moving).
+Baraff–Witkin's step is 5–7 % of a moving step's displacement from the reference (N = 16, 24,
+64), about as close as 40 FastMassSprings iterations; from rest it is free fall (see the
+runners), and its error is at the pinned corners' neighbours, which the reference's stretched
+springs hold up: 14 %, 31 % and 70 % of the step's displacement at N = 16, 24, 64 (the finer
+the cloth, the nearer the neighbour to its pin), at most 4e-5 m (1.4 %) beyond the first
+quarter of the cloth from the pinned row (N = 24, 64). The dampers change neither. The
 reference itself is expensive where the cloth buckles: from the moving start at N = 128 it took
 291 Newton and 149,473 CG iterations (560 s on one thread while other processes ran), hence the
 moving start at N ≤ 64 by default.
 
-Sanity checks: no NaN (FastMassSprings' included); after the warm-up step (one step from the
-same start) the two Newton runners' positions agree within 1e-6 m; and after all the steps
-within 5 cm; every reference step of the accuracy table converged without being halved. The two
-Newton runners solve the same equations to the same tolerances, and their CG iterates differ by
-round-off only, but round-off is enough to send the cloth down different paths: within the
-first ten steps it buckles, its incremental potential has more than one minimum, and a
-different Newton iteration count or line-search decision in one step picks another. Measured at
+Sanity checks: no NaN (FastMassSprings' and Baraff–Witkin's included); after the warm-up step
+(one step from the same start) the block-Jacobi and SciPy Newton runners' positions agree within
+1e-6 m (visviva's and SciPy's within 1e-4 m, each solved to Newton's tolerance), and so do the
+two Baraff–Witkin runners' (free fall for both: this guards only against one solving another
+problem); after all the steps each pair within 5 cm; every reference step of the accuracy table
+converged without being halved. The block-Jacobi and SciPy Newton runners solve the same
+equations to the same tolerances, and their CG iterates differ by round-off only, but
+round-off is enough to send the cloth down different paths: within the first ten steps it
+buckles, its incremental potential has more than one minimum, and a different Newton iteration
+count or line-search decision in one step picks another. Measured at
 N = 64 (default tolerances): the positions agree to 1e-16 m for two steps, 1e-7 m after six,
 then the runners part (steps 7–8, one Newton iteration more in one of them) and differ by up to
 1.1 cm (step 16), 2.6 mm after 31 steps. With the tolerances tightened (Newton's rtol 1e-9,
@@ -141,7 +180,7 @@ from bench_integrators import (
     wait_for_quiet,
 )
 from visviva.integrators.fast_springs import _Global
-from visviva.integrators.newton_solve import newton_blocks, same_blocks
+from visviva.integrators.newton_solve import BlockNewtonSolve, newton_blocks, same_blocks
 from visviva.ode.state import State
 
 # --------------------------------------------------------------------------------------------
@@ -222,12 +261,13 @@ def cloth_scene(n: int, damping: float = DAMPING) -> Any:
 # --------------------------------------------------------------------------------------------
 
 
-class TimedNewton(vv.integrators.ProjectedNewton):
-    """``ProjectedNewton`` with its defaults, adding up the wall time [s] of its linear solves
-    (two ``perf_counter`` calls per solve, nothing else)."""
+class TimedSolve(BlockNewtonSolve):
+    """Mixin for an integrator that solves by ``BlockNewtonSolve``: adds up the wall time [s]
+    of its linear solves (two ``perf_counter`` calls per solve, nothing else). It goes before
+    the integrator among the bases, so that its ``_solve`` is the one the step calls."""
 
-    def __init__(self, preconditioner: str = "multigrid") -> None:
-        super().__init__(preconditioner=preconditioner)
+    def __init__(self, **options: Any) -> None:
+        super().__init__(**options)
         self.solve_seconds = 0.0
 
     def _solve(self, *args: Any) -> tuple[np.ndarray, bool]:
@@ -237,12 +277,28 @@ class TimedNewton(vv.integrators.ProjectedNewton):
         return result
 
     def _direction(self, *args: Any) -> tuple[np.ndarray, bool]:
-        """The Newton direction and whether A looked positive definite (visviva's solve)."""
-        return vv.integrators.ProjectedNewton._solve(self, *args)
+        """The solution of the step's linear system and whether A looked positive definite
+        (visviva's solve)."""
+        return super()._solve(*args)
 
 
-class ScipyCGNewton(TimedNewton):
-    """The same integrator, its Newton systems solved by ``scipy.sparse.linalg.cg``."""
+class TimedNewton(TimedSolve, vv.integrators.ProjectedNewton):
+    """``ProjectedNewton`` with its defaults, its linear solves timed."""
+
+    def __init__(self, preconditioner: str = "multigrid") -> None:
+        super().__init__(preconditioner=preconditioner)
+
+
+class TimedBaraffWitkin(TimedSolve, vv.integrators.LinearlyImplicitEuler):
+    """``LinearlyImplicitEuler`` (Baraff & Witkin) with its defaults, its linear solve timed."""
+
+    def __init__(self, preconditioner: str = "multigrid") -> None:
+        super().__init__(preconditioner=preconditioner)
+
+
+class ScipyCGSolve(TimedSolve):
+    """Mixin, as ``TimedSolve``: the integrator's systems solved by ``scipy.sparse.linalg.cg``
+    instead of visviva's CG, to the integrator's ``cg_rtol`` and ``cg_max_iterations``."""
 
     def __init__(self) -> None:
         super().__init__(preconditioner="jacobi")  # (its CG is replaced: see _direction)
@@ -262,7 +318,7 @@ class ScipyCGNewton(TimedNewton):
         """Solve (M − h D − h² K) d = rhs as visviva's ``_solve`` does, with SciPy's CG."""
         if normals is not None or extra is not None or not same_blocks(stiffness, damping):
             raise NotImplementedError("only a free cloth's 3×3-block Newton matrix is handled")
-        # The Newton matrix's blocks, exactly as in ProjectedNewton._solve.
+        # The matrix's blocks, exactly as in BlockNewtonSolve._solve.
         data = np.empty_like(stiffness.data)
         damping_data = stiffness.data[:0] if damping is None else damping.data
         indptr, indices = stiffness.indptr, stiffness.indices
@@ -277,6 +333,15 @@ class ScipyCGNewton(TimedNewton):
         )
         system.counters.krylov_iterations += iterations
         return direction.reshape(rhs.shape), positive
+
+
+class ScipyCGNewton(ScipyCGSolve, vv.integrators.ProjectedNewton):
+    """``ProjectedNewton``, its Newton systems solved by SciPy's CG (its ``cg_rtol``: 1e-2)."""
+
+
+class ScipyCGBaraffWitkin(ScipyCGSolve, vv.integrators.LinearlyImplicitEuler):
+    """``LinearlyImplicitEuler``, its one system per step solved by SciPy's CG (its
+    ``cg_rtol``: 1e-3)."""
 
 
 def block_jacobi(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray) -> Any:
@@ -349,12 +414,21 @@ def scipy_cg(
 VISVIVA = "visviva"
 JACOBI = "visviva, block Jacobi"
 SCIPY = "SciPy CG"
-#: The Newton runners, compared with each other in (a) and (b).
-RUNNERS: dict[str, Callable[[], TimedNewton]] = {
+LINEARIZED = "visviva, Baraff–Witkin"
+SCIPY_LINEARIZED = "SciPy CG, Baraff–Witkin"
+#: The runners whose linear solves are timed, compared with each other in (a) and (b): the
+#: converged Newton step three ways, then Baraff–Witkin's one linear solve two ways.
+RUNNERS: dict[str, Callable[[], TimedSolve]] = {
     VISVIVA: TimedNewton,
     JACOBI: lambda: TimedNewton(preconditioner="jacobi"),
     SCIPY: ScipyCGNewton,
+    LINEARIZED: TimedBaraffWitkin,
+    SCIPY_LINEARIZED: ScipyCGBaraffWitkin,
 }
+#: Each visviva runner held to the targets, and the runner with SciPy's CG in its place.
+PAIRS = {VISVIVA: SCIPY, LINEARIZED: SCIPY_LINEARIZED}
+#: What each of them computes, for the verdicts.
+KINDS = {VISVIVA: "converged Newton", LINEARIZED: "one linearized solve"}
 FAST = "FastMassSprings"
 
 
@@ -375,7 +449,7 @@ class Run:
     n: int
     times: list[float]  # wall time of each timed step [s]
     first: float  # the warm-up step [s]
-    solve_seconds: float  # inside the linear solve over the timed steps [s] (Newton runners)
+    solve_seconds: float  # inside the linear solve over the timed steps [s] (``RUNNERS``)
     setup_seconds: float  # of which CSR conversion and block inversion (SciPy only) [s]
     work: dict[str, int]  # counters over the timed steps
     start: np.ndarray  # (N², 3) positions [m] after the warm-up step
@@ -416,9 +490,9 @@ def run_once(label: str, n: int, steps: int, quiet_wait: float) -> Run:
     positions_after_first = np.array(simulation.state["particle_position"])
     counters = simulation.system.counters
     before = counters.as_dict()
-    if isinstance(method, TimedNewton):
+    if isinstance(method, TimedSolve):
         method.solve_seconds = 0.0
-    if isinstance(method, ScipyCGNewton):
+    if isinstance(method, ScipyCGSolve):
         method.setup_seconds = 0.0
     wait_for_quiet(quiet_wait)
     meter = Contention()
@@ -525,13 +599,18 @@ def bench_runs(args: argparse.Namespace) -> dict[tuple[str, int], Run]:
         '  solves > Newton: only with projection="adaptive" (not the default), where CG meets'
         " negative curvature in the exact matrix and solves again with the definite one"
     )
+    print(
+        f"  {LINEARIZED} and {SCIPY_LINEARIZED}: one linear solve per step, counted as one"
+        " Newton iteration (no line search); CG to cg_rtol 1e-3, the Newton runners' 1e-2"
+    )
     for n in args.sizes:
-        scipy_run = runs[SCIPY, n]
-        share = scipy_run.setup_seconds / scipy_run.solve_seconds
-        print(
-            f"  {SCIPY}, N = {n}: BSR → CSR conversion and block inversion take {share:.0%}"
-            f" of its linear-solve time"
-        )
+        for label in PAIRS.values():
+            scipy_run = runs[label, n]
+            share = scipy_run.setup_seconds / scipy_run.solve_seconds
+            print(
+                f"  {label}, N = {n}: BSR → CSR conversion and block inversion take {share:.0%}"
+                f" of its linear-solve time"
+            )
     print(
         f"  {VISVIVA}: Numba kernels on {numba.get_num_threads()} threads;"
         f" {SCIPY}: SciPy's sparse products on one thread (assembly on"
@@ -555,65 +634,117 @@ def summarise(
     errors: dict[int, list[Accuracy]],
     checks: Checks,
 ) -> None:
-    """The ratios, the targets and the sanity checks."""
-    heading("(b) SciPy ÷ visviva, targets and agreement")
+    """The targets, the ratios and the sanity checks."""
+    heading("(b) Targets, SciPy ÷ visviva and agreement")
     rows = []
+    verdicts = []
     for n in args.sizes:
-        ours, theirs, fast = runs[VISVIVA, n], runs[SCIPY, n], runs[FAST, n]
-        jacobi = runs[JACOBI, n]
-        step_ratio = theirs.mean / ours.mean
         target = TARGET_STEP.get(n)
-        rows.append(
-            [
+        for label, error in (
+            (VISVIVA, None),
+            (LINEARIZED, linearized_error),
+            (FAST, fast_error(FAST_ITERATIONS)),
+        ):
+            ours = runs[label, n]
+            row = [
                 str(n),
+                label,
                 milliseconds(ours.mean),
                 "n/a" if target is None else f"≤ {milliseconds(target)}",
                 meets(ours.mean, target),
-                milliseconds(fast.mean),
-                meets(fast.mean, target),
-                worst_error(errors[n], FAST_ITERATIONS),
-                f"{step_ratio:.2f}×",
-                "met" if step_ratio >= TARGET_RATIO else "not met",
-                f"{theirs.solve_mean / ours.solve_mean:.2f}×",
-                f"{theirs.solve_per_iteration / ours.solve_per_iteration:.2f}×",
+                "converged" if error is None else worst_error(errors[n], error),
+            ]
+            if label in PAIRS:
+                theirs = runs[PAIRS[label], n]
+                step_ratio = theirs.mean / ours.mean
+                row += [
+                    milliseconds(theirs.mean),
+                    f"{step_ratio:.2f}×",
+                    "met" if step_ratio >= TARGET_RATIO else "not met",
+                    f"{theirs.solve_mean / ours.solve_mean:.2f}×",
+                    f"{theirs.solve_per_iteration / ours.solve_per_iteration:.2f}×",
+                ]
+                if target is not None:
+                    verdicts.append(
+                        f"  N = {n}, {label} ({KINDS[label]}): {milliseconds(ours.mean)} ms/step,"
+                        f" target ≤ {milliseconds(target)} ms: {yes_no(ours.mean <= target)};"
+                        f" {step_ratio:.2f}× faster than {PAIRS[label]}, target ≥"
+                        f" {TARGET_RATIO:g}×: {yes_no(step_ratio >= TARGET_RATIO)}"
+                    )
+            else:
+                row += ["n/a"] * 5
+            rows.append(row)
+    print()
+    print_table(
+        ["N", "runner", "ms/step", "target", "", "error (d)", "SciPy ms/step"]
+        + ["SciPy ÷ visviva: step", f"≥ {TARGET_RATIO:g}×", "linear solve", "per CG iteration"],
+        rows,
+    )
+    print(
+        f"  targets (the issue's): at most {milliseconds(TARGET_STEP[64])} ms per step at N = 64"
+        f" and {milliseconds(TARGET_STEP[128])} ms at N = 128 (the mean, ms/step: total ÷"
+        f" steps), and SciPy ÷ visviva ≥ {TARGET_RATIO:g}× for the whole step, each visviva"
+        f" runner against the same step with SciPy's CG ({SCIPY} for {VISVIVA},"
+        f" {SCIPY_LINEARIZED} for {LINEARIZED})"
+    )
+    print(
+        "  SciPy ÷ visviva: of the mean wall time per step, of the time inside the linear solve"
+        " per step, and of that time per CG iteration (which does not depend on how many"
+        " iterations each took)"
+    )
+    print(
+        f"  error (d): the largest distance of a point after one step from converged backward"
+        f" Euler's (ProjectedNewton with tight tolerances, implicit dampers), as a share of the"
+        f" step's largest displacement, the worst of the starts in (d) ((rest): the moving start"
+        f" not measured at that N); {VISVIVA}: backward Euler solved to Newton's tolerance"
+    )
+    print(
+        f"  {LINEARIZED}: one linear solve per step, backward Euler linearized at its start;"
+        f" {FAST}: Liu et al.'s local/global step, {FAST_ITERATIONS} iterations per step, not"
+        f" iterated to convergence, dampers explicit (see (c)). Their ms/step are for those"
+        f" steps, not for backward Euler solved to ProjectedNewton's tolerance"
+    )
+    if args.quick:
+        print("  --quick: the sizes are not the targets' (64, 128); no target applies")
+    else:
+        print()
+        print("\n".join(verdicts))
+    rows = []
+    for n in args.sizes:
+        ours, theirs, jacobi = runs[VISVIVA, n], runs[SCIPY, n], runs[JACOBI, n]
+        linearized, scipy_linearized = runs[LINEARIZED, n], runs[SCIPY_LINEARIZED, n]
+        rows.append(
+            [
+                str(n),
                 f"{jacobi.mean / ours.mean:.2f}×",
                 f"{theirs.mean / jacobi.mean:.2f}×",
                 f"{largest_difference(jacobi.start, theirs.start):.1e}",
                 f"{largest_difference(ours.start, theirs.start):.1e}",
                 f"{largest_difference(ours.positions, theirs.positions):.1e}",
+                f"{largest_difference(linearized.start, scipy_linearized.start):.1e}",
+                f"{largest_difference(linearized.positions, scipy_linearized.positions):.1e}",
             ]
         )
     print()
     print_table(
-        ["N", "visviva ms/step", "target", "", f"{FAST} ms/step", "", "its error (d)"]
-        + ["SciPy ÷ visviva: step", f"≥ {TARGET_RATIO:g}×", "linear solve", "per CG iteration"]
-        + ["Jacobi ÷ multigrid", "SciPy ÷ Jacobi"]
-        + ["|Δx| Jacobi–SciPy, 1 step", "visviva–SciPy: 1 step", f"{1 + args.steps} steps"],
+        ["N", "Jacobi ÷ multigrid", "SciPy ÷ Jacobi", "|Δx| Jacobi–SciPy, 1 step"]
+        + ["visviva–SciPy: 1 step", f"{1 + args.steps} steps"]
+        + ["Baraff–Witkin visviva–SciPy: 1 step", f"{1 + args.steps} steps"],
         rows,
     )
     print(
-        "  ms/step: total ÷ steps; SciPy ÷ visviva: of the mean wall time per step, of the time"
-        " inside the linear solve per step, and of that time per CG iteration; Jacobi ÷"
-        " multigrid: visviva's step with block Jacobi over its step with multigrid; SciPy ÷"
-        " Jacobi: the same preconditioner in SciPy's CG and in visviva's; |Δx|: the largest"
-        " distance between two runners' points after the warm-up step and at the end"
+        f"  Jacobi ÷ multigrid: {JACOBI}'s step over {VISVIVA}'s; SciPy ÷ Jacobi: the same"
+        " preconditioner in SciPy's CG and in visviva's; |Δx|: the largest distance between two"
+        " runners' points after the warm-up step and at the end"
     )
-    print(
-        f"  {FAST}: Liu et al.'s local/global step, {FAST_ITERATIONS} iterations per step, not"
-        f" iterated to convergence, dampers explicit (see (c)); its error: the largest distance"
-        f" of a point after one such step from converged backward Euler's (ProjectedNewton,"
-        f" implicit dampers), as a share of the step's largest displacement, the worst of the"
-        f" starts in (d) ((rest): the moving start not measured at that N). Its ms/step is for"
-        f" that truncated step, not for backward Euler solved to ProjectedNewton's tolerance"
-    )
-    if args.quick:
-        print("  --quick: the sizes are not the targets' (64, 128); no target applies")
     print()
     for n in args.sizes:
-        ours, theirs, fast = runs[VISVIVA, n], runs[SCIPY, n], runs[FAST, n]
-        finite = all(np.isfinite(r.positions).all() for r in (ours, theirs))
-        checks.check(finite, f"N={n}: both runners' positions finite")
-        checks.check(bool(np.isfinite(fast.positions).all()), f"N={n}: {FAST}'s positions finite")
+        for label in METHODS:
+            checks.check(
+                bool(np.isfinite(runs[label, n].positions).all()),
+                f"N={n}: {label}'s positions finite",
+            )
+        ours, theirs = runs[VISVIVA, n], runs[SCIPY, n]
         first = largest_difference(runs[JACOBI, n].start, theirs.start)
         checks.check(
             first <= AGREEMENT_FIRST,
@@ -634,6 +765,24 @@ def summarise(
             f" (≤ {AGREEMENT_END:g} m: the cloth buckles, see the module docstring; its lowest"
             f" point fell {sag:.3f} m)",
         )
+        ours, theirs = runs[LINEARIZED, n], runs[SCIPY_LINEARIZED, n]
+        first = largest_difference(ours.start, theirs.start)
+        checks.check(
+            first <= AGREEMENT_FIRST,
+            f"N={n}: {LINEARIZED} vs {SCIPY_LINEARIZED} after 1 step: max |Δx| = {first:.1e} m"
+            f" (≤ {AGREEMENT_FIRST:g} m: from rest, free fall for both; see the module docstring)",
+        )
+        last = largest_difference(ours.positions, theirs.positions)
+        checks.check(
+            last <= AGREEMENT_END,
+            f"N={n}: {LINEARIZED} vs {SCIPY_LINEARIZED} after {1 + args.steps} steps:"
+            f" max |Δx| = {last:.1e} m (≤ {AGREEMENT_END:g} m: each step's system solved to"
+            f" CG's rtol 1e-3 only, and the cloth buckles)",
+        )
+
+
+def yes_no(condition: bool) -> str:
+    return "yes" if condition else "no"
 
 
 # --------------------------------------------------------------------------------------------
@@ -696,8 +845,8 @@ def print_fast(args: argparse.Namespace, runs: dict[tuple[str, int], Run]) -> No
 
 @dataclass
 class Accuracy:
-    """One step from one start: converged backward Euler (the reference) and FastMassSprings
-    at each of ``ACCURACY_ITERATIONS``."""
+    """One step from one start: converged backward Euler (the reference), FastMassSprings at
+    each of ``ACCURACY_ITERATIONS`` and Baraff–Witkin's linearized step."""
 
     n: int
     start: str  # "rest" or "moving"
@@ -708,7 +857,8 @@ class Accuracy:
     splits: int  # the reference's halved steps (0: one step of h)
     seconds: float  # the reference step's wall time [s]
     errors: dict[int, float]  # iterations → largest distance of a point from the reference [m]
-    finite: bool  # FastMassSprings' positions finite at every count
+    linearized: float  # the same for ``LinearlyImplicitEuler()``'s step [m]
+    finite: bool  # FastMassSprings' positions finite at every count, and Baraff–Witkin's
     failure: str | None = None  # why the reference did not converge, if it did not
 
 
@@ -735,7 +885,8 @@ def largest_distance(a: np.ndarray, b: np.ndarray) -> float:
 def one_step(
     n: int, start: str, state: State, damping: float, system: Any, fast: dict[int, Any]
 ) -> Accuracy:
-    """One step of h from ``state`` by the reference and by each of ``fast``'s integrators."""
+    """One step of h from ``state`` by the reference, by each of ``fast``'s integrators and by
+    ``LinearlyImplicitEuler()`` (its defaults, as the timed runner's)."""
     before = system.counters.as_dict()
     begin = time.perf_counter()
     failure = None
@@ -751,6 +902,7 @@ def one_step(
         for iterations, method in fast.items()
     }
     errors = {iterations: largest_distance(x, reference) for iterations, x in stepped.items()}
+    linearized = positions(vv.integrators.LinearlyImplicitEuler().step(system, state, STEP))
     return Accuracy(
         n,
         start,
@@ -761,7 +913,8 @@ def one_step(
         after["rejected_steps"] - before["rejected_steps"],
         seconds,
         errors,
-        all(np.isfinite(x).all() for x in stepped.values()),
+        largest_distance(linearized, reference),
+        all(np.isfinite(x).all() for x in [*stepped.values(), linearized]),
         failure,
     )
 
@@ -805,19 +958,29 @@ def accuracy_at_sizes(args: argparse.Namespace) -> dict[int, list[Accuracy]]:
     return results
 
 
-def error_cell(result: Accuracy, iterations: int) -> str:
+def fast_error(iterations: int) -> Callable[[Accuracy], float]:
+    """A result's error [m] of FastMassSprings' step with ``iterations`` iterations."""
+    return lambda result: result.errors[iterations]
+
+
+def linearized_error(result: Accuracy) -> float:
+    """A result's error [m] of Baraff–Witkin's step."""
+    return result.linearized
+
+
+def error_cell(result: Accuracy, error: Callable[[Accuracy], float]) -> str:
     if result.failure is not None:
         return "n/a"
-    error = result.errors[iterations]
-    return f"{error:.1e} ({error / result.displacement:.0%})"
+    distance = error(result)
+    return f"{distance:.1e} ({distance / result.displacement:.0%})"
 
 
-def worst_error(results: list[Accuracy], iterations: int) -> str:
-    """The largest error of the ``iterations``-iteration step relative to the step's largest
-    displacement, over ``results``."""
+def worst_error(results: list[Accuracy], error: Callable[[Accuracy], float]) -> str:
+    """The largest ``error`` of a method's step relative to the step's largest displacement,
+    over ``results``."""
     if any(result.failure is not None for result in results):
         return "n/a"
-    worst = max(r.errors[iterations] / r.displacement for r in results)
+    worst = max(error(r) / r.displacement for r in results)
     starts = {result.start for result in results}
     return f"{worst:.0%}" + ("" if "moving" in starts else " (rest)")
 
@@ -826,7 +989,7 @@ def print_accuracy(
     args: argparse.Namespace, results: dict[int, list[Accuracy]], checks: Checks
 ) -> None:
     """The table of one step's errors, and its checks."""
-    heading(f"(d) One step of {FAST} against converged backward Euler")
+    heading(f"(d) One step of {FAST}, and of Baraff–Witkin, against converged backward Euler")
     rows = []
     for n in args.sizes:
         for result in results[n]:
@@ -840,12 +1003,14 @@ def print_accuracy(
                     + (f" ({result.splits} split)" if result.splits else ""),
                     f"{result.seconds:.2f}",
                 ]
-                + [error_cell(result, iterations) for iterations in ACCURACY_ITERATIONS]
+                + [error_cell(result, fast_error(k)) for k in ACCURACY_ITERATIONS]
+                + [error_cell(result, linearized_error)]
             )
     print()
     print_table(
         ["N", "start", "dampers", "step [m]", "ref. Newton / CG", "ref. s"]
-        + [f"{iterations} iterations" for iterations in ACCURACY_ITERATIONS],
+        + [f"{iterations} iterations" for iterations in ACCURACY_ITERATIONS]
+        + ["Baraff–Witkin"],
         rows,
     )
     print(
@@ -862,7 +1027,7 @@ def print_accuracy(
     print(
         "  ref.: converged backward Euler, ProjectedNewton("
         + ", ".join(f"{key}={value!r}" for key, value in REFERENCE.items())
-        + "), both methods starting their iteration at x_n + h v_n; step [m]: the"
+        + f"), it and {FAST} starting their iteration at x_n + h v_n; step [m]: the"
         " largest distance a point moves in the reference step; ref. Newton / CG: its Newton"
         " and CG iterations (split: the step was halved, the reference then two steps of h/2,"
         " a failed check); ref. s: its wall time"
@@ -873,6 +1038,12 @@ def print_accuracy(
         " dampers' treatment (explicit in FastMassSprings, implicit in the reference); without,"
         " both solve the same backward Euler step and the rest is truncation"
     )
+    print(
+        "  Baraff–Witkin: LinearlyImplicitEuler()'s step (the timed runner's: one linear solve,"
+        " CG to 1e-3), the same distance. It treats the dampers implicitly, as the reference"
+        " does; what is left is the force's linearization at the start of the step (and CG's"
+        " tolerance)"
+    )
     for n in args.sizes:
         for result in results[n]:
             label = f"N={n}, {result.start}, dampers {result.damping:g}"
@@ -881,7 +1052,7 @@ def print_accuracy(
                 f"{label}: the reference converged in one step of h"
                 + ("" if result.failure is None else f" ({result.failure})"),
             )
-            checks.check(result.finite, f"{label}: {FAST}'s steps finite")
+            checks.check(result.finite, f"{label}: {FAST}'s and Baraff–Witkin's steps finite")
 
 
 # --------------------------------------------------------------------------------------------
