@@ -19,7 +19,7 @@ kernel):
 * ``triangle_points`` ``(T, 3, 3)``: the corners a, b, c of the triangle in each slot [m];
   the slots are the triangles sorted so that every leaf owns a contiguous range.
 * ``triangle_normals`` ``(T, 7, 3)``: the pseudo-normals of each slot's face, vertices and
-  edges (:func:`visviva.collision.mesh_topology.pseudo_normals`).
+  edges (:func:`visviva.geometry.mesh_topology.pseudo_normals`).
 
 ``triangle_order[slot]`` maps a slot back to the mesh's own triangle index.
 

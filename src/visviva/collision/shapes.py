@@ -26,8 +26,8 @@ import numpy as np
 
 from .._validation import describe, real_number
 from ..errors import ModelError
+from ..geometry.mesh_topology import check_closed_mesh, enclosed_volume, pseudo_normals
 from .bvh import MeshBVH, mesh_closest_points, mesh_distances, mesh_first_hits
-from .mesh_topology import check_closed_mesh, enclosed_volume, pseudo_normals
 from .tables import ColliderKind, check_points, collider_distances, collider_first_hits
 
 __all__ = ["QUATERNION_TOLERANCE", "Box", "Plane", "Sphere", "TriangleMesh"]
@@ -204,7 +204,7 @@ class TriangleMesh:
 
     The mesh must be watertight (every edge shared by exactly two triangles), consistently
     oriented, and counter-clockwise seen from outside (positive enclosed volume); see
-    :func:`visviva.collision.mesh_topology.check_closed_mesh` for every check. Queries walk a
+    :func:`visviva.geometry.mesh_topology.check_closed_mesh` for every check. Queries walk a
     bounding-volume hierarchy built once here (:class:`visviva.collision.bvh.MeshBVH`).
 
     Attributes:

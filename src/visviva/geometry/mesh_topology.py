@@ -198,7 +198,7 @@ def check_closed_mesh(vertices: Any, triangles: Any) -> tuple[np.ndarray, np.nda
     if not volume > _FLAT_TOLERANCE * extent**3:
         raise ModelError(
             f"`triangles` enclose no volume ({volume:.3g} m³ within an extent of {extent:.3g} "
-            "m): the mesh is flat; a collider mesh must bound a solid"
+            "m): the mesh is flat; a mesh for collisions or mass properties must bound a solid"
         )
     return vertices, triangles, triangle_edges
 

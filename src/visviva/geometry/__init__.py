@@ -1,0 +1,1 @@
+"""Geometry shared by the physics packages: mesh topology checks (closed, oriented, outward)."""
