@@ -56,6 +56,9 @@ class Integrator(ABC):
         adaptive: True if the method can choose its own step from an error estimate.
         second_order_only: True if the method needs the split ``(q, v)`` state of a
             :class:`~visviva.ode.SecondOrderProblem`.
+        manifold_positions: True if the method steps systems whose positions do not move as
+            ``q' = v`` (rigid bodies' orientations; :class:`~visviva.ode.system.Kinematics`),
+            through ``system.position_rate`` and ``system.drift``.
         evaluations_per_step: Evaluations of ``f`` per step of an explicit method (with
             position-only forces, after the first step); per Newton iteration for an implicit one.
         cost: One line on the work per step, for tables.
@@ -69,6 +72,7 @@ class Integrator(ABC):
     symplectic: ClassVar[bool] = False
     adaptive: ClassVar[bool] = False
     second_order_only: ClassVar[bool] = False
+    manifold_positions: ClassVar[bool] = False
     evaluations_per_step: ClassVar[int]
     cost: ClassVar[str]
     reference: ClassVar[str]
@@ -92,6 +96,13 @@ class Integrator(ABC):
                 f"method {self.name!r} needs the split (q, v) state of a second-order problem; "
                 "build it with vv.ode.SecondOrderProblem, or pick a method that integrates "
                 "first-order problems (e.g. 'rk4')"
+            )
+        if getattr(system, "kinematics", None) is not None and not self.manifold_positions:
+            raise ModelError(
+                f"method {self.name!r} cannot step rigid bodies (their orientations do not move "
+                "as q' = v); pick one that does: 'symplectic_euler' (the default), "
+                "'velocity_verlet', 'leapfrog', 'symplectic_euler_position_first', "
+                "'explicit_euler', 'midpoint', 'heun', 'rk4' or 'dopri5'"
             )
 
     def stability_function(self, z: Any) -> np.ndarray:

@@ -99,6 +99,9 @@ class DormandPrince5(Integrator):
     Fifth order; with ``adaptive=False`` a plain fixed-step fifth-order method.
     """
 
+    #: Stages combine derivatives, and ``q'`` is the system's (rigid bodies included).
+    manifold_positions = True
+
     name = "dopri5"
     order = 5
     adaptive = True

@@ -159,6 +159,9 @@ class ExplicitRungeKutta(Integrator):
     ``docs/integrators.md`` for a worked example registering Kutta's third-order method.
     """
 
+    #: Stages combine derivatives, and ``q'`` is the system's (rigid bodies included).
+    manifold_positions = True
+
     tableau: ClassVar[ButcherTableau]
 
     def step(self, system: System, state: State, dt: float) -> State:

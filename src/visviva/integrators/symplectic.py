@@ -1,10 +1,12 @@
 """Symplectic methods on the split state ``(q, v)``: symplectic Euler, velocity Verlet, leapfrog.
 
-Each alternates *kicks* (``v += h·a``) and *drifts* (``q += h·v``). For forces that depend on
-position only, every one of these maps is symplectic: it conserves a *modified* energy
-``H̃ = H + O(h^p)`` exactly, so the true energy oscillates within ``O(h^p)`` of its initial value
-for exponentially long times instead of drifting (seed 001). Velocity Verlet and leapfrog are
-also time-reversible: running backwards with ``−v`` retraces the trajectory to round-off.
+Each alternates *kicks* (``v += h·a``) and *drifts* (``q += h·v``; for a rigid body's
+orientation, a rotation by its angular momentum: ``SecondOrderSystem.drift``). For forces
+that depend on position only, every one of these maps is symplectic: it conserves a
+*modified* energy ``H̃ = H + O(h^p)`` exactly, so the true energy oscillates within
+``O(h^p)`` of its initial value for exponentially long times instead of drifting (seed 001).
+Velocity Verlet and leapfrog are also time-reversible: running backwards with ``−v`` retraces
+the trajectory to round-off.
 
 With velocity-dependent forces (damping, drag) no explicit method is symplectic, and a plain
 kick that reads a stale velocity drops Verlet and leapfrog to first order. Here they evaluate
@@ -21,6 +23,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from .base import CompiledStep, Integrator
 from .compiled import _memoized, acceleration_adapter, problem_key
@@ -40,11 +44,18 @@ def start_acceleration(system: SecondOrderSystem, state: State):
     return system.acceleration(state.t, state.q, state.v)
 
 
+def _derivative(system: SecondOrderSystem, q: np.ndarray, v: np.ndarray, a: np.ndarray):
+    """The derivative ``(q', v')`` of a state whose acceleration ``a`` is known."""
+    return system.position_rate(q, v), a
+
+
 class _Split(Integrator):
-    """A method that needs the split ``(q, v)`` state."""
+    """A method that needs the split ``(q, v)`` state; its drifts go through
+    ``system.drift``, so it steps orientations too (rigid bodies)."""
 
     second_order_only = True
     symplectic = True
+    manifold_positions = True
 
     def _compile(self, problem: Problem, make: Callable[..., CompiledStep]) -> CompiledStep | None:
         key = problem_key(problem)
@@ -75,7 +86,7 @@ class SymplecticEuler(_Split):
     def step(self, system: System, state: State, dt: float) -> State:
         a = start_acceleration(system, state)
         v1 = state.v + dt * a
-        return state.from_parts(state.t + dt, (state.q + dt * v1, v1))
+        return state.from_parts(state.t + dt, (system.drift(state.q, v1, dt), v1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         return self._compile(problem, _symplectic_euler_kernel)
@@ -96,12 +107,13 @@ class SymplecticEulerPositionFirst(_Split):
 
     def step(self, system: System, state: State, dt: float) -> State:
         t1 = state.t + dt
-        q1 = state.q + dt * state.v
+        q1 = system.drift(state.q, state.v, dt)
         a = system.acceleration(t1, q1, state.v)
         v1 = state.v + dt * a
         # For position-only forces `a` is exactly the acceleration of the new state.
-        cached = None if system.velocity_dependent else a
-        return state.from_parts(t1, (q1, v1), None if cached is None else (v1, cached))
+        if system.velocity_dependent:
+            return state.from_parts(t1, (q1, v1))
+        return state.from_parts(t1, (q1, v1), _derivative(system, q1, v1, a))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         return self._compile(problem, _symplectic_euler_position_first_kernel)
@@ -126,13 +138,13 @@ class VelocityVerlet(_Split):
         a0 = start_acceleration(system, state)
         t1 = state.t + dt
         v_half = state.v + (0.5 * dt) * a0
-        q1 = state.q + dt * v_half
+        q1 = system.drift(state.q, v_half, dt)
         if system.velocity_dependent:
             a1 = system.acceleration(t1, q1, state.v + dt * a0)
             return state.from_parts(t1, (q1, v_half + (0.5 * dt) * a1))
         a1 = system.acceleration(t1, q1, v_half)
         v1 = v_half + (0.5 * dt) * a1
-        return state.from_parts(t1, (q1, v1), (v1, a1))
+        return state.from_parts(t1, (q1, v1), _derivative(system, q1, v1, a1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         return self._compile(problem, _velocity_verlet_kernel)
@@ -154,14 +166,14 @@ class Leapfrog(_Split):
 
     def step(self, system: System, state: State, dt: float) -> State:
         t_half = state.t + 0.5 * dt
-        q_half = state.q + (0.5 * dt) * state.v
+        q_half = system.drift(state.q, state.v, 0.5 * dt)
         v_mid = state.v
         if system.velocity_dependent:
             a0 = start_acceleration(system, state)
             v_mid = state.v + (0.5 * dt) * a0
         a = system.acceleration(t_half, q_half, v_mid)
         v1 = state.v + dt * a
-        return state.from_parts(state.t + dt, (q_half + (0.5 * dt) * v1, v1))
+        return state.from_parts(state.t + dt, (system.drift(q_half, v1, 0.5 * dt), v1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         return self._compile(problem, _leapfrog_kernel)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, fields
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from .mass import Mass
     from .problems import FirstOrderProblem, SecondOrderProblem
 
-__all__ = ["FirstOrderSystem", "SecondOrderSystem", "System", "WorkCounters"]
+__all__ = ["FirstOrderSystem", "Kinematics", "SecondOrderSystem", "System", "WorkCounters"]
 
 #: Relative perturbation of forward finite differences: √ε balances truncation and round-off.
 FINITE_DIFFERENCE_STEP = float(np.sqrt(np.finfo(np.float64).eps))
@@ -195,12 +195,15 @@ class SecondOrderSystem:
         energy: ``energy(t, q, v)``, one value per system, or ``None``.
         layout: The names of the state's parts (default: ``q`` and ``v``).
         counters: Work counters to add to (default: fresh ones).
+        kinematics: How the positions move with the velocities where that is not ``q' = v``
+            (rigid bodies: orientations, momenta; see :class:`Kinematics`), or ``None``.
 
     Attributes:
         counters: Work done so far in this run.
         mass: The mass matrix, or ``None``.
         velocity_dependent: True if the force takes ``v``.
         layout: The names of the state's parts.
+        kinematics: The :class:`Kinematics`, or ``None`` for ``q' = v``.
     """
 
     second_order = True
@@ -215,8 +218,10 @@ class SecondOrderSystem:
         energy: Callable[..., Any] | None = None,
         layout: Layout | None = None,
         counters: WorkCounters | None = None,
+        kinematics: Kinematics | None = None,
     ) -> None:
         self._force = force
+        self.kinematics = kinematics
         self.mass = mass
         self.velocity_dependent = velocity_dependent
         self._jacobian = jacobian
@@ -287,20 +292,30 @@ class SecondOrderSystem:
         )
 
     def force(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``F(t, q, v)`` (the acceleration for a problem without mass), shape of ``q``."""
+        """``F(t, q, v)`` (the acceleration for a problem without mass), shape of ``v``."""
         self.counters.f_evaluations += 1
         what = "the force F(t, q, v)" if self.velocity_dependent else "the force F(t, q)"
-        return _same_shape(what, np.asarray(self._force(t, q, v)), q, t)
+        return _same_shape(what, np.asarray(self._force(t, q, v)), v, t)
 
     def acceleration(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``q'' = M⁻¹ F(t, q, v)``, shape of ``q``."""
+        """``v' = M⁻¹ F(t, q, v)``, shape of ``v``."""
         force = self.force(t, q, v)
         return force if self.mass is None else self.mass.solve(force)
 
+    def position_rate(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``q'``: ``v`` itself, or what the :class:`Kinematics` make of it."""
+        return v if self.kinematics is None else self.kinematics.rate(q, v)
+
+    def drift(self, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
+        """The positions after ``h`` [s] at the velocities ``v`` held: ``q + h v``, or the
+        :class:`Kinematics`' update (a rotation for an orientation)."""
+        return q + h * v if self.kinematics is None else self.kinematics.drift(q, v, h)
+
     def derivative(self, t: float, parts: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
-        """Time derivative of ``(q, v)``: ``(v, q'')``."""
+        """Time derivative of ``(q, v)``: ``(q', v')``, ``q' = v`` unless the system has
+        :class:`Kinematics`."""
         q, v = parts
-        return (v, self.acceleration(t, q, v))
+        return (self.position_rate(q, v), self.acceleration(t, q, v))
 
     def force_jacobian(
         self,
@@ -342,6 +357,26 @@ class SecondOrderSystem:
 
 
 System = FirstOrderSystem | SecondOrderSystem
+
+
+class Kinematics(Protocol):
+    """How a second-order system's positions move where ``q' = v`` does not hold.
+
+    A rigid body's configuration is a position and an orientation (a unit quaternion, 4
+    numbers) and its "velocities" are its momenta ``P`` and ``L`` (3 + 3): ``q`` and ``v`` then
+    differ in length (MuJoCo's ``nq`` and ``nv``), ``q' = K(q) v`` is a function of both, and
+    an orientation must not be moved by "vector plus vector". Integrators that support such
+    systems (``Integrator.manifold_positions``) go through these two methods, never ``q + h v``.
+    """
+
+    def rate(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``q'`` at ``(q, v)``, shape of ``q``."""
+        ...
+
+    def drift(self, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
+        """The positions after ``h`` [s] of motion at the velocities (momenta) ``v`` held, as
+        a new array: on the configuration manifold (unit quaternions stay unit)."""
+        ...
 
 
 def _optional_evaluator(
