@@ -17,7 +17,11 @@ from visviva.errors import ModelError
 from visviva.ode.state import Layout, PartView, State
 from visviva.ode.system import SecondOrderSystem
 from visviva.rigid.motion import BodyMotion
-from visviva.rigid.quaternions import quaternion_matrix, quaternion_multiply
+from visviva.rigid.quaternions import (
+    matrix_quaternion,
+    quaternion_matrix,
+    quaternion_multiply,
+)
 
 INERTIA = (1.0, 2.0, 3.0)  # kg·m², principal moments of an asymmetric body
 MASS = 2.0  # kg
@@ -173,3 +177,35 @@ def test_methods_that_cannot_step_orientations_refuse_with_the_alternatives(meth
     system, _, _ = _free_body((1.0, 2.0, 3.0))
     with pytest.raises(ModelError, match=r"cannot step rigid bodies.*symplectic_euler"):
         vv.integrators.get(method).check(system)
+
+
+def test_matrix_and_quaternion_convert_both_ways():
+    rng = np.random.default_rng(3)
+    for q in rng.normal(size=(50, 4)):
+        q = q / np.linalg.norm(q) * np.sign(q[0])
+        np.testing.assert_allclose(matrix_quaternion(quaternion_matrix(q)), q, atol=1e-14)
+    for half_turn in np.eye(3):  # w = 0: the branches that divide by x, y or z
+        q = np.concatenate([[0.0], half_turn])
+        np.testing.assert_allclose(
+            np.abs(matrix_quaternion(quaternion_matrix(q))), np.abs(q), atol=1e-15
+        )
+
+
+def test_a_body_whose_axes_are_not_principal_moves_as_its_principal_frame_does():
+    """The same body given in turned axes (inertia R diag(I) Rᵀ, principal frame ``r`` in its
+    axes): its orientation q is (q ⊗ r) ⊗ r⁻¹ of the principal frame's, step after step."""
+    r = np.array([0.9, -0.2, 0.3, 0.25])
+    r /= np.linalg.norm(r)
+    principal, state, _ = _free_body((0.5, 1.5, -2.0), orientation=(0.7, 0.1, 0.5, -0.2))
+    turned_q = state.parts[0].copy()
+    turned_q[-4:] = quaternion_multiply(turned_q[-4:], r * [1, -1, -1, -1])
+    turned = SecondOrderSystem(
+        lambda t, q, v: np.zeros_like(v), velocity_dependent=False, layout=principal.layout,
+        kinematics=BodyMotion(0, np.array([MASS]), np.array([INERTIA]), r[None]),
+    )  # fmt: skip
+    for method in ("symplectic_euler", "rk4"):
+        a = _run(method, state, principal, 0.01, 200).parts[0][-4:]
+        b = _run(
+            method, State(0.0, (turned_q, state.parts[1]), principal.layout), turned, 0.01, 200
+        )
+        np.testing.assert_allclose(quaternion_multiply(b.parts[0][-4:], r), a, atol=1e-12)

@@ -7,9 +7,12 @@ momenta, ``P' = F``, ``L' = τ``; the momenta move the body,
 
     x' = P / M,    q' = ½ (0, ω) ⊗ q,    ω = R I_body⁻¹ Rᵀ L          [rad/s]
 
-with the body frame at the centre of mass along the principal axes, so that ``I_body`` is
-diagonal (``(I₁, I₂, I₃)``). ``ω`` is not conserved by a free body — ``I(t) = R I_body Rᵀ``
-turns with it — but ``L`` is: that is why ``L``, not ``ω``, is the state.
+with ``I_body`` the inertia about the centre of mass in the body's own axes (those its shape
+was given in). The kernels work in the principal frame, turned from the body's axes by a fixed
+rotation ``r`` (``p_body = R(r) p_principal``, so the principal frame's orientation is
+``q ⊗ r``), where ``I_body`` is diagonal (``I₁, I₂, I₃``). ``ω`` is not conserved by a free
+body — ``I(t) = R I_body Rᵀ`` turns with it — but ``L`` is: that is why ``L``, not ``ω``, is
+the state.
 
 In a scene's integrated arrays the bodies follow the particles and generalized coordinates:
 ``q = [..., x (3B), q (4B)]`` and ``v = [..., P (3B), L (3B)]``, ``q`` 7 numbers a body and
@@ -54,21 +57,31 @@ class BodyMotion:
         mass: ``(B,)`` masses [kg] (``inf`` for a body nothing moves).
         inertia: ``(B, 3)`` principal moments ``I₁, I₂, I₃`` [kg·m²] about the centre of mass
             (``inf`` for a body nothing turns).
+        axes: ``(B, 4)`` unit quaternions ``r``: each body's principal frame in its own axes
+            (default: the identity, the body's axes are principal).
     """
 
-    def __init__(self, offset: int, mass: np.ndarray, inertia: np.ndarray) -> None:
+    def __init__(
+        self,
+        offset: int,
+        mass: np.ndarray,
+        inertia: np.ndarray,
+        axes: np.ndarray | None = None,
+    ) -> None:
         self.offset = offset
         self.count = int(np.shape(mass)[0])
         with np.errstate(divide="ignore"):
             self.inverse_mass = 1.0 / np.asarray(mass, dtype=np.float64)
             self.inverse_inertia = 1.0 / np.asarray(inertia, dtype=np.float64).reshape(-1, 3)
+        identity = np.tile([1.0, 0.0, 0.0, 0.0], (self.count, 1))
+        self.axes = identity if axes is None else np.asarray(axes, dtype=np.float64)
 
     def rate(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``q'``: ``v`` for the entries before the bodies, then ``P/M`` and ``½ (0, ω) ⊗ q``."""
         out = np.empty_like(q)
         n = self.offset
         out[:n] = v[:n]
-        _rates(q[n:], v[n:], self.inverse_mass, self.inverse_inertia, out[n:])
+        _rates(q[n:], v[n:], self.inverse_mass, self.inverse_inertia, self.axes, out[n:])
         return out
 
     def drift(self, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
@@ -77,27 +90,31 @@ class BodyMotion:
         out = np.empty_like(q)
         n = self.offset
         out[:n] = q[:n] + h * v[:n]
-        _drift(q[n:], v[n:], h, self.inverse_mass, self.inverse_inertia, out[n:])
+        _drift(q[n:], v[n:], h, self.inverse_mass, self.inverse_inertia, self.axes, out[n:])
         return out
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> float:
         """``Σ |P|²/2M + ½ Πᵀ I_body⁻¹ Π`` [J] over the bodies."""
         n = self.offset
-        return float(_kinetic_energy(q[n:], v[n:], self.inverse_mass, self.inverse_inertia))
+        return float(
+            _kinetic_energy(q[n:], v[n:], self.inverse_mass, self.inverse_inertia, self.axes)
+        )
 
     def angular_velocity(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """``ω = R I_body⁻¹ Rᵀ L`` [rad/s] of every body, ``(B, 3)`` in the world frame."""
         out = np.empty((self.count, 3))
         n = self.offset
-        _angular_velocities(q[n:], v[n:], self.inverse_inertia, out)
+        _angular_velocities(q[n:], v[n:], self.inverse_inertia, self.axes, out)
         return out
 
 
 @njit(cache=True, inline="always")
-def _orientation(q, b, count):  # pragma: no cover - compiled
-    """Body ``b``'s orientation from the bodies' part of ``q`` (``count`` bodies), unit."""
+def _principal(q, b, count, axes):  # pragma: no cover - compiled
+    """Body ``b``'s principal frame's orientation ``q ⊗ r``, unit, from the bodies' part of
+    ``q`` (``count`` bodies)."""
     k = 3 * count + 4 * b
-    return normalized(q[k], q[k + 1], q[k + 2], q[k + 3])
+    w, x, y, z = normalized(q[k], q[k + 1], q[k + 2], q[k + 3])
+    return multiply(w, x, y, z, axes[b, 0], axes[b, 1], axes[b, 2], axes[b, 3])
 
 
 @njit(cache=True, inline="always")
@@ -112,13 +129,13 @@ def _omega(w, x, y, z, lx, ly, lz, inverse_inertia, b):  # pragma: no cover - co
 
 
 @njit(cache=True, parallel=True)
-def _rates(q, v, inverse_mass, inverse_inertia, out):  # pragma: no cover - compiled
+def _rates(q, v, inverse_mass, inverse_inertia, axes, out):  # pragma: no cover - compiled
     count = inverse_mass.shape[0]
     for b in prange(count):
         for a in range(3):
             out[3 * b + a] = v[3 * b + a] * inverse_mass[b]
         k, m = 3 * count + 4 * b, 3 * count + 3 * b
-        w, x, y, z = _orientation(q, b, count)
+        w, x, y, z = _principal(q, b, count, axes)
         ox, oy, oz = _omega(w, x, y, z, v[m], v[m + 1], v[m + 2], inverse_inertia, b)
         # ½ (0, ω) ⊗ q on the quaternion as stored (its linear growth is the projection's).
         dw, dx, dy, dz = multiply(0.0, ox, oy, oz, q[k], q[k + 1], q[k + 2], q[k + 3])
@@ -140,30 +157,32 @@ def _turn(w, x, y, z, px, py, pz, axis, angle):  # pragma: no cover - compiled
 
 
 @njit(cache=True, parallel=True)
-def _drift(q, v, h, inverse_mass, inverse_inertia, out):  # pragma: no cover - compiled
+def _drift(q, v, h, inverse_mass, inverse_inertia, axes, out):  # pragma: no cover - compiled
     count = inverse_mass.shape[0]
     for b in prange(count):
         for a in range(3):
             out[3 * b + a] = q[3 * b + a] + h * v[3 * b + a] * inverse_mass[b]
         k, m = 3 * count + 4 * b, 3 * count + 3 * b
-        w, x, y, z = _orientation(q, b, count)
+        w, x, y, z = _principal(q, b, count, axes)
         px, py, pz = rotate_back(w, x, y, z, v[m], v[m + 1], v[m + 2])
         # T₁(h/2) T₂(h/2) T₃(h) T₂(h/2) T₁(h/2); each angle from the Π of its moment.
         for axis, fraction in ((0, 0.5), (1, 0.5), (2, 1.0), (1, 0.5), (0, 0.5)):
             held = px if axis == 0 else (py if axis == 1 else pz)
             angle = fraction * h * held * inverse_inertia[b, axis]
             w, x, y, z, px, py, pz = _turn(w, x, y, z, px, py, pz, axis, angle)
+        # Back to the body's own axes: q = (q ⊗ r) ⊗ r⁻¹.
+        w, x, y, z = multiply(w, x, y, z, axes[b, 0], -axes[b, 1], -axes[b, 2], -axes[b, 3])
         out[k], out[k + 1], out[k + 2], out[k + 3] = normalized(w, x, y, z)
 
 
 @njit(cache=True)
-def _kinetic_energy(q, v, inverse_mass, inverse_inertia):  # pragma: no cover - compiled
+def _kinetic_energy(q, v, inverse_mass, inverse_inertia, axes):  # pragma: no cover
     count = inverse_mass.shape[0]
     total = 0.0
     for b in range(count):
         p2 = v[3 * b] ** 2 + v[3 * b + 1] ** 2 + v[3 * b + 2] ** 2
         total += 0.5 * p2 * inverse_mass[b]
-        w, x, y, z = _orientation(q, b, count)
+        w, x, y, z = _principal(q, b, count, axes)
         m = 3 * count + 3 * b
         px, py, pz = rotate_back(w, x, y, z, v[m], v[m + 1], v[m + 2])
         i = inverse_inertia[b]
@@ -172,10 +191,10 @@ def _kinetic_energy(q, v, inverse_mass, inverse_inertia):  # pragma: no cover - 
 
 
 @njit(cache=True, parallel=True)
-def _angular_velocities(q, v, inverse_inertia, out):  # pragma: no cover - compiled
+def _angular_velocities(q, v, inverse_inertia, axes, out):  # pragma: no cover - compiled
     count = out.shape[0]
     for b in prange(count):
-        w, x, y, z = _orientation(q, b, count)
+        w, x, y, z = _principal(q, b, count, axes)
         m = 3 * count + 3 * b
         out[b, 0], out[b, 1], out[b, 2] = _omega(
             w, x, y, z, v[m], v[m + 1], v[m + 2], inverse_inertia, b

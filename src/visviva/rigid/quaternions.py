@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["quaternion_matrix", "quaternion_multiply", "quaternion_rotate"]
+__all__ = ["matrix_quaternion", "quaternion_matrix", "quaternion_multiply", "quaternion_rotate"]
 
 
 @njit(cache=True, inline="always")
@@ -81,3 +81,31 @@ def quaternion_matrix(q: np.ndarray) -> np.ndarray:
         ],
         axis=-2,
     )
+
+
+def matrix_quaternion(matrix: np.ndarray) -> np.ndarray:
+    """The unit quaternion ``(w, x, y, z)`` with ``w ≥ 0`` of a rotation matrix ``(3, 3)``.
+
+    From the largest of ``4w², 4x², 4y², 4z²`` (the trace and the diagonal), which keeps the
+    division well away from zero (Shepperd, J. Guidance Control 1(3), 1978)."""
+    m = np.asarray(matrix, dtype=np.float64)
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    squares = np.array([1.0 + trace, 1.0 + 2 * m[0, 0] - trace, 1.0 + 2 * m[1, 1] - trace,
+                        1.0 + 2 * m[2, 2] - trace])  # 4w², 4x², 4y², 4z²  # fmt: skip
+    k = int(np.argmax(squares))
+    big = 0.5 * np.sqrt(squares[k])  # the largest component
+    quarter = 0.25 / big
+    if k == 0:
+        q = [big, (m[2, 1] - m[1, 2]) * quarter, (m[0, 2] - m[2, 0]) * quarter,
+             (m[1, 0] - m[0, 1]) * quarter]  # fmt: skip
+    elif k == 1:
+        q = [(m[2, 1] - m[1, 2]) * quarter, big, (m[0, 1] + m[1, 0]) * quarter,
+             (m[0, 2] + m[2, 0]) * quarter]  # fmt: skip
+    elif k == 2:
+        q = [(m[0, 2] - m[2, 0]) * quarter, (m[0, 1] + m[1, 0]) * quarter, big,
+             (m[1, 2] + m[2, 1]) * quarter]  # fmt: skip
+    else:
+        q = [(m[1, 0] - m[0, 1]) * quarter, (m[0, 2] + m[2, 0]) * quarter,
+             (m[1, 2] + m[2, 1]) * quarter, big]  # fmt: skip
+    q = np.array(q)
+    return q if q[0] >= 0.0 else -q
