@@ -30,7 +30,19 @@ from .errors import (
 )
 
 if TYPE_CHECKING:
-    from . import analysis, demos, forces, integrators, io, mechanics, model, ode, simulation, viz
+    from . import (
+        analysis,
+        demos,
+        forces,
+        integrators,
+        io,
+        mechanics,
+        model,
+        ode,
+        rigid,
+        simulation,
+        viz,
+    )
     from .model import Model, SceneBuilder
     from .scenes import load_model, run_scene
     from .simulation import Simulation, Solution, simulate, solve
@@ -58,6 +70,7 @@ __all__ = [
     "mechanics",
     "model",
     "ode",
+    "rigid",
     "run_scene",
     "simulate",
     "simulation",
@@ -74,6 +87,7 @@ _SUBPACKAGES = {
     "mechanics",
     "model",
     "ode",
+    "rigid",
     "simulation",
     "viz",
 }

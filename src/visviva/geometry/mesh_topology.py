@@ -7,7 +7,8 @@ directions) and *outward* (counter-clockwise seen from outside, so the enclosed 
 naming the first offending triangle or edge; signed distances, inside tests and mass properties
 are only meaningful on meshes that pass. A mesh of several closed shells passes, and a shell
 listed inside-out within a larger one is a cavity (the total volume must still be positive).
-Not checked: self-intersections, and shells touching at a single vertex.
+Not checked here: shells touching at a single vertex, and self-intersections (see
+:func:`visviva.geometry.self_intersection.check_self_intersections`).
 
 :func:`pseudo_normals` gives the angle-weighted pseudo-normals of J. A. Bærentzen and
 H. Aanæs, "Signed distance computation using the angle weighted pseudonormal", *IEEE TVCG*
@@ -23,6 +24,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from .._validation import describe
 from ..errors import ModelError
@@ -31,6 +33,7 @@ __all__ = [
     "DEGENERATE_TOLERANCE",
     "check_closed_mesh",
     "enclosed_volume",
+    "mesh_arrays",
     "pseudo_normals",
 ]
 
@@ -38,6 +41,10 @@ __all__ = [
 #: its longest edge squared (its height below this fraction of that edge): its normal would be
 #: mostly rounding error.
 DEGENERATE_TOLERANCE = 1e-10
+
+#: Vertices with more outgoing edges than this sort them with ``np.argsort`` (insertion sort
+#: below: a vertex of a typical mesh has about six).
+_INSERTION_SORT_MAX = 32
 
 #: The enclosed volume must exceed this fraction of the cube of the mesh's extent.
 _FLAT_TOLERANCE = 1e-12
@@ -89,23 +96,107 @@ def _triangles(value: Any, vertex_count: int) -> np.ndarray:
     return triangles
 
 
-def _check_areas(vertices: np.ndarray, triangles: np.ndarray) -> None:
-    a, b, c = (vertices[triangles[:, k]] for k in range(3))
-    twice_area = np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    longest = np.max(
-        [np.sum((b - a) ** 2, axis=1), np.sum((c - b) ** 2, axis=1), np.sum((a - c) ** 2, axis=1)],
-        axis=0,
-    )
-    bad = ~(twice_area > DEGENERATE_TOLERANCE * longest)
-    if bad.any():
-        row = int(np.flatnonzero(bad)[0])
-        ratio = twice_area[row] / longest[row] if longest[row] > 0 else 0.0
-        raise ModelError(
-            f"`triangles` entry {row} (vertices {describe(triangles[row])}) is degenerate: its "
-            f"area is {0.5 * twice_area[row]:.3g} m², {ratio:.3g} of its longest edge squared "
-            f"(at least {DEGENERATE_TOLERANCE:g} is needed); remove it or move its vertices "
-            "apart"
+@njit(cache=True)
+def _first_degenerate(vertices: np.ndarray, triangles: np.ndarray, tolerance: float) -> int:
+    """Index of the first triangle whose twice-area is not above ``tolerance`` times its longest
+    edge squared (``-1`` if none): the test of :func:`_check_areas`, in one pass."""
+    for t in range(triangles.shape[0]):
+        i, j, k = triangles[t, 0], triangles[t, 1], triangles[t, 2]
+        e1x = vertices[j, 0] - vertices[i, 0]
+        e1y = vertices[j, 1] - vertices[i, 1]
+        e1z = vertices[j, 2] - vertices[i, 2]
+        e2x = vertices[k, 0] - vertices[i, 0]
+        e2y = vertices[k, 1] - vertices[i, 1]
+        e2z = vertices[k, 2] - vertices[i, 2]
+        nx = e1y * e2z - e1z * e2y
+        ny = e1z * e2x - e1x * e2z
+        nz = e1x * e2y - e1y * e2x
+        twice_area = np.sqrt(nx * nx + ny * ny + nz * nz)
+        e3x, e3y, e3z = e2x - e1x, e2y - e1y, e2z - e1z
+        longest = max(
+            e1x * e1x + e1y * e1y + e1z * e1z,
+            e2x * e2x + e2y * e2y + e2z * e2z,
+            e3x * e3x + e3y * e3y + e3z * e3z,
         )
+        if not twice_area > tolerance * longest:
+            return t
+    return -1
+
+
+def _check_areas(vertices: np.ndarray, triangles: np.ndarray) -> None:
+    row = int(_first_degenerate(vertices, triangles, DEGENERATE_TOLERANCE))
+    if row < 0:
+        return
+    a, b, c = vertices[triangles[row]]
+    twice_area = float(np.linalg.norm(np.cross(b - a, c - a)))
+    longest = float(max(np.sum((b - a) ** 2), np.sum((c - b) ** 2), np.sum((a - c) ** 2)))
+    ratio = twice_area / longest if longest > 0 else 0.0
+    raise ModelError(
+        f"`triangles` entry {row} (vertices {describe(triangles[row])}) is degenerate: its "
+        f"area is {0.5 * twice_area:.3g} m², {ratio:.3g} of its longest edge squared "
+        f"(at least {DEGENERATE_TOLERANCE:g} is needed); remove it or move its vertices "
+        "apart"
+    )
+
+
+@njit(cache=True)
+def _paired_edges(triangles: np.ndarray, vertex_count: int) -> np.ndarray:
+    """Each directed edge's undirected index, or an empty array if the mesh is not closed and
+    consistently oriented.
+
+    A closed, consistently oriented mesh uses every directed edge a→b once and its reverse b→a
+    once. The directed edges are bucketed by tail vertex (a counting sort), each bucket sorted
+    by head, and each edge's reverse found by binary search: O(T log d) for vertex degree d,
+    where the general table of :func:`_edge_table` sorts all 3T edges. Undirected edges are
+    numbered in the order (smaller vertex, larger vertex), as :func:`_edge_table` numbers them.
+    """
+    count = triangles.shape[0]
+    start = np.zeros(vertex_count + 1, dtype=np.int64)
+    for t in range(count):
+        for j in range(3):
+            start[triangles[t, j] + 1] += 1
+    for v in range(vertex_count):
+        start[v + 1] += start[v]
+    head = np.empty(3 * count, dtype=np.int64)
+    owner = np.empty(3 * count, dtype=np.int64)  # 3t + j: edge j (vertex j to j + 1) of t
+    fill = start[:-1].copy()
+    for t in range(count):
+        for j in range(3):
+            tail = triangles[t, j]
+            head[fill[tail]] = triangles[t, (j + 1) % 3]
+            owner[fill[tail]] = 3 * t + j
+            fill[tail] += 1
+    for v in range(vertex_count):
+        if start[v + 1] - start[v] > _INSERTION_SORT_MAX:
+            order = np.argsort(head[start[v] : start[v + 1]])
+            head[start[v] : start[v + 1]] = head[start[v] : start[v + 1]][order]
+            owner[start[v] : start[v + 1]] = owner[start[v] : start[v + 1]][order]
+            continue
+        for k in range(start[v] + 1, start[v + 1]):  # insertion sort: buckets hold ~6 edges
+            h, o = head[k], owner[k]
+            m = k - 1
+            while m >= start[v] and head[m] > h:
+                head[m + 1] = head[m]
+                owner[m + 1] = owner[m]
+                m -= 1
+            head[m + 1] = h
+            owner[m + 1] = o
+    edge = np.full(3 * count, -1, dtype=np.int64)
+    failed = np.empty(0, dtype=np.int64)
+    numbered = 0
+    for a in range(vertex_count):
+        for k in range(start[a], start[a + 1]):
+            b = head[k]
+            if k + 1 < start[a + 1] and head[k + 1] == b:
+                return failed  # a→b twice
+            lo = start[b] + np.searchsorted(head[start[b] : start[b + 1]], a)
+            if lo >= start[b + 1] or head[lo] != a:
+                return failed  # no b→a: open, or both triangles run a→b
+            if a < b:
+                edge[owner[k]] = numbered
+                edge[owner[lo]] = numbered
+                numbered += 1
+    return edge
 
 
 def _edge_table(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -155,6 +246,19 @@ def _edge_table(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return edges, inverse.reshape(count, 3)
 
 
+@njit(cache=True)
+def _six_volume(vertices: np.ndarray, triangles: np.ndarray, origin: np.ndarray) -> float:
+    total = 0.0
+    ox, oy, oz = origin[0], origin[1], origin[2]
+    for t in range(triangles.shape[0]):
+        i, j, k = triangles[t, 0], triangles[t, 1], triangles[t, 2]
+        ax, ay, az = vertices[i, 0] - ox, vertices[i, 1] - oy, vertices[i, 2] - oz
+        bx, by, bz = vertices[j, 0] - ox, vertices[j, 1] - oy, vertices[j, 2] - oz
+        cx, cy, cz = vertices[k, 0] - ox, vertices[k, 1] - oy, vertices[k, 2] - oz
+        total += ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)
+    return total
+
+
 def enclosed_volume(vertices: np.ndarray, triangles: np.ndarray) -> float:
     """Signed volume [m³] enclosed by a closed mesh: positive when it is counter-clockwise
     seen from outside.
@@ -162,9 +266,20 @@ def enclosed_volume(vertices: np.ndarray, triangles: np.ndarray) -> float:
     Sum of the tetrahedra (o, a, b, c) with ``o`` the mean vertex, which keeps the terms small
     for a mesh far from the origin (the sum does not depend on ``o`` for a closed mesh).
     """
-    origin = vertices.mean(axis=0)
-    a, b, c = (vertices[triangles[:, k]] - origin for k in range(3))
-    return float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6.0)
+    vertices = np.ascontiguousarray(vertices, dtype=np.float64)
+    triangles = np.ascontiguousarray(triangles, dtype=np.int64)
+    return float(_six_volume(vertices, triangles, vertices.mean(axis=0)) / 6.0)
+
+
+def mesh_arrays(vertices: Any, triangles: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Check the arrays of a mesh, not its topology: ``vertices`` ``(V, 3)`` finite [m] and
+    ``triangles`` ``(T, 3)`` integer indices into them (V, T ≥ 4).
+
+    Returns:
+        Fresh C-contiguous copies: float64 vertices and int64 triangles.
+    """
+    vertices = np.ascontiguousarray(_vertices(vertices))
+    return vertices, np.ascontiguousarray(_triangles(triangles, vertices.shape[0]))
 
 
 def check_closed_mesh(vertices: Any, triangles: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -183,10 +298,13 @@ def check_closed_mesh(vertices: Any, triangles: Any) -> tuple[np.ndarray, np.nda
         ModelError: Non-finite vertices, indices out of range, a degenerate triangle, an open
             or non-manifold mesh, inconsistent orientation, an inside-out or flat mesh.
     """
-    vertices = _vertices(vertices)
-    triangles = _triangles(triangles, vertices.shape[0])
+    vertices, triangles = mesh_arrays(vertices, triangles)
     _check_areas(vertices, triangles)
-    _, triangle_edges = _edge_table(triangles)
+    paired = _paired_edges(triangles, vertices.shape[0])
+    if paired.size:
+        triangle_edges = paired.reshape(-1, 3)
+    else:  # the general table finds the first offending edge and says what is wrong
+        _, triangle_edges = _edge_table(triangles)
     volume = enclosed_volume(vertices, triangles)
     extent = float(np.max(np.ptp(vertices, axis=0)))
     if volume < 0.0:

@@ -1,0 +1,301 @@
+"""Self-intersections of a triangle mesh: pairs of triangles whose interiors cross.
+
+A closed, outward mesh whose surface passes through itself — two overlapping shells merged in
+one mesh, a surface folded through itself — bounds no single solid: its enclosed-volume
+integrals count the overlap twice (or cancel a folded part). :func:`check_self_intersections`
+refuses it, naming two crossing triangles.
+
+Broad phase: a uniform grid of cubic cells about as large as the triangles' bounding boxes
+(the mean of their longest sides, doubled until the triangles touch at most
+:data:`_ENTRIES_PER_TRIANGLE` cells each on average), stored as a hash table bucketed by a
+counting sort: O(T) time and memory for T triangles of similar sizes, with no T² step. Each pair
+of triangles whose boxes overlap is tested once, in the one cell holding the lowest corner of
+the boxes' intersection.
+
+Narrow phase: two triangles that are not coplanar cross if and only if an edge of one passes
+through the interior of the other (the segment where they meet ends on such edges). Edge ab
+passes through triangle cde when a and b lie strictly on opposite sides of the plane of cde and
+the line ab passes strictly inside its three edges: the signs of the orientation determinants
+[a, b, c, d], [a, b, d, e], [a, b, e, c] agree, where [p, q, r, s] = (q − p)·((r − p) × (s − p)).
+A determinant within :data:`ORIENTATION_TOLERANCE` of the pair's size cubed counts as zero, so
+rounding reports nothing.
+
+Not reported, by design: pairs of triangles sharing a vertex (a mesh's neighbours touch there),
+touching contacts (a vertex or an edge resting on another triangle) and coplanar overlaps. Two
+shells that really overlap always have edges of one piercing faces of the other.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from .._validation import describe
+from ..errors import ModelError
+
+__all__ = ["ORIENTATION_TOLERANCE", "check_self_intersections", "find_self_intersection"]
+
+#: An orientation determinant below this fraction of the cube of the pair's extent is zero.
+ORIENTATION_TOLERANCE = 1e-12
+#: Average (triangle, cell) entries per triangle allowed before the cells are made larger.
+_ENTRIES_PER_TRIANGLE = 8
+#: Cells per axis at most, so that a cell's three integer coordinates pack into one int64 key.
+_CELL_BITS = 20
+#: Odd multiplier of the hash (the 64-bit LCG multiplier of PCG, below 2⁶³).
+_MIX = 6364136223846793005
+
+
+@njit(cache=True)
+def _boxes(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    count = triangles.shape[0]
+    lo = np.empty((count, 3))
+    hi = np.empty((count, 3))
+    for t in range(count):
+        for axis in range(3):
+            a = vertices[triangles[t, 0], axis]
+            b = vertices[triangles[t, 1], axis]
+            c = vertices[triangles[t, 2], axis]
+            lo[t, axis] = min(a, b, c)
+            hi[t, axis] = max(a, b, c)
+    return lo, hi
+
+
+@njit(cache=True, inline="always")
+def _cell(x: float, base: float, inverse: float) -> int:
+    return int(np.floor((x - base) * inverse))
+
+
+@njit(cache=True)
+def _entry_count(lo: np.ndarray, hi: np.ndarray, base: np.ndarray, inverse: float) -> int:
+    total = 0
+    for t in range(lo.shape[0]):
+        cells = 1
+        for axis in range(3):
+            first = _cell(lo[t, axis], base[axis], inverse)
+            cells *= _cell(hi[t, axis], base[axis], inverse) - first + 1
+        total += cells
+    return total
+
+
+@njit(cache=True, inline="always")
+def _key(i: int, j: int, k: int) -> int:
+    return i | (j << _CELL_BITS) | (k << (2 * _CELL_BITS))
+
+
+@njit(cache=True, inline="always")
+def _bucket(key: int, mask: int) -> int:
+    h = key ^ (key >> 29)
+    h = h * _MIX
+    h = h ^ (h >> 32)
+    return h & mask
+
+
+@njit(cache=True, inline="always")
+def _cell_range(
+    lo: np.ndarray, hi: np.ndarray, t: int, base: np.ndarray, inverse: float
+) -> tuple[int, int, int, int, int, int]:
+    return (
+        _cell(lo[t, 0], base[0], inverse),
+        _cell(hi[t, 0], base[0], inverse),
+        _cell(lo[t, 1], base[1], inverse),
+        _cell(hi[t, 1], base[1], inverse),
+        _cell(lo[t, 2], base[2], inverse),
+        _cell(hi[t, 2], base[2], inverse),
+    )
+
+
+@njit(cache=True)
+def _grid(
+    lo: np.ndarray, hi: np.ndarray, base: np.ndarray, inverse: float, entries: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Bucket every (triangle, cell) entry by a hash of its cell (a counting sort).
+
+    Returns ``start`` (buckets + 1) and, per entry in bucket order: its triangle, its cell's
+    key, its triangle's box (lo, hi) and ``lowest``, whose bit ``a`` says that the cell is the
+    triangle's first along axis ``a``. The boxes are copied next to each other so that the pair
+    loop reads memory in order.
+    """
+    buckets = 1
+    while buckets < 2 * entries:
+        buckets *= 2
+    mask = buckets - 1
+    start = np.zeros(buckets + 1, dtype=np.int64)
+    for t in range(lo.shape[0]):
+        i0, i1, j0, j1, k0, k1 = _cell_range(lo, hi, t, base, inverse)
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                for k in range(k0, k1 + 1):
+                    start[_bucket(_key(i, j, k), mask) + 1] += 1
+    for b in range(buckets):
+        start[b + 1] += start[b]
+    fill = start[:-1].copy()
+    triangle = np.empty(entries, dtype=np.int64)
+    key = np.empty(entries, dtype=np.int64)
+    box = np.empty((entries, 6))
+    lowest = np.empty(entries, dtype=np.int64)
+    for t in range(lo.shape[0]):
+        i0, i1, j0, j1, k0, k1 = _cell_range(lo, hi, t, base, inverse)
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                for k in range(k0, k1 + 1):
+                    code = _key(i, j, k)
+                    n = fill[_bucket(code, mask)]
+                    fill[_bucket(code, mask)] += 1
+                    triangle[n] = t
+                    key[n] = code
+                    for axis in range(3):
+                        box[n, axis] = lo[t, axis]
+                        box[n, 3 + axis] = hi[t, axis]
+                    lowest[n] = (i == i0) | ((j == j0) << 1) | ((k == k0) << 2)
+    return start, triangle, key, box, lowest
+
+
+@njit(cache=True, inline="always")
+def _orient(v: np.ndarray, a: int, b: int, c: int, d: int) -> float:
+    """[a, b, c, d] = (b − a)·((c − a) × (d − a)) for rows a, b, c, d of ``v``."""
+    bx, by, bz = v[b, 0] - v[a, 0], v[b, 1] - v[a, 1], v[b, 2] - v[a, 2]
+    cx, cy, cz = v[c, 0] - v[a, 0], v[c, 1] - v[a, 1], v[c, 2] - v[a, 2]
+    dx, dy, dz = v[d, 0] - v[a, 0], v[d, 1] - v[a, 1], v[d, 2] - v[a, 2]
+    return bx * (cy * dz - cz * dy) + by * (cz * dx - cx * dz) + bz * (cx * dy - cy * dx)
+
+
+@njit(cache=True, inline="always")
+def _side(value: float, tolerance: float) -> int:
+    if value > tolerance:
+        return 1
+    if value < -tolerance:
+        return -1
+    return 0
+
+
+@njit(cache=True)
+def _pierces(v: np.ndarray, a: int, b: int, c: int, d: int, e: int, tolerance: float) -> bool:
+    """Whether the line ab passes strictly inside triangle cde (a, b already on either side)."""
+    s1 = _side(_orient(v, a, b, c, d), tolerance)
+    s2 = _side(_orient(v, a, b, d, e), tolerance)
+    s3 = _side(_orient(v, a, b, e, c), tolerance)
+    return s1 != 0 and s1 == s2 and s2 == s3
+
+
+@njit(cache=True)
+def _cross(v: np.ndarray, p: np.ndarray, q: np.ndarray, tolerance: float) -> bool:
+    """Whether triangles p and q (vertex index triples) cross, by the edge test above."""
+    p0, p1, p2 = p[0], p[1], p[2]
+    q0, q1, q2 = q[0], q[1], q[2]
+    a0 = _side(_orient(v, q0, q1, q2, p0), tolerance)  # sides of p's vertices about q's plane
+    a1 = _side(_orient(v, q0, q1, q2, p1), tolerance)
+    a2 = _side(_orient(v, q0, q1, q2, p2), tolerance)
+    if abs(a0 + a1 + a2) == 3:
+        return False  # p wholly on one side of q's plane
+    b0 = _side(_orient(v, p0, p1, p2, q0), tolerance)
+    b1 = _side(_orient(v, p0, p1, p2, q1), tolerance)
+    b2 = _side(_orient(v, p0, p1, p2, q2), tolerance)
+    if abs(b0 + b1 + b2) == 3:
+        return False
+    return (
+        (a0 * a1 < 0 and _pierces(v, p0, p1, q0, q1, q2, tolerance))
+        or (a1 * a2 < 0 and _pierces(v, p1, p2, q0, q1, q2, tolerance))
+        or (a2 * a0 < 0 and _pierces(v, p2, p0, q0, q1, q2, tolerance))
+        or (b0 * b1 < 0 and _pierces(v, q0, q1, p0, p1, p2, tolerance))
+        or (b1 * b2 < 0 and _pierces(v, q1, q2, p0, p1, p2, tolerance))
+        or (b2 * b0 < 0 and _pierces(v, q2, q0, p0, p1, p2, tolerance))
+    )
+
+
+@njit(cache=True, parallel=True)
+def _crossing_pairs(
+    vertices: np.ndarray,
+    triangles: np.ndarray,
+    start: np.ndarray,
+    entry_triangle: np.ndarray,
+    entry_key: np.ndarray,
+    entry_box: np.ndarray,
+    entry_lowest: np.ndarray,
+) -> np.ndarray:
+    """Per bucket, the lowest crossing pair (s < t) found in it, or (-1, -1)."""
+    buckets = start.shape[0] - 1
+    found = np.full((buckets, 2), -1, dtype=np.int64)
+    for b in prange(buckets):
+        for x in range(start[b], start[b + 1]):
+            for y in range(x + 1, start[b + 1]):
+                # Same cell, and the cell holds the lowest corner of the boxes' intersection
+                # (along each axis, the first cell of one of the two): each pair tested once.
+                if entry_key[x] != entry_key[y] or (entry_lowest[x] | entry_lowest[y]) != 7:
+                    continue
+                overlap = True
+                extent = 0.0
+                for axis in range(3):
+                    low = max(entry_box[x, axis], entry_box[y, axis])
+                    high = min(entry_box[x, 3 + axis], entry_box[y, 3 + axis])
+                    overlap = overlap and low <= high
+                    width = max(entry_box[x, 3 + axis], entry_box[y, 3 + axis]) - min(
+                        entry_box[x, axis], entry_box[y, axis]
+                    )
+                    extent = max(extent, width)
+                if not overlap:
+                    continue
+                s = min(entry_triangle[x], entry_triangle[y])
+                t = max(entry_triangle[x], entry_triangle[y])
+                shared = False
+                for m in range(3):
+                    for n in range(3):
+                        shared = shared or triangles[s, m] == triangles[t, n]
+                if shared:
+                    continue
+                tolerance = ORIENTATION_TOLERANCE * extent * extent * extent
+                if _cross(vertices, triangles[s], triangles[t], tolerance) and (
+                    found[b, 0] < 0 or s < found[b, 0] or (s == found[b, 0] and t < found[b, 1])
+                ):
+                    found[b, 0] = s
+                    found[b, 1] = t
+    return found
+
+
+def find_self_intersection(vertices: np.ndarray, triangles: np.ndarray) -> tuple[int, int] | None:
+    """The crossing pair of triangles (s, t), s < t, lowest in s then t, or ``None``.
+
+    Args:
+        vertices: ``(V, 3)`` float64 vertex positions [m], C-contiguous, finite.
+        triangles: ``(T, 3)`` int64 vertex indices, valid (as from
+            :func:`visviva.geometry.mesh_topology.mesh_arrays`).
+    """
+    if triangles.shape[0] < 2:
+        return None
+    lo, hi = _boxes(vertices, triangles)
+    base = lo.min(axis=0)
+    span = float(np.max(hi.max(axis=0) - base))
+    size = float(np.mean(np.max(hi - lo, axis=1)))
+    # Cells no smaller than the span over 2^20, so that their coordinates pack in the key.
+    size = max(size, span / float((1 << _CELL_BITS) - 2), np.finfo(float).tiny)
+    while True:
+        entries = _entry_count(lo, hi, base, 1.0 / size)
+        if entries <= _ENTRIES_PER_TRIANGLE * triangles.shape[0]:
+            break
+        size *= 2.0
+    inverse = 1.0 / size
+    found = _crossing_pairs(vertices, triangles, *_grid(lo, hi, base, inverse, entries))
+    hits = found[found[:, 0] >= 0]
+    if not hits.size:
+        return None
+    s, t = hits[np.lexsort((hits[:, 1], hits[:, 0]))[0]]
+    return int(s), int(t)
+
+
+def check_self_intersections(vertices: np.ndarray, triangles: np.ndarray) -> None:
+    """Raise a ModelError naming two crossing triangles, if the mesh crosses itself.
+
+    Args:
+        vertices: ``(V, 3)`` float64 vertex positions [m], C-contiguous, finite.
+        triangles: ``(T, 3)`` int64 valid vertex indices.
+    """
+    pair = find_self_intersection(vertices, triangles)
+    if pair is None:
+        return
+    s, t = pair
+    near = 0.5 * (vertices[triangles[s]].mean(axis=0) + vertices[triangles[t]].mean(axis=0))
+    raise ModelError(
+        f"`triangles` cross each other: entries {s} (vertices {describe(triangles[s])}) and "
+        f"{t} (vertices {describe(triangles[t])}) intersect, near {describe(near.round(6))} m, "
+        "so the mesh bounds no single solid (an overlap would count twice in its volume and "
+        "mass); merge the overlapping parts into one surface (a boolean union) or separate them"
+    )
