@@ -13,16 +13,23 @@ of triangles whose boxes overlap is tested once, in the one cell holding the low
 the boxes' intersection.
 
 Narrow phase: two triangles that are not coplanar cross if and only if an edge of one passes
-through the interior of the other (the segment where they meet ends on such edges). Edge ab
-passes through triangle cde when a and b lie strictly on opposite sides of the plane of cde and
-the line ab passes strictly inside its three edges: the signs of the orientation determinants
+through the other (the segment where they meet ends on such edges). Edge ab passes through
+triangle cde when a and b lie strictly on opposite sides of the plane of cde and the line ab
+passes strictly inside its three edges: the signs of the orientation determinants
 [a, b, c, d], [a, b, d, e], [a, b, e, c] agree, where [p, q, r, s] = (q − p)·((r − p) × (s − p)).
 A determinant within :data:`ORIENTATION_TOLERANCE` of the pair's size cubed counts as zero, so
-rounding reports nothing.
+rounding reports nothing. A line through the inside of an edge cd (one determinant zero) is
+decided with the neighbouring triangle across cd, as if the line were moved off the edge by an
+infinitesimal (simulation of simplicity, H. Edelsbrunner and E. P. Mücke, *ACM Transactions on
+Graphics* 9(1), 1990): it then pierces exactly one of the two triangles — the surface is crossed —
+when both face the line the same way, and both or neither — a ridge or valley is touched —
+otherwise. Overlapping boxes offset along a diagonal cross each other exactly through their
+faces' diagonal edges, and are seen.
 
 Not reported, by design: pairs of triangles sharing a vertex (a mesh's neighbours touch there),
-touching contacts (a vertex or an edge resting on another triangle) and coplanar overlaps. Two
-shells that really overlap always have edges of one piercing faces of the other.
+touching contacts (a vertex or an edge resting on another triangle), coplanar overlaps, and a
+line passing exactly through a vertex. Two shells that really overlap have edges of one
+crossing faces of the other, away from such coincidences.
 """
 
 from __future__ import annotations
@@ -32,6 +39,7 @@ from numba import njit, prange
 
 from .._validation import describe
 from ..errors import ModelError
+from .mesh_topology import _paired_edges
 
 __all__ = ["ORIENTATION_TOLERANCE", "check_self_intersections", "find_self_intersection"]
 
@@ -169,43 +177,96 @@ def _side(value: float, tolerance: float) -> int:
 
 
 @njit(cache=True)
-def _pierces(v: np.ndarray, a: int, b: int, c: int, d: int, e: int, tolerance: float) -> bool:
-    """Whether the line ab passes strictly inside triangle cde (a, b already on either side)."""
-    s1 = _side(_orient(v, a, b, c, d), tolerance)
-    s2 = _side(_orient(v, a, b, d, e), tolerance)
-    s3 = _side(_orient(v, a, b, e, c), tolerance)
-    return s1 != 0 and s1 == s2 and s2 == s3
+def _pierces(
+    v: np.ndarray,
+    a: int,
+    b: int,
+    triangles: np.ndarray,
+    far: np.ndarray,
+    t: int,
+    tolerance: float,
+) -> bool:
+    """Whether the line ab crosses the surface at triangle t (a, b on either side of its
+    plane): strictly inside it, or through the inside of one of its edges where the
+    neighbour across that edge faces the line the same way."""
+    c, d, e = triangles[t, 0], triangles[t, 1], triangles[t, 2]
+    s0 = _side(_orient(v, a, b, c, d), tolerance)  # about edge c → d (slot 0)
+    s1 = _side(_orient(v, a, b, d, e), tolerance)  # d → e (slot 1)
+    s2 = _side(_orient(v, a, b, e, c), tolerance)  # e → c (slot 2)
+    if s0 != 0 and s0 == s1 and s1 == s2:
+        return True
+    # Through an edge: exactly one side zero, the other two agreeing.
+    if s0 == 0 and s1 != 0 and s1 == s2:
+        slot, p, sigma = 0, c, s1  # the edge p → q, here c → d
+    elif s1 == 0 and s2 != 0 and s2 == s0:
+        slot, p, sigma = 1, d, s2
+    elif s2 == 0 and s0 != 0 and s0 == s1:
+        slot, p, sigma = 2, e, s0
+    else:
+        return False
+    f = far[t, slot]
+    if f < 0:
+        return False
+    # The neighbour (q, p, f): a line moved off the edge pierces exactly one of the two
+    # triangles (it crosses the surface) when both face it the same way, both or neither (it
+    # touches a ridge or a valley) otherwise.
+    return _side(_orient(v, a, b, p, f), tolerance) == sigma
 
 
 @njit(cache=True)
-def _cross(v: np.ndarray, p: np.ndarray, q: np.ndarray, tolerance: float) -> bool:
-    """Whether triangles p and q (vertex index triples) cross, by the edge test above."""
-    p0, p1, p2 = p[0], p[1], p[2]
-    q0, q1, q2 = q[0], q[1], q[2]
-    a0 = _side(_orient(v, q0, q1, q2, p0), tolerance)  # sides of p's vertices about q's plane
+def _cross(
+    v: np.ndarray, triangles: np.ndarray, far: np.ndarray, s: int, t: int, tolerance: float
+) -> bool:
+    """Whether triangles s and t cross, by the edge test above."""
+    p0, p1, p2 = triangles[s, 0], triangles[s, 1], triangles[s, 2]
+    q0, q1, q2 = triangles[t, 0], triangles[t, 1], triangles[t, 2]
+    a0 = _side(_orient(v, q0, q1, q2, p0), tolerance)  # sides of s's vertices about t's plane
     a1 = _side(_orient(v, q0, q1, q2, p1), tolerance)
     a2 = _side(_orient(v, q0, q1, q2, p2), tolerance)
     if abs(a0 + a1 + a2) == 3:
-        return False  # p wholly on one side of q's plane
+        return False  # s wholly on one side of t's plane
     b0 = _side(_orient(v, p0, p1, p2, q0), tolerance)
     b1 = _side(_orient(v, p0, p1, p2, q1), tolerance)
     b2 = _side(_orient(v, p0, p1, p2, q2), tolerance)
     if abs(b0 + b1 + b2) == 3:
         return False
     return (
-        (a0 * a1 < 0 and _pierces(v, p0, p1, q0, q1, q2, tolerance))
-        or (a1 * a2 < 0 and _pierces(v, p1, p2, q0, q1, q2, tolerance))
-        or (a2 * a0 < 0 and _pierces(v, p2, p0, q0, q1, q2, tolerance))
-        or (b0 * b1 < 0 and _pierces(v, q0, q1, p0, p1, p2, tolerance))
-        or (b1 * b2 < 0 and _pierces(v, q1, q2, p0, p1, p2, tolerance))
-        or (b2 * b0 < 0 and _pierces(v, q2, q0, p0, p1, p2, tolerance))
+        (a0 * a1 < 0 and _pierces(v, p0, p1, triangles, far, t, tolerance))
+        or (a1 * a2 < 0 and _pierces(v, p1, p2, triangles, far, t, tolerance))
+        or (a2 * a0 < 0 and _pierces(v, p2, p0, triangles, far, t, tolerance))
+        or (b0 * b1 < 0 and _pierces(v, q0, q1, triangles, far, s, tolerance))
+        or (b1 * b2 < 0 and _pierces(v, q1, q2, triangles, far, s, tolerance))
+        or (b2 * b0 < 0 and _pierces(v, q2, q0, triangles, far, s, tolerance))
     )
+
+
+@njit(cache=True)
+def _far_vertices(triangles: np.ndarray, triangle_edges: np.ndarray) -> np.ndarray:
+    """Per triangle and edge slot (a → b, b → c, c → a), the vertex of the neighbour across
+    that edge not on it; −1 without ``triangle_edges`` (an empty array)."""
+    count = triangles.shape[0]
+    far = np.full((count, 3), -1, dtype=np.int64)
+    if triangle_edges.shape[0] != count:
+        return far
+    first = np.full(3 * count, -1, dtype=np.int64)  # the first directed edge seen per edge
+    for t in range(count):
+        for slot in range(3):
+            edge = triangle_edges[t, slot]
+            other = first[edge]
+            if other < 0:
+                first[edge] = 3 * t + slot
+                continue
+            u, k = other // 3, other % 3
+            far[t, slot] = triangles[u, (k + 2) % 3]
+            far[u, k] = triangles[t, (slot + 2) % 3]
+    return far
 
 
 @njit(cache=True, parallel=True)
 def _crossing_pairs(
     vertices: np.ndarray,
     triangles: np.ndarray,
+    far: np.ndarray,
     start: np.ndarray,
     entry_triangle: np.ndarray,
     entry_key: np.ndarray,
@@ -243,7 +304,7 @@ def _crossing_pairs(
                 if shared:
                     continue
                 tolerance = ORIENTATION_TOLERANCE * extent * extent * extent
-                if _cross(vertices, triangles[s], triangles[t], tolerance) and (
+                if _cross(vertices, triangles, far, s, t, tolerance) and (
                     found[b, 0] < 0 or s < found[b, 0] or (s == found[b, 0] and t < found[b, 1])
                 ):
                     found[b, 0] = s
@@ -251,13 +312,18 @@ def _crossing_pairs(
     return found
 
 
-def find_self_intersection(vertices: np.ndarray, triangles: np.ndarray) -> tuple[int, int] | None:
+def find_self_intersection(
+    vertices: np.ndarray, triangles: np.ndarray, triangle_edges: np.ndarray | None = None
+) -> tuple[int, int] | None:
     """The crossing pair of triangles (s, t), s < t, lowest in s then t, or ``None``.
 
     Args:
         vertices: ``(V, 3)`` float64 vertex positions [m], C-contiguous, finite.
         triangles: ``(T, 3)`` int64 vertex indices, valid (as from
             :func:`visviva.geometry.mesh_topology.mesh_arrays`).
+        triangle_edges: ``(T, 3)`` edge indices as returned by
+            :func:`~visviva.geometry.mesh_topology.check_closed_mesh` (found again if not
+            given; for a mesh that is not closed, crossings through an edge are not seen).
     """
     if triangles.shape[0] < 2:
         return None
@@ -273,7 +339,12 @@ def find_self_intersection(vertices: np.ndarray, triangles: np.ndarray) -> tuple
             break
         size *= 2.0
     inverse = 1.0 / size
-    found = _crossing_pairs(vertices, triangles, *_grid(lo, hi, base, inverse, entries))
+    if triangle_edges is None:
+        paired = _paired_edges(triangles, vertices.shape[0])
+        triangle_edges = paired.reshape(-1, 3) if paired.size else np.empty((0, 3), np.int64)
+    far = _far_vertices(triangles, np.ascontiguousarray(triangle_edges, dtype=np.int64))
+    grid = _grid(lo, hi, base, inverse, entries)
+    found = _crossing_pairs(vertices, triangles, far, *grid)
     hits = found[found[:, 0] >= 0]
     if not hits.size:
         return None
@@ -281,14 +352,14 @@ def find_self_intersection(vertices: np.ndarray, triangles: np.ndarray) -> tuple
     return int(s), int(t)
 
 
-def check_self_intersections(vertices: np.ndarray, triangles: np.ndarray) -> None:
+def check_self_intersections(
+    vertices: np.ndarray, triangles: np.ndarray, triangle_edges: np.ndarray | None = None
+) -> None:
     """Raise a ModelError naming two crossing triangles, if the mesh crosses itself.
 
-    Args:
-        vertices: ``(V, 3)`` float64 vertex positions [m], C-contiguous, finite.
-        triangles: ``(T, 3)`` int64 valid vertex indices.
+    Arguments as for :func:`find_self_intersection`.
     """
-    pair = find_self_intersection(vertices, triangles)
+    pair = find_self_intersection(vertices, triangles, triangle_edges)
     if pair is None:
         return
     s, t = pair

@@ -192,12 +192,13 @@ def mesh_mass_properties(
     (2000.0, [1.0, 0.5, 0.5])
     """
     rho = dimension("mesh", "density", density, "kg/m³")
+    edges = None
     if check_topology:
-        vertices, triangles, _ = check_closed_mesh(vertices, triangles)
+        vertices, triangles, edges = check_closed_mesh(vertices, triangles)
     else:
         vertices, triangles = mesh_arrays(vertices, triangles)
     if check_intersections:
-        check_self_intersections(vertices, triangles)
+        check_self_intersections(vertices, triangles, edges)
     origin = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
     return _from_integrals(polyhedral_integrals(vertices, triangles, origin), origin, rho)
 

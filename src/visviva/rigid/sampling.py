@@ -119,9 +119,9 @@ def _region(shape: str, dims: dict[str, Any], check_intersections: bool) -> Regi
         vertices, triangles = read_triangle_mesh(dims["path"])
     else:
         vertices, triangles = dims["vertices"], dims["triangles"]
-    vertices, triangles, _ = check_closed_mesh(vertices, triangles)
+    vertices, triangles, edges = check_closed_mesh(vertices, triangles)
     if check_intersections:
-        check_self_intersections(vertices, triangles)
+        check_self_intersections(vertices, triangles, edges)
     test = InsideTest.of(vertices, triangles)
     return vertices.min(axis=0), vertices.max(axis=0), test.contains
 
