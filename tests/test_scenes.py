@@ -212,6 +212,7 @@ def test_cli_validate_schema_dry_run_and_plot(tmp_path):
         "cloth_mesh",
         "soft_lattice",
         "soft_mesh",
+        "body",
         "emitter",
         "system",
         "force",

@@ -1,7 +1,7 @@
 """Symplectic methods on the split state ``(q, v)``: symplectic Euler, velocity Verlet, leapfrog.
 
 Each alternates *kicks* (``v += h·a``) and *drifts* (``q += h·v``; for a rigid body's
-orientation, a rotation by its angular momentum: ``SecondOrderSystem.drift``). For forces
+orientation, a rotation by its angular momentum: ``Kinematics.drift``). For forces
 that depend on position only, every one of these maps is symplectic: it conserves a
 *modified* energy ``H̃ = H + O(h^p)`` exactly, so the true energy oscillates within
 ``O(h^p)`` of its initial value for exponentially long times instead of drifting (seed 001).
@@ -44,9 +44,16 @@ def start_acceleration(system: SecondOrderSystem, state: State):
     return system.acceleration(state.t, state.q, state.v)
 
 
+def _drift(system: SecondOrderSystem, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
+    """``q + h v``, or the system's kinematics' drift (rigid bodies' rotations)."""
+    kinematics = getattr(system, "kinematics", None)
+    return q + h * v if kinematics is None else kinematics.drift(q, v, h)
+
+
 def _derivative(system: SecondOrderSystem, q: np.ndarray, v: np.ndarray, a: np.ndarray):
     """The derivative ``(q', v')`` of a state whose acceleration ``a`` is known."""
-    return system.position_rate(q, v), a
+    kinematics = getattr(system, "kinematics", None)
+    return (v if kinematics is None else kinematics.rate(q, v)), a
 
 
 class _Split(Integrator):
@@ -86,7 +93,7 @@ class SymplecticEuler(_Split):
     def step(self, system: System, state: State, dt: float) -> State:
         a = start_acceleration(system, state)
         v1 = state.v + dt * a
-        return state.from_parts(state.t + dt, (system.drift(state.q, v1, dt), v1))
+        return state.from_parts(state.t + dt, (_drift(system, state.q, v1, dt), v1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         return self._compile(problem, _symplectic_euler_kernel)
@@ -107,7 +114,7 @@ class SymplecticEulerPositionFirst(_Split):
 
     def step(self, system: System, state: State, dt: float) -> State:
         t1 = state.t + dt
-        q1 = system.drift(state.q, state.v, dt)
+        q1 = _drift(system, state.q, state.v, dt)
         a = system.acceleration(t1, q1, state.v)
         v1 = state.v + dt * a
         # For position-only forces `a` is exactly the acceleration of the new state.
@@ -138,7 +145,7 @@ class VelocityVerlet(_Split):
         a0 = start_acceleration(system, state)
         t1 = state.t + dt
         v_half = state.v + (0.5 * dt) * a0
-        q1 = system.drift(state.q, v_half, dt)
+        q1 = _drift(system, state.q, v_half, dt)
         if system.velocity_dependent:
             a1 = system.acceleration(t1, q1, state.v + dt * a0)
             return state.from_parts(t1, (q1, v_half + (0.5 * dt) * a1))
@@ -166,14 +173,14 @@ class Leapfrog(_Split):
 
     def step(self, system: System, state: State, dt: float) -> State:
         t_half = state.t + 0.5 * dt
-        q_half = system.drift(state.q, state.v, 0.5 * dt)
+        q_half = _drift(system, state.q, state.v, 0.5 * dt)
         v_mid = state.v
         if system.velocity_dependent:
             a0 = start_acceleration(system, state)
             v_mid = state.v + (0.5 * dt) * a0
         a = system.acceleration(t_half, q_half, v_mid)
         v1 = state.v + dt * a
-        return state.from_parts(state.t + dt, (system.drift(q_half, v1, 0.5 * dt), v1))
+        return state.from_parts(state.t + dt, (_drift(system, q_half, v1, 0.5 * dt), v1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
         return self._compile(problem, _leapfrog_kernel)

@@ -19,6 +19,7 @@ import numpy as np
 
 from .._validation import describe, did_you_mean
 from ..errors import ModelError, SceneError, SceneProblem
+from ..rigid.projection import BodyProjection
 from ..simulation.loop import MAX_STEPS
 from .model import Integration, Model, SystemInstance, frozen_array
 from .parts import (
@@ -31,6 +32,7 @@ from .parts import (
     penalty_forces,
     spring_forces,
 )
+from .rigid_parts import rigid_bodies
 from .scene import (
     MAX_PARTICLES,
     Collider,
@@ -43,6 +45,7 @@ from .scene import (
 )
 from .scene_bodies import BODIES, POINT_BODIES, Body, Hair, Rope, SpringGraph
 from .scene_meshes import with_mesh_files
+from .scene_rigid import RigidBody
 from .systems import SYSTEMS
 
 __all__ = ["build_model", "entity_names"]
@@ -105,6 +108,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
             forces = force_objects(scene, groups, arrays["mass"])
             forces += penalty_forces(scene, groups, arrays, h)
             forces += spring_forces(scene, groups, count)
+        bodies, body_forces = rigid_bodies(scene, names)
         collisions = collision_stage(scene, groups, arrays["pinned"], h)
         if collisions is not None:
             stages.append(collisions)
@@ -112,6 +116,8 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
             from ..particles.emission import Emission
 
             stages.append(Emission(specs, count))
+        if bodies is not None:
+            stages.append(BodyProjection(bodies.count))
     except Located as located:
         raise SceneError([located.problem]) from None
     model = Model(
@@ -135,6 +141,8 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         particle_pinned=frozen_array(arrays["pinned"], dtype=bool),
         particle_groups=tuple(groups),
         systems=tuple(systems),
+        bodies=bodies,
+        body_forces=tuple(body_forces),
         forces=tuple(forces),
         emitters=tuple(specs),
         stages=tuple(stages),
@@ -238,13 +246,13 @@ def _located(message: str, where: str, values: Mapping[str, float]) -> SceneProb
 def _check(scene: Scene) -> list[SceneProblem]:
     problems: list[SceneProblem] = []
     entities = scene.entities
-    if not any(isinstance(e, (*PARTICLE_ENTITIES, System)) for e in entities):
+    if not any(isinstance(e, (*PARTICLE_ENTITIES, System, RigidBody)) for e in entities):
         what = "nothing in this scene moves" if entities else "the scene is empty"
         problems.append(
             SceneProblem(
                 "entities",
                 f'{what}; add at least one [[entities]] table of type "particles", '
-                '"particle_cloud", "emitter" or "system"',
+                '"particle_cloud", "emitter", "body" or "system"',
             )
         )
     problems += _check_steps(scene)

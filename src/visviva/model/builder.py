@@ -43,6 +43,7 @@ from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, S
 from .scene_errors import scene_problems
 from .scene_handles import Handle
 from .scene_meshes import with_mesh_file
+from .scene_rigid import RigidBody
 
 __all__ = ["SceneBuilder"]
 
@@ -313,6 +314,47 @@ class SceneBuilder:
         index = len(self._scene.entities)
         where = f"entities[{index}]"
         entity = _validated(ClothMesh, where, **(given | {"type": "cloth_mesh"}))
+        self._replace(entities=[*self._scene.entities, with_mesh_file(entity, where)])
+        return index
+
+    def add_body(
+        self,
+        shape: str,
+        *,
+        density: float | None = None,
+        mass: float | None = None,
+        position: Vector | None = None,
+        orientation: Sequence[float] | None = None,
+        velocity: Vector | None = None,
+        angular_velocity: Vector | None = None,
+        size: Vector | None = None,
+        radius: float | None = None,
+        height: float | None = None,
+        vertices: Any = None,
+        triangles: Any = None,
+        path: str | os.PathLike[str] | None = None,
+        linear_damping: float | None = None,
+        angular_damping: float | None = None,
+        color: Vector | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add a rigid body: a ``shape`` (``"box"`` with ``size`` [m] its full edge lengths,
+        ``"sphere"`` with ``radius``, ``"ellipsoid"`` with ``size`` its semi-axes,
+        ``"cylinder"``, ``"capsule"``, ``"cone"`` with ``radius`` and ``height`` along its y
+        axis, ``"mesh"`` with ``vertices`` ``(V, 3)`` and ``triangles`` ``(T, 3)`` or a mesh
+        file at ``path``) of uniform ``density`` [kg/m³] or total ``mass`` [kg], its own
+        origin at ``position`` [m], turned by ``orientation`` (a unit quaternion (w, x, y, z),
+        body to world), its centre of mass moving at ``velocity`` [m/s] and spinning at
+        ``angular_velocity`` [rad/s] (world frame); ``linear_damping`` and
+        ``angular_damping`` [1/s] damp its momenta (see :mod:`visviva.model.scene_rigid`).
+        Its state is ``body_position`` (the centre of mass), ``body_orientation``,
+        ``body_momentum`` and ``body_angular_momentum``."""
+        given = _given(locals())
+        if "path" in given:
+            given["path"] = os.fspath(given["path"])
+        index = len(self._scene.entities)
+        where = f"entities[{index}]"
+        entity = _validated(RigidBody, where, **(given | {"type": "body"}))
         self._replace(entities=[*self._scene.entities, with_mesh_file(entity, where)])
         return index
 

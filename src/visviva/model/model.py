@@ -23,9 +23,11 @@ from .systems import SYSTEMS
 
 if TYPE_CHECKING:
     from ..forces.base import Force
+    from ..forces.body_forces import BodyForce
     from ..ode.state import State
     from ..ode.system import System
     from ..particles.emitters import EmitterSpec
+    from ..rigid.bodies import RigidBodies
     from ..simulation.stepper import Stage
     from .scene import Scene
 
@@ -142,6 +144,8 @@ class Model:
             handle's path (no force moves them), ``(particle_count,)``.
         particle_groups: Which entity each range of particle slots came from.
         systems: The named systems, whose coordinates follow the particles' in the state.
+        bodies: The rigid bodies, whose state follows the systems' (``None`` if none).
+        body_forces: The forces on the rigid bodies (world gravity first).
         forces: The forces on particles, world gravity first.
         emitters: The emitters (their slots are among the particles').
         stages: The post-step stages, in order (handles, collisions, then emission).
@@ -165,6 +169,8 @@ class Model:
     particle_pinned: np.ndarray
     particle_groups: tuple[ParticleGroup, ...] = ()
     systems: tuple[SystemInstance, ...] = ()
+    bodies: RigidBodies | None = field(default=None, repr=False)
+    body_forces: tuple[BodyForce, ...] = field(default=(), repr=False)
     forces: tuple[Force, ...] = field(default=(), repr=False)
     emitters: tuple[EmitterSpec, ...] = field(default=(), repr=False)
     stages: tuple[Stage, ...] = field(default=(), repr=False)
@@ -180,6 +186,11 @@ class Model:
         return self.particle_position.shape[0]
 
     @property
+    def body_count(self) -> int:
+        """Number of rigid bodies."""
+        return 0 if self.bodies is None else self.bodies.count
+
+    @property
     def coordinate_count(self) -> int:
         """Number of generalized coordinates of the named systems."""
         return sum(s.size for s in self.systems)
@@ -189,7 +200,9 @@ class Model:
         """True if the scene's energy is conserved by the exact dynamics (so a change in it
         measures the integrator's error): no dissipative force, no stage that changes the
         state (collisions, births), no damped system."""
-        if self.stages or not all(f.conservative for f in self.forces):
+        if any(getattr(s, "changes_energy", True) for s in self.stages):
+            return False
+        if not all(f.conservative for f in (*self.forces, *self.body_forces)):
             return False
         return all(SYSTEMS[s.system].conservative(s.parameters) for s in self.systems)
 

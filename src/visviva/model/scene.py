@@ -13,7 +13,8 @@ nothing here knows about files.
 Entities (``[[entities]]``, each with a ``type``): ``particles`` and ``particle_cloud`` (particles
 placed once), ``emitter`` (particles born and dying over time), the deformable bodies of
 :mod:`.scene_bodies` (``rope``, ``hair``, ``springs``, ``cloth``, ``cloth_mesh``,
-``soft_lattice``, ``soft_mesh``: particles joined by springs), ``system`` (a named mechanical
+``soft_lattice``, ``soft_mesh``: particles joined by springs), ``body`` (a rigid body,
+:mod:`.scene_rigid`), ``system`` (a named mechanical
 system: pendulums, Kepler orbits, star clusters...), ``force`` (a force field on particles, or
 gravitation among them) and ``collider`` (a static shape particles bounce off). The value types
 the tables share are in :mod:`.scene_fields`.
@@ -39,6 +40,7 @@ from .scene_fields import (
     Strict,
     Vector,
 )
+from .scene_rigid import RigidBody
 
 __all__ = [
     "COLLIDER_SHAPES",
@@ -524,6 +526,7 @@ Entity = Annotated[
     | ClothMesh
     | SoftLattice
     | SoftMesh
+    | RigidBody
     | Emitter
     | System
     | ForceField
@@ -540,6 +543,7 @@ ENTITY_TYPES: dict[str, type[BaseModel]] = {
     "cloth_mesh": ClothMesh,
     "soft_lattice": SoftLattice,
     "soft_mesh": SoftMesh,
+    "body": RigidBody,
     "emitter": Emitter,
     "system": System,
     "force": ForceField,

@@ -19,6 +19,7 @@ from ..deformables.mesh_files import MeshFileError, read_triangle_mesh
 from ..errors import SceneError, SceneProblem
 from .scene import Scene
 from .scene_bodies import ClothMesh
+from .scene_rigid import RigidBody
 
 __all__ = ["with_mesh_file", "with_mesh_files"]
 
@@ -31,7 +32,7 @@ def with_mesh_files(scene: Scene) -> Scene:
     """
     entities, problems, read = list(scene.entities), [], False
     for index, entity in enumerate(entities):
-        if isinstance(entity, ClothMesh) and entity.path is not None:
+        if isinstance(entity, (ClothMesh, RigidBody)) and entity.path is not None:
             read = True
             try:
                 entities[index] = with_mesh_file(entity, f"entities[{index}]")
@@ -42,9 +43,10 @@ def with_mesh_files(scene: Scene) -> Scene:
     return scene.model_copy(update={"entities": entities}) if read else scene
 
 
-def with_mesh_file(entity: ClothMesh, where: str) -> ClothMesh:
-    """The cloth mesh ``entity`` (at ``where`` in its scene) with the vertices and triangles
-    of the file at its ``path`` and no path.
+def with_mesh_file(entity: ClothMesh | RigidBody, where: str) -> ClothMesh | RigidBody:
+    """The cloth mesh or rigid body ``entity`` (at ``where`` in its scene) with the vertices
+    and triangles of the file at its ``path`` and no path (a body's mesh is checked as a
+    solid when the scene is built).
 
     Raises:
         SceneError: At ``where.path`` for a file refused or a mesh no cloth can be made of, at
@@ -55,7 +57,8 @@ def with_mesh_file(entity: ClothMesh, where: str) -> ClothMesh:
         return entity
     try:
         vertices, triangles = read_triangle_mesh(path)
-        cloth_mesh(vertices, triangles, entity.density, entity.stretch, entity.bend)
+        if isinstance(entity, ClothMesh):
+            cloth_mesh(vertices, triangles, entity.density, entity.stretch, entity.bend)
     except MeshFileError as error:
         raise SceneError([SceneProblem(f"{where}.path", str(error))]) from None
     except DeformableError as error:
@@ -63,7 +66,7 @@ def with_mesh_file(entity: ClothMesh, where: str) -> ClothMesh:
         raise SceneError(
             [SceneProblem(f"{where}.path", f"the mesh in {path!r} at {item}: {error}")]
         ) from None
-    outside = [i for i in entity.pinned if i >= vertices.shape[0]]
+    outside = [i for i in getattr(entity, "pinned", ()) if i >= vertices.shape[0]]
     if outside:
         raise SceneError(
             [

@@ -1,13 +1,19 @@
 """The view of a scene that an integrator steps: one second-order system over every entity.
 
-The integrated arrays are ``q`` and ``v`` of length ``3N + m``: the ``N`` particles' positions
-(and velocities) flattened, then the ``m`` generalized coordinates of the named systems, in
-scene order. Named parts are views into them (:class:`~visviva.ode.state.Layout`):
+The integrated arrays are ``q`` and ``v``: the ``N`` particles' positions (and velocities)
+flattened, then the ``m`` generalized coordinates of the named systems, in scene order, then
+the ``B`` rigid bodies' ``(x, q)`` and ``(P, L)`` (:mod:`visviva.rigid.motion`; ``q`` has
+``3N + m + 7B`` entries, ``v`` ``3N + m + 6B``). Named parts are views into them
+(:class:`~visviva.ode.state.Layout`), with ``n = 3N + m``:
 
-    particle_position     (N, 3) [m]      q[0 : 3N]
-    particle_velocity     (N, 3) [m/s]    v[0 : 3N]
-    generalized_position  (m,)            q[3N :]
-    generalized_velocity  (m,)            v[3N :]
+    particle_position      (N, 3) [m]          q[0 : 3N]
+    particle_velocity      (N, 3) [m/s]        v[0 : 3N]
+    generalized_position   (m,)                q[3N : n]
+    generalized_velocity   (m,)                v[3N : n]
+    body_position          (B, 3) [m]          q[n : n + 3B]       centres of mass
+    body_orientation       (B, 4)              q[n + 3B : n + 7B]  unit quaternions (w, x, y, z)
+    body_momentum          (B, 3) [kg m/s]     v[n : n + 3B]
+    body_angular_momentum  (B, 3) [kg m²/s]    v[n + 3B : n + 6B]  world frame
 
 so a particle scene's integrator works on its particle arrays without a copy. The force is the
 particle forces' sum (:class:`~visviva.forces.ForceSum`) beside each system's own equations;
@@ -15,6 +21,9 @@ the mass matrix is diagonal (each particle's mass on its three coordinates, and 
 systems, which give accelerations); the Jacobian, when every piece has an analytic one, is the
 block-diagonal of the particle forces' sparse Jacobian and the systems' dense ones. A scene
 made of a first-order system alone (Dahlquist's test equation) is that system, part ``y``.
+The bodies' rows of the force are their forces and torques (``P' = F``, ``L' = τ``, unit mass),
+their positions move by the system's kinematics (:class:`~visviva.rigid.motion.BodyMotion`),
+and implicit methods do not step them.
 
 Pinned particles feel no force (their rows of the force and of its Jacobians are zero). Those on
 a handle (:mod:`visviva.particles.handles`) are moreover put where their handle holds them at
@@ -69,6 +78,14 @@ def layout(model: Model) -> Layout:
             PartView("generalized_position", 0, n, end),
             PartView("generalized_velocity", 1, n, end),
         ]
+    if model.bodies is not None:
+        b = model.bodies.count
+        views += [
+            PartView("body_position", 0, end, end + 3 * b, (b, 3), "m"),
+            PartView("body_orientation", 0, end + 3 * b, end + 7 * b, (b, 4)),
+            PartView("body_momentum", 1, end, end + 3 * b, (b, 3), "kg m/s"),
+            PartView("body_angular_momentum", 1, end + 3 * b, end + 6 * b, (b, 3), "kg m^2/s"),
+        ]
     return Layout(True, tuple(views))
 
 
@@ -77,11 +94,16 @@ def initial_state(model: Model) -> State:
     if _first_order(model):
         problem = model.systems[0].problem
         return State(problem.t0, (problem.y0.copy(),), layout(model))
+    bodies = model.bodies
     q = np.concatenate(
-        [model.particle_position.ravel()] + [s.problem.q0 for s in model.systems]  # type: ignore[attr-defined]
+        [model.particle_position.ravel()]
+        + [s.problem.q0 for s in model.systems]  # type: ignore[attr-defined]
+        + ([] if bodies is None else [bodies.positions()])
     )
     v = np.concatenate(
-        [model.particle_velocity.ravel()] + [s.problem.v0 for s in model.systems]  # type: ignore[attr-defined]
+        [model.particle_velocity.ravel()]
+        + [s.problem.v0 for s in model.systems]  # type: ignore[attr-defined]
+        + ([] if bodies is None else [bodies.momenta()])
     )
     carried: dict[str, np.ndarray] = {}
     if model.particle_count:
@@ -112,10 +134,16 @@ def scene_system(model: Model) -> System:
     n = 3 * count
     forces = ForceSum(model.forces, count)
     pieces = [(s.offset + n, s.offset + n + s.size, s.problem.system()) for s in model.systems]
+    end = n + model.coordinate_count  # where the bodies start in q and v
+    bodies = model.bodies
+    b = model.body_count
     mass = Mass(
-        np.concatenate([np.repeat(model.particle_mass, 3), np.ones(model.coordinate_count)]),
-        np.zeros(n + model.coordinate_count),
+        np.concatenate(
+            [np.repeat(model.particle_mass, 3), np.ones(model.coordinate_count + 6 * b)]
+        ),
+        np.zeros(end + 6 * b),
     )
+    motion = None if bodies is None else bodies.motion(end)
 
     # Pinned particles feel no net force, so they keep their place (and zero velocity) under
     # every integrator, explicit or implicit: their rows and columns of the Jacobians are
@@ -138,12 +166,17 @@ def scene_system(model: Model) -> System:
         return (x, u) if handles is None else handles.hold(t, x, u)
 
     def force(t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        out = np.zeros_like(q)
+        out = np.zeros_like(v)
         if count:
             forces.accumulate(t, *placed(t, q, v), out[:n].reshape(count, 3))
             out[held] = 0.0
-        for a, b, piece in pieces:
-            out[a:b] = piece.acceleration(t, q[a:b], v[a:b])
+        for first, last, piece in pieces:
+            out[first:last] = piece.acceleration(t, q[first:last], v[first:last])
+        if b:
+            x, orientation, momentum, spin = _body_parts(q, v, end, b)
+            wrench = out[end:].reshape(2, b, 3)  # forces, then torques (views)
+            for body_force in model.body_forces:
+                body_force.accumulate_wrench(t, x, orientation, momentum, spin, *wrench)
         return out
 
     def jacobian(t: float, q: np.ndarray, v: np.ndarray, form: str = "exact") -> tuple[Any, Any]:
@@ -164,10 +197,11 @@ def scene_system(model: Model) -> System:
                 return dfdx, dfdv  # block-sparse, 3×3 blocks, as the forces' sum gives it
             stiffness.append(dfdx)
             damping.append(dfdv if dfdv is not None else sp.csr_matrix((n, n)))
-        for a, b, piece in pieces:
-            dq, dv = piece.force_jacobian(t, q[a:b], v[a:b])
+        for first, last, piece in pieces:
+            dq, dv = piece.force_jacobian(t, q[first:last], v[first:last])
+            size = last - first
             stiffness.append(sp.csr_matrix(dq))
-            damping.append(sp.csr_matrix((b - a, b - a)) if dv is None else sp.csr_matrix(dv))
+            damping.append(sp.csr_matrix((size, size)) if dv is None else sp.csr_matrix(dv))
         return sp.block_diag(stiffness, format="csr"), (
             sp.block_diag(damping, format="csr") if velocity_dependent else None
         )
@@ -179,16 +213,24 @@ def scene_system(model: Model) -> System:
             x, u = q[:n].reshape(count, 3), v[:n].reshape(count, 3)
             total += 0.5 * float(np.einsum("i,ij,ij->", model.particle_mass * alive, u, u))
             total += forces.potential(t, x, alive)
-        for a, b, piece in pieces:
-            value = piece.energy(State(t, (q[a:b], v[a:b])))
+        for first, last, piece in pieces:
+            value = piece.energy(State(t, (q[first:last], v[first:last])))
             total += 0.0 if value is None else float(value)
+        if motion is not None:
+            total += motion.kinetic_energy(q, v)
+            x = _body_parts(q, v, end, b)[0]
+            total += sum(f.potential(t, x) for f in model.body_forces)
         return total
 
     def potential(t: float, q: np.ndarray) -> float:
         return forces.potential(t, placed(t, q, None)[0])
 
-    velocity_dependent = forces.velocity_dependent or any(p.velocity_dependent for *_, p in pieces)
-    analytic = forces.has_jacobian and all(p.has_jacobian for *_, p in pieces)
+    velocity_dependent = (
+        forces.velocity_dependent
+        or any(p.velocity_dependent for *_, p in pieces)
+        or any(f.velocity_dependent for f in model.body_forces)
+    )
+    analytic = forces.has_jacobian and all(p.has_jacobian for *_, p in pieces) and not b
     system = SceneSystem(
         force,
         mass=mass,
@@ -196,15 +238,29 @@ def scene_system(model: Model) -> System:
         jacobian=jacobian if analytic else None,
         energy=energy,
         layout=names,
+        kinematics=motion,
     )
-    if count and not pieces and forces.gradient_form and not _damped_handles(model, handles):
+    particles_only = count and not pieces and not b
+    if particles_only and forces.gradient_form and not _damped_handles(model, handles):
         system.potential = potential
     system.contact_constraints = _contact_constraints(model)
     springs = [f for f in model.forces if isinstance(f, Springs)]
-    if springs and not pieces:
+    if springs and not pieces and not b:
         network = SpringView(model.particle_mass, model.particle_pinned, tuple(springs), handles)
         system.spring_network = lambda: network
     return system
+
+
+def _body_parts(
+    q: np.ndarray, v: np.ndarray, start: int, count: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Views of the bodies' ``x`` ``(B, 3)``, ``q`` ``(B, 4)``, ``P`` and ``L`` ``(B, 3)`` in
+    the integrated arrays, the bodies starting at entry ``start``."""
+    x = q[start : start + 3 * count].reshape(count, 3)
+    orientation = q[start + 3 * count : start + 7 * count].reshape(count, 4)
+    momentum = v[start : start + 3 * count].reshape(count, 3)
+    spin = v[start + 3 * count : start + 6 * count].reshape(count, 3)
+    return x, orientation, momentum, spin
 
 
 @dataclass(frozen=True)
@@ -373,8 +429,13 @@ def as_problem(model: Model) -> Problem:
 
     Raises:
         ModelError: For a scene with stages (collisions, emitters), which a plain problem cannot
-            express.
+            express, or rigid bodies, whose orientations do not move as ``q' = v``.
     """
+    if model.bodies is not None:
+        raise ModelError(
+            "this scene has rigid bodies, whose orientations do not move as q' = v (a plain "
+            "problem's): run it with vv.Simulation or visviva run"
+        )
     if model.stages:
         raise ModelError(
             "this scene has collisions, emitters or moving handles, which change its state "

@@ -141,7 +141,9 @@ class FusedParticles:
         must be symplectic Euler, the scene made only of particles, every force a field or
         springs (gravitation and penalty contact are not), every stage handles, collisions or
         emission."""
-        if method != "symplectic_euler" or model.systems or not model.particle_count:
+        if method != "symplectic_euler" or model.systems or model.bodies is not None:
+            return None
+        if not model.particle_count:
             return None
         if not all(isinstance(f, (*_FIELDS, Springs)) for f in model.forces):
             return None

@@ -1,0 +1,107 @@
+"""A scene's rigid bodies built from its ``body`` entities: mass properties, starts, forces.
+
+Each body's mass properties come from its shape (:func:`visviva.rigid.mass_properties`: closed
+forms for the primitives, Mirtich's integrals for a mesh, which must be a closed, outward,
+non-self-intersecting surface); a body given a ``mass`` has the density that gives it. A
+refusal names the entity and its field. The bodies feel the world's gravity and their own
+damping (:mod:`visviva.forces.body_forces`).
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from ..errors import ModelError
+from ..forces.body_forces import BodyDamping, BodyForce, BodyGravity
+from ..rigid.bodies import BodyStart, RigidBodies
+from ..rigid.mass_properties import MassProperties
+from ..rigid.shapes import mass_properties
+from .parts import Located
+from .scene import Scene
+from .scene_rigid import DIMENSIONS, RigidBody
+
+__all__ = ["rigid_bodies"]
+
+
+def rigid_bodies(scene: Scene, names: list[str]) -> tuple[RigidBodies | None, list[BodyForce]]:
+    """The scene's rigid bodies (``None`` if it has none) and the forces on them.
+
+    Raises:
+        Located: At the entity and field of a body whose shape no mass properties can be
+            computed for (a mesh that is open, inside-out or crosses itself, a degenerate
+            triangle, dimensions beyond what a float holds).
+    """
+    chosen = [(i, e) for i, e in enumerate(scene.entities) if isinstance(e, RigidBody)]
+    if not chosen:
+        return None, []
+    properties, starts, shapes = [], [], []
+    for index, entity in chosen:
+        properties.append(_mass_properties(index, entity))
+        starts.append(_start(index, entity))
+        shapes.append({"shape": entity.shape, **_shape(entity)})
+    bodies = RigidBodies.of(
+        [names[i] for i, _ in chosen],
+        properties,
+        starts,
+        shapes,
+        [e.linear_damping for _, e in chosen],
+        [e.angular_damping for _, e in chosen],
+    )
+    forces: list[BodyForce] = []
+    if any(scene.world.gravity):
+        forces.append(BodyGravity(scene.world.gravity, bodies.mass))
+    if bodies.linear_damping.any() or bodies.angular_damping.any():
+        forces.append(BodyDamping(bodies.linear_damping, bodies.angular_damping))
+    return bodies, forces
+
+
+def _mass_properties(index: int, entity: RigidBody) -> Any:
+    """The body's mass properties, with the density its ``mass`` asks for if it gives one."""
+    where = f"entities[{index}]"
+    try:
+        with np.errstate(all="ignore"):
+            properties = mass_properties(entity.shape, entity.density or 1.0, **_shape(entity))
+            if entity.mass is not None:  # the same body at the density that gives that mass
+                scale = entity.mass / properties.mass
+                properties = MassProperties(
+                    entity.mass, properties.center_of_mass, properties.inertia * scale,
+                    properties.volume,
+                )  # fmt: skip
+    except ModelError as error:
+        field = "vertices" if entity.shape == "mesh" else DIMENSIONS[entity.shape][0]
+        raise Located(f"{where}.{field}", str(error)) from None
+    return properties
+
+
+def _shape(entity: RigidBody) -> dict[str, Any]:
+    """The keywords of :func:`mass_properties` for the entity's shape (what drawing it needs
+    too): its dimensions, or its mesh's arrays."""
+    if entity.shape == "mesh":
+        return {"vertices": np.array(entity.vertices), "triangles": np.array(entity.triangles)}
+    return entity.dimensions()
+
+
+def _start(index: int, entity: RigidBody) -> BodyStart:
+    """How the body starts; a non-unit orientation is normalized, with a warning."""
+    q = np.asarray(entity.orientation, dtype=np.float64)
+    norm = float(np.linalg.norm(q))
+    if not np.isfinite(norm) or norm == 0.0:
+        raise Located(
+            f"entities[{index}].orientation",
+            "the orientation's length is not a finite positive number: give a unit quaternion",
+        )
+    if abs(norm - 1.0) > 1e-6:
+        warnings.warn(
+            f"entities[{index}].orientation {tuple(entity.orientation)} has length {norm:.6g}, "
+            "not 1: it is normalized (a rotation is a unit quaternion)",
+            stacklevel=2,
+        )
+    return BodyStart(
+        np.asarray(entity.position, dtype=np.float64),
+        q / norm,
+        np.asarray(entity.velocity, dtype=np.float64),
+        np.asarray(entity.angular_velocity, dtype=np.float64),
+    )

@@ -1,0 +1,133 @@
+"""The scene entity of a rigid body (``type = "body"``), as plain data validated by pydantic.
+
+A body is a shape — a primitive with its dimensions, or a closed triangle mesh given as arrays
+or read from a file — with a density or a total mass, placed at ``position`` with
+``orientation``, moving with ``velocity`` and ``angular_velocity``. Its mass properties come
+from :mod:`visviva.rigid` when the scene is built; its state is ``(x, q, P, L)``
+(:mod:`visviva.rigid.motion`). What each shape needs:
+
+==========  =============================================================================
+shape       dimensions [m]
+==========  =============================================================================
+box         ``size``: the three full edge lengths
+sphere      ``radius``
+ellipsoid   ``size``: the three semi-axes
+cylinder    ``radius``, ``height`` (axis along the body's y)
+capsule     ``radius``, ``height``: the distance between its hemispheres' centres (axis y)
+cone        ``radius``, ``height``: base in the body's y = 0 plane, apex at y = ``height``
+mesh        ``vertices`` and ``triangles`` (counter-clockwise seen from outside), or ``path``
+==========  =============================================================================
+
+``position`` is where the body's own origin goes (the shape's centre for the primitives but
+the cone, whose origin is its base's centre; a mesh's coordinate origin); the state's
+``body_position`` is its centre of mass.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, ClassVar, Literal, Self
+
+from pydantic import Field, model_validator
+from pydantic_core import PydanticCustomError
+
+from .scene_bodies import FilePath
+from .scene_fields import Color, Finite, Index, Name, NonNegative, Positive, Strict, Vector
+
+__all__ = ["BODY_SHAPES", "RigidBody"]
+
+BodyShape = Literal["box", "sphere", "ellipsoid", "cylinder", "capsule", "cone", "mesh"]
+BODY_SHAPES: tuple[str, ...] = BodyShape.__args__  # type: ignore[attr-defined]
+
+#: The dimensions each shape takes (the others must be left out).
+DIMENSIONS: dict[str, tuple[str, ...]] = {
+    "box": ("size",),
+    "sphere": ("radius",),
+    "ellipsoid": ("size",),
+    "cylinder": ("radius", "height"),
+    "capsule": ("radius", "height"),
+    "cone": ("radius", "height"),
+    "mesh": (),
+}
+_ALL_DIMENSIONS = ("size", "radius", "height")
+Quaternion = tuple[Finite, Finite, Finite, Finite]
+
+
+class RigidBody(Strict):
+    """``type = "body"``: a rigid body (see the module docstring)."""
+
+    type: Literal["body"]
+    noun: ClassVar[str] = "body"
+    name: Name | None = None
+    shape: BodyShape = Field(description="box, sphere, ellipsoid, cylinder, capsule, cone, mesh")
+    density: Positive | None = Field(None, description="mass per volume [kg/m^3]")
+    mass: Positive | None = Field(None, description="total mass [kg] (instead of density)")
+    size: tuple[Positive, Positive, Positive] | None = Field(
+        None, description="box: full edge lengths; ellipsoid: semi-axes [m]"
+    )
+    radius: Positive | None = Field(None, description="sphere, cylinder, capsule, cone [m]")
+    height: Positive | None = Field(None, description="cylinder, capsule, cone, along y [m]")
+    path: FilePath | None = Field(None, description="mesh: a mesh file to read")
+    vertices: Annotated[list[Vector], Field(min_length=4)] | None = Field(
+        None, description="mesh: vertex positions in the body's axes [m]"
+    )
+    triangles: Annotated[list[tuple[Index, Index, Index]], Field(min_length=4)] | None = Field(
+        None, description="mesh: triangles, counter-clockwise seen from outside"
+    )
+    position: Vector = Field((0.0, 0.0, 0.0), description="where the body's origin is [m]")
+    orientation: Quaternion = Field(
+        (1.0, 0.0, 0.0, 0.0), description="unit quaternion (w, x, y, z), body to world"
+    )
+    velocity: Vector = Field((0.0, 0.0, 0.0), description="of the centre of mass [m/s]")
+    angular_velocity: Vector = Field((0.0, 0.0, 0.0), description="world frame [rad/s]")
+    linear_damping: NonNegative = Field(0.0, description="P' = F − γ P: γ [1/s]")
+    angular_damping: NonNegative = Field(0.0, description="L' = τ − γ L: γ [1/s]")
+    color: Color = Field((0.8, 0.8, 0.8), description="sRGB colour in [0, 1]")
+
+    @model_validator(mode="after")
+    def _complete(self) -> Self:
+        if (self.density is None) == (self.mass is None):
+            raise PydanticCustomError(
+                "mass_or_density", "give the body a `density` [kg/m^3] or a `mass` [kg], not both"
+            )
+        needed = DIMENSIONS[self.shape]
+        for name in _ALL_DIMENSIONS:
+            given = getattr(self, name) is not None
+            if name in needed and not given:
+                raise PydanticCustomError(
+                    "missing_dimension",
+                    "a {shape} needs {needs}",
+                    {"shape": self.shape, "needs": " and ".join(f"`{n}`" for n in needed)},
+                )
+            if given and name not in needed:
+                raise PydanticCustomError(
+                    "extra_dimension",
+                    "a {shape} takes no `{field}` (it takes {needs})",
+                    {
+                        "shape": self.shape,
+                        "field": name,
+                        "needs": ", ".join(needed) or "vertices and triangles, or path",
+                    },
+                )
+        meshed = self.path is not None or self.vertices is not None or self.triangles is not None
+        if self.shape != "mesh" and meshed:
+            raise PydanticCustomError(
+                "not_a_mesh", 'vertices, triangles and path belong to shape = "mesh"'
+            )
+        if self.shape == "mesh":
+            arrays = self.vertices is not None and self.triangles is not None
+            if (self.path is not None) == arrays or (not arrays and self.vertices is not None):
+                raise PydanticCustomError(
+                    "one_mesh",
+                    "give the mesh either as `path` (a mesh file) or as `vertices` and `triangles`",
+                )
+        if not any(self.orientation):
+            raise PydanticCustomError(
+                "zero_quaternion",
+                "`orientation` (0, 0, 0, 0) is no rotation: give a unit quaternion (w, x, y, z), "
+                "e.g. (1, 0, 0, 0) for none",
+            )
+        return self
+
+    def dimensions(self) -> dict[str, Any]:
+        """The shape's dimensions as keywords of :func:`visviva.rigid.mass_properties`."""
+        return {name: getattr(self, name) for name in DIMENSIONS[self.shape]}
