@@ -5,12 +5,13 @@ one mesh, a surface folded through itself — bounds no single solid: its enclos
 integrals count the overlap twice (or cancel a folded part). :func:`check_self_intersections`
 refuses it, naming two crossing triangles.
 
-Broad phase: a uniform grid of cubic cells about as large as the triangles' bounding boxes
-(the mean of their longest sides, doubled until the triangles touch at most
-:data:`_ENTRIES_PER_TRIANGLE` cells each on average), stored as a hash table bucketed by a
-counting sort: O(T) time and memory for T triangles of similar sizes, with no T² step. Each pair
-of triangles whose boxes overlap is tested once, in the one cell holding the lowest corner of
-the boxes' intersection.
+Broad phase: a uniform grid of cubic cells twice the mean longest side of the triangles'
+bounding boxes (doubled again until the triangles touch at most :data:`_ENTRIES_PER_TRIANGLE`
+cells each on average), stored as a hash table bucketed by a counting sort: O(T) time and
+memory for T triangles of similar sizes, with no T² step. Each pair of triangles whose boxes
+overlap is tested once, in the one cell holding the lowest corner of the boxes' intersection.
+Cost: about 0.25 µs a triangle on 2 cores of a 2020s laptop-class CPU — some ten times the mass
+integrals themselves (``benchmarks/bench_mass_properties.py`` measures both).
 
 Narrow phase: two triangles that are not coplanar cross if and only if an edge of one passes
 through the other (the segment where they meet ends on such edges). Edge ab passes through
@@ -45,6 +46,9 @@ __all__ = ["ORIENTATION_TOLERANCE", "check_self_intersections", "find_self_inter
 
 #: An orientation determinant below this fraction of the cube of the pair's extent is zero.
 ORIENTATION_TOLERANCE = 1e-12
+#: Cell side over the mean longest side of the triangles' boxes: larger cells hold more
+#: triangles (more pairs to try), smaller ones more entries (more memory to fill).
+_CELL_SCALE = 2.0
 #: Average (triangle, cell) entries per triangle allowed before the cells are made larger.
 _ENTRIES_PER_TRIANGLE = 8
 #: Cells per axis at most, so that a cell's three integer coordinates pack into one int64 key.
@@ -54,18 +58,31 @@ _MIX = 6364136223846793005
 
 
 @njit(cache=True)
-def _boxes(vertices: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _boxes(
+    vertices: np.ndarray, triangles: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float]:
+    """Each triangle's bounding box (``lo``, ``hi``), the mesh's lowest corner, its largest
+    extent and the mean of the boxes' longest sides (in one pass: NumPy's reductions along
+    short rows cost more than this whole loop)."""
     count = triangles.shape[0]
     lo = np.empty((count, 3))
     hi = np.empty((count, 3))
+    low = np.full(3, np.inf)
+    high = np.full(3, -np.inf)
+    longest = 0.0
     for t in range(count):
+        side = 0.0
         for axis in range(3):
             a = vertices[triangles[t, 0], axis]
             b = vertices[triangles[t, 1], axis]
             c = vertices[triangles[t, 2], axis]
             lo[t, axis] = min(a, b, c)
             hi[t, axis] = max(a, b, c)
-    return lo, hi
+            low[axis] = min(low[axis], lo[t, axis])
+            high[axis] = max(high[axis], hi[t, axis])
+            side = max(side, hi[t, axis] - lo[t, axis])
+        longest += side
+    return lo, hi, low, float(np.max(high - low)), longest / count
 
 
 @njit(cache=True, inline="always")
@@ -115,47 +132,44 @@ def _cell_range(
 @njit(cache=True)
 def _grid(
     lo: np.ndarray, hi: np.ndarray, base: np.ndarray, inverse: float, entries: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Bucket every (triangle, cell) entry by a hash of its cell (a counting sort).
 
-    Returns ``start`` (buckets + 1) and, per entry in bucket order: its triangle, its cell's
-    key, its triangle's box (lo, hi) and ``lowest``, whose bit ``a`` says that the cell is the
-    triangle's first along axis ``a``. The boxes are copied next to each other so that the pair
-    loop reads memory in order.
+    Returns ``bounds``, where bucket ``b`` holds entries ``bounds[b + 1]`` to ``bounds[b + 2]``,
+    and per entry its triangle, its cell's key and ``lowest``, whose bit ``a`` says that the
+    cell is the triangle's first along axis ``a``. Kept small (13 bytes an entry): on a large
+    mesh the time goes to touching fresh memory.
     """
     buckets = 1
-    while buckets < 2 * entries:
+    while buckets < entries:
         buckets *= 2
     mask = buckets - 1
-    start = np.zeros(buckets + 1, dtype=np.int64)
+    bounds = np.zeros(buckets + 2, dtype=np.int64)
     for t in range(lo.shape[0]):
         i0, i1, j0, j1, k0, k1 = _cell_range(lo, hi, t, base, inverse)
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
                 for k in range(k0, k1 + 1):
-                    start[_bucket(_key(i, j, k), mask) + 1] += 1
+                    bounds[_bucket(_key(i, j, k), mask) + 1] += 1
     for b in range(buckets):
-        start[b + 1] += start[b]
-    fill = start[:-1].copy()
-    triangle = np.empty(entries, dtype=np.int64)
+        bounds[b + 1] += bounds[b]  # the end of bucket b
+    bounds[buckets + 1] = entries
+    triangle = np.empty(entries, dtype=np.int32)
     key = np.empty(entries, dtype=np.int64)
-    box = np.empty((entries, 6))
-    lowest = np.empty(entries, dtype=np.int64)
+    lowest = np.empty(entries, dtype=np.int8)
     for t in range(lo.shape[0]):
         i0, i1, j0, j1, k0, k1 = _cell_range(lo, hi, t, base, inverse)
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
                 for k in range(k0, k1 + 1):
                     code = _key(i, j, k)
-                    n = fill[_bucket(code, mask)]
-                    fill[_bucket(code, mask)] += 1
+                    b = _bucket(code, mask)
+                    bounds[b + 1] -= 1  # filled from its end: ends at the start of bucket b
+                    n = bounds[b + 1]
                     triangle[n] = t
                     key[n] = code
-                    for axis in range(3):
-                        box[n, axis] = lo[t, axis]
-                        box[n, 3 + axis] = hi[t, axis]
                     lowest[n] = (i == i0) | ((j == j0) << 1) | ((k == k0) << 2)
-    return start, triangle, key, box, lowest
+    return bounds, triangle, key, lowest
 
 
 @njit(cache=True, inline="always")
@@ -262,53 +276,60 @@ def _far_vertices(triangles: np.ndarray, triangle_edges: np.ndarray) -> np.ndarr
     return far
 
 
+#: Buckets are walked in this many chunks (one lowest pair kept per chunk).
+_CHUNKS = 256
+
+
 @njit(cache=True, parallel=True)
 def _crossing_pairs(
     vertices: np.ndarray,
     triangles: np.ndarray,
     far: np.ndarray,
-    start: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    bounds: np.ndarray,
     entry_triangle: np.ndarray,
     entry_key: np.ndarray,
-    entry_box: np.ndarray,
     entry_lowest: np.ndarray,
 ) -> np.ndarray:
-    """Per bucket, the lowest crossing pair (s < t) found in it, or (-1, -1)."""
-    buckets = start.shape[0] - 1
-    found = np.full((buckets, 2), -1, dtype=np.int64)
-    for b in prange(buckets):
-        for x in range(start[b], start[b + 1]):
-            for y in range(x + 1, start[b + 1]):
-                # Same cell, and the cell holds the lowest corner of the boxes' intersection
-                # (along each axis, the first cell of one of the two): each pair tested once.
-                if entry_key[x] != entry_key[y] or (entry_lowest[x] | entry_lowest[y]) != 7:
-                    continue
-                overlap = True
-                extent = 0.0
-                for axis in range(3):
-                    low = max(entry_box[x, axis], entry_box[y, axis])
-                    high = min(entry_box[x, 3 + axis], entry_box[y, 3 + axis])
-                    overlap = overlap and low <= high
-                    width = max(entry_box[x, 3 + axis], entry_box[y, 3 + axis]) - min(
-                        entry_box[x, axis], entry_box[y, axis]
-                    )
-                    extent = max(extent, width)
-                if not overlap:
-                    continue
-                s = min(entry_triangle[x], entry_triangle[y])
-                t = max(entry_triangle[x], entry_triangle[y])
-                shared = False
-                for m in range(3):
-                    for n in range(3):
-                        shared = shared or triangles[s, m] == triangles[t, n]
-                if shared:
-                    continue
-                tolerance = ORIENTATION_TOLERANCE * extent * extent * extent
-                if _cross(vertices, triangles, far, s, t, tolerance) and (
-                    found[b, 0] < 0 or s < found[b, 0] or (s == found[b, 0] and t < found[b, 1])
-                ):
-                    found[b, 0] = s
-                    found[b, 1] = t
+    """Per chunk of buckets, the lowest crossing pair (s < t) found in it, or (-1, -1)."""
+    buckets = bounds.shape[0] - 2
+    per_chunk = (buckets + _CHUNKS - 1) // _CHUNKS
+    found = np.full((_CHUNKS, 2), -1, dtype=np.int64)
+    for chunk in prange(_CHUNKS):
+        for b in range(chunk * per_chunk, min(buckets, (chunk + 1) * per_chunk)):
+            for x in range(bounds[b + 1], bounds[b + 2]):
+                for y in range(x + 1, bounds[b + 2]):
+                    # Same cell, and the cell holds the lowest corner of the boxes'
+                    # intersection (along each axis, the first cell of one of the two): each
+                    # pair is tested once.
+                    if (entry_lowest[x] | entry_lowest[y]) != 7 or entry_key[x] != entry_key[y]:
+                        continue
+                    s = min(entry_triangle[x], entry_triangle[y])
+                    t = max(entry_triangle[x], entry_triangle[y])
+                    overlap = True
+                    extent = 0.0
+                    for axis in range(3):
+                        low = max(lo[s, axis], lo[t, axis])
+                        overlap = overlap and low <= min(hi[s, axis], hi[t, axis])
+                        width = max(hi[s, axis], hi[t, axis]) - min(lo[s, axis], lo[t, axis])
+                        extent = max(extent, width)
+                    if not overlap:
+                        continue
+                    shared = False
+                    for m in range(3):
+                        for n in range(3):
+                            shared = shared or triangles[s, m] == triangles[t, n]
+                    if shared:
+                        continue
+                    tolerance = ORIENTATION_TOLERANCE * extent * extent * extent
+                    if _cross(vertices, triangles, far, s, t, tolerance) and (
+                        found[chunk, 0] < 0
+                        or s < found[chunk, 0]
+                        or (s == found[chunk, 0] and t < found[chunk, 1])
+                    ):
+                        found[chunk, 0] = s
+                        found[chunk, 1] = t
     return found
 
 
@@ -327,12 +348,9 @@ def find_self_intersection(
     """
     if triangles.shape[0] < 2:
         return None
-    lo, hi = _boxes(vertices, triangles)
-    base = lo.min(axis=0)
-    span = float(np.max(hi.max(axis=0) - base))
-    size = float(np.mean(np.max(hi - lo, axis=1)))
+    lo, hi, base, span, mean_side = _boxes(vertices, triangles)
     # Cells no smaller than the span over 2^20, so that their coordinates pack in the key.
-    size = max(size, span / float((1 << _CELL_BITS) - 2), np.finfo(float).tiny)
+    size = max(_CELL_SCALE * mean_side, span / float((1 << _CELL_BITS) - 2), np.finfo(float).tiny)
     while True:
         entries = _entry_count(lo, hi, base, 1.0 / size)
         if entries <= _ENTRIES_PER_TRIANGLE * triangles.shape[0]:
@@ -344,7 +362,7 @@ def find_self_intersection(
         triangle_edges = paired.reshape(-1, 3) if paired.size else np.empty((0, 3), np.int64)
     far = _far_vertices(triangles, np.ascontiguousarray(triangle_edges, dtype=np.int64))
     grid = _grid(lo, hi, base, inverse, entries)
-    found = _crossing_pairs(vertices, triangles, far, *grid)
+    found = _crossing_pairs(vertices, triangles, far, lo, hi, *grid)
     hits = found[found[:, 0] >= 0]
     if not hits.size:
         return None
