@@ -446,6 +446,27 @@ def test_hostile_mass_properties_give_a_result_or_a_model_error(inertia, mass, c
         pass
 
 
+@settings(deadline=None, max_examples=100, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    shape=st.sampled_from(["box", "sphere", "cone", "capsule", "ellipsoid"]),
+    first=st.one_of(HOSTILE, HOSTILE_TRIPLE),
+    height=HOSTILE,
+    density=HOSTILE,
+    samples=st.one_of(st.integers(-5, 400), st.sampled_from([10**12, 2.5, None])),
+)
+def test_hostile_sampling_gives_a_result_or_a_model_error(shape, first, height, density, samples):
+    dimensions = {"size": first} if shape in ("box", "ellipsoid") else {"radius": first}
+    if shape in ("capsule", "cone"):
+        dimensions["height"] = height
+    try:
+        estimate = rigid.sampled_mass_properties(
+            shape, density, samples=samples, rng=0, **dimensions
+        )
+    except ModelError:
+        return
+    assert np.isfinite([estimate.mass, estimate.mass_error, *estimate.inertia.ravel()]).all()
+
+
 # --- Monte-Carlo estimate --------------------------------------------------------------------
 
 

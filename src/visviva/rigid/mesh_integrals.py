@@ -168,9 +168,9 @@ def mesh_mass_properties(
         triangles: ``(T, 3)`` integer vertex indices, counter-clockwise seen from outside.
         density: Uniform density [kg/m³], positive.
         check_topology: Check that the mesh bounds a solid (closed, manifold, consistently
-            oriented, outward, no degenerate triangle); about half the time of the whole call
-            on a large mesh. Turn it off only for a mesh already checked: an open mesh's
-            integrals are meaningless.
+            oriented, outward, no degenerate triangle); about twice the integration's time on a
+            large mesh. Turn it off only for a mesh already checked: an open mesh's integrals
+            are meaningless.
         check_intersections: Also refuse a mesh whose triangles cross each other (the overlap
             would count twice); costs a few times the integration itself (see
             :mod:`visviva.geometry.self_intersection`).
