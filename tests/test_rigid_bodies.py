@@ -184,3 +184,36 @@ def test_implicit_methods_refuse_rigid_bodies_and_name_those_that_step_them():
     model = _scene().build()
     with pytest.raises(vv.ModelError, match="cannot step rigid bodies"):
         vv.Simulation(model, method="projected_newton")
+
+
+@pytest.mark.parametrize(
+    "shape",
+    [
+        {"shape": "box", "size": (1.0, 2.0, 3.0)},
+        {"shape": "sphere", "radius": 0.5},
+        {"shape": "ellipsoid", "size": (1.0, 2.0, 3.0)},
+        {"shape": "cylinder", "radius": 0.5, "height": 2.0},
+        {"shape": "cone", "radius": 0.5, "height": 2.0},
+        {"shape": "capsule", "radius": 0.5, "height": 1.0},
+    ],
+)
+def test_drawn_surfaces_face_outward_and_enclose_the_shapes_volume(shape):
+    """Every triangle has area and faces outward (the signed volume Σ a·(b × c)/6 is
+    positive); a cylinder or cone drawn with N segments encloses exactly the inscribed prism's
+    or pyramid's share N sin(2π/N)/2π of the volume, round shapes within 2 %."""
+    from visviva.rigid import mass_properties
+    from visviva.rigid.surfaces import AROUND, body_surface
+
+    vertices, triangles = body_surface(shape)
+    a, b, c = (vertices[triangles[:, k]] for k in range(3))
+    assert np.linalg.norm(np.cross(b - a, c - a), axis=1).min() > 0.0
+    volume = np.einsum("ij,ij->", a, np.cross(b, c)) / 6.0
+    dimensions = {k: v for k, v in shape.items() if k != "shape"}
+    exact = mass_properties(shape["shape"], 1.0, **dimensions).volume
+    if shape["shape"] == "box":
+        assert volume == pytest.approx(exact, rel=1e-14)
+    elif shape["shape"] in ("cylinder", "cone"):
+        share = AROUND * np.sin(2 * np.pi / AROUND) / (2 * np.pi)
+        assert volume == pytest.approx(share * exact, rel=1e-12)
+    else:
+        assert 0.98 * exact < volume < exact
