@@ -19,7 +19,7 @@ moved shape (I' = R I Rᵀ); :meth:`MassProperties.principal` the principal mome
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -170,8 +170,8 @@ class MassProperties:
     """
 
     mass: float
-    center_of_mass: np.ndarray = field(repr=True)
-    inertia: np.ndarray = field(repr=True)
+    center_of_mass: np.ndarray
+    inertia: np.ndarray
     volume: float | None = None
 
     def __post_init__(self) -> None:
