@@ -13,7 +13,7 @@ import pytest
 
 import visviva as vv
 from visviva.forces.body_forces import wrench_at
-from visviva.rigid.quaternions import quaternion_matrix
+from visviva.geometry.quaternions import quaternion_matrix
 
 GRAVITY = np.array([0.0, -9.81, 0.0])
 #: A tetrahedron with one triangle wound against the others.

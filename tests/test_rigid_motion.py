@@ -14,14 +14,14 @@ import pytest
 
 import visviva as vv
 from visviva.errors import ModelError
-from visviva.ode.state import Layout, PartView, State
-from visviva.ode.system import SecondOrderSystem
-from visviva.rigid.motion import BodyMotion
-from visviva.rigid.quaternions import (
+from visviva.geometry.quaternions import (
     matrix_quaternion,
     quaternion_matrix,
     quaternion_multiply,
 )
+from visviva.ode.state import Layout, PartView, State
+from visviva.ode.system import SecondOrderSystem
+from visviva.rigid.motion import BodyMotion
 
 INERTIA = (1.0, 2.0, 3.0)  # kg·m², principal moments of an asymmetric body
 MASS = 2.0  # kg

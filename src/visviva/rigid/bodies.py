@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry.quaternions import matrix_quaternion, quaternion_matrix
 from .mass_properties import MassProperties
 from .motion import BodyMotion
-from .quaternions import matrix_quaternion, quaternion_matrix
 
 __all__ = ["BodyStart", "RigidBodies"]
 
