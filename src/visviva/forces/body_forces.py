@@ -1,4 +1,4 @@
-"""Forces and torques on rigid bodies: gravity and damping.
+"""Forces and torques on rigid bodies: gravity, damping, pushes at points, anchors.
 
 The protocol of :mod:`.base` for bodies: a force *adds* the force [N] through each body's
 centre of mass and the torque [N·m] about it, both in the world frame, into ``(B, 3)`` arrays
@@ -17,9 +17,10 @@ from typing import ClassVar, Protocol
 
 import numpy as np
 
+from ..geometry.quaternions import quaternion_matrix, quaternion_multiply
 from .fields import vector
 
-__all__ = ["BodyDamping", "BodyForce", "BodyGravity", "wrench_at"]
+__all__ = ["BodyAnchor", "BodyDamping", "BodyForce", "BodyGravity", "BodyPush", "wrench_at"]
 
 
 class BodyForce(Protocol):
@@ -42,8 +43,9 @@ class BodyForce(Protocol):
         ``force`` and ``torque``, ``(B, 3)`` each."""
         ...
 
-    def potential(self, t: float, x: np.ndarray) -> float:
-        """Potential energy [J] of the bodies with centres of mass ``x`` ``(B, 3)``."""
+    def potential(self, t: float, x: np.ndarray, q: np.ndarray) -> float:
+        """Potential energy [J] of the bodies with centres of mass ``x`` ``(B, 3)`` and
+        orientations ``q`` ``(B, 4)``."""
         ...
 
 
@@ -77,7 +79,7 @@ class BodyGravity:
         """Add ``M g`` [N] to ``force`` (no torque)."""
         force += self._weight
 
-    def potential(self, t: float, x: np.ndarray) -> float:
+    def potential(self, t: float, x: np.ndarray, q: np.ndarray) -> float:
         """``U = −Σ M g·x`` [J]."""
         return -float(np.einsum("ij,ij->", x, self._weight))
 
@@ -103,6 +105,100 @@ class BodyDamping:
         force -= self.linear * momentum
         torque -= self.angular * angular_momentum
 
-    def potential(self, t: float, x: np.ndarray) -> float:
+    def potential(self, t: float, x: np.ndarray, q: np.ndarray) -> float:
         """0: damping stores no energy."""
         return 0.0
+
+
+def _world_points(q: np.ndarray, body: np.ndarray, x: np.ndarray, arm: np.ndarray) -> np.ndarray:
+    """World positions ``x + R(q) arm`` [m] of points at ``arm`` ``(K, 3)`` from the centres
+    of mass of bodies ``body`` ``(K,)`` (arms in the bodies' own axes)."""
+    return x[body] + np.einsum("kij,kj->ki", quaternion_matrix(q[body]), arm)
+
+
+class BodyPush:
+    """Forces applied at points of bodies for a while: ``f`` [N] (world frame) at a point of
+    the body, from ``start`` to ``stop`` [s]; the body feels ``f`` and the torque ``(p − x) ×
+    f`` about its centre of mass (seed 002: a force off the centre of mass turns the body).
+
+    Args:
+        body: ``(K,)`` the body each push acts on.
+        force: ``(K, 3)`` [N].
+        arm: ``(K, 3)`` the point from the body's centre of mass, in its own axes [m].
+        start, stop: ``(K,)`` when each push acts [s] (``stop`` may be ``inf``).
+    """
+
+    conservative = False
+    velocity_dependent = False
+
+    def __init__(self, body, force, arm, start, stop) -> None:  # type: ignore[no-untyped-def]
+        self.body = np.asarray(body, dtype=np.int64)
+        self.force = np.asarray(force, dtype=np.float64).reshape(-1, 3)
+        self.arm = np.asarray(arm, dtype=np.float64).reshape(-1, 3)
+        self.start = np.asarray(start, dtype=np.float64)
+        self.stop = np.asarray(stop, dtype=np.float64)
+
+    def accumulate_wrench(self, t, x, q, momentum, angular_momentum, force, torque) -> None:  # type: ignore[no-untyped-def]
+        """Add the pushes acting at ``t`` (``start ≤ t < stop``) and their torques. A time
+        within 1e-9 (relative) below an end counts as that end: a step's start time, summed
+        from its steps, may fall a rounding short of the push's, which would add or drop a
+        whole step of it."""
+        t = t + 1e-9 * max(1.0, abs(t))
+        on = (self.start <= t) & (t < self.stop)
+        if not on.any():
+            return
+        body = self.body[on]
+        points = _world_points(q, body, x, self.arm[on])
+        f, tau = wrench_at(x[body], points, self.force[on])
+        np.add.at(force, body, f)
+        np.add.at(torque, body, tau)
+
+    def potential(self, t: float, x: np.ndarray, q: np.ndarray) -> float:
+        """0: a push is an outside force, not a field with a potential."""
+        return 0.0
+
+
+class BodyAnchor:
+    """Points of bodies held near world points by stiff damped springs (a ball joint by
+    penalty): ``f = −k (p − a) − c ṗ`` at the body point ``p``, ``ṗ = v + ω × (p − x)``;
+    ``U = ½ k |p − a|²``. A spinning top's tip on its pivot.
+
+    Args:
+        body: ``(K,)`` the body of each anchor.
+        arm: ``(K, 3)`` the anchored point from the body's centre of mass, in its own axes [m].
+        at: ``(K, 3)`` the world point it is held at [m].
+        stiffness: ``(K,)`` k [N/m]. damping: ``(K,)`` c [N·s/m].
+        mass: ``(B,)`` every body's mass [kg]; moments ``(B, 3)`` and axes ``(B, 4)``: its
+            principal moments [kg·m²] and principal frame in its own axes (for ``ω``).
+    """
+
+    velocity_dependent = True
+
+    def __init__(self, body, arm, at, stiffness, damping, mass, moments, axes) -> None:  # type: ignore[no-untyped-def]
+        self.body = np.asarray(body, dtype=np.int64)
+        self.arm = np.asarray(arm, dtype=np.float64).reshape(-1, 3)
+        self.at = np.asarray(at, dtype=np.float64).reshape(-1, 3)
+        self.stiffness = np.asarray(stiffness, dtype=np.float64)[:, None]
+        self.damping = np.asarray(damping, dtype=np.float64)[:, None]
+        self.inverse_mass = 1.0 / np.asarray(mass, dtype=np.float64)[self.body, None]
+        self.inverse_moments = 1.0 / np.asarray(moments, dtype=np.float64)[self.body]
+        self.axes = np.asarray(axes, dtype=np.float64)[self.body]
+        self.conservative = not self.damping.any()  # type: ignore[misc]
+
+    def accumulate_wrench(self, t, x, q, momentum, angular_momentum, force, torque) -> None:  # type: ignore[no-untyped-def]
+        """Add each anchor's spring and damper force at its point, and their torques."""
+        body = self.body
+        points = _world_points(q, body, x, self.arm)
+        principal = quaternion_matrix(quaternion_multiply(q[body], self.axes))
+        spin = np.einsum("kij,kj->ki", principal.transpose(0, 2, 1), angular_momentum[body])
+        omega = np.einsum("kij,kj->ki", principal, spin * self.inverse_moments)
+        velocity = momentum[body] * self.inverse_mass + np.cross(omega, points - x[body])
+        pull = -self.stiffness * (points - self.at) - self.damping * velocity
+        f, tau = wrench_at(x[body], points, pull)
+        np.add.at(force, body, f)
+        np.add.at(torque, body, tau)
+
+    def potential(self, t: float, x: np.ndarray, q: np.ndarray) -> float:
+        """``Σ ½ k |p − a|²`` [J]."""
+        stretch = _world_points(q, self.body, x, self.arm) - self.at
+        return float(0.5 * np.einsum("k,ki,ki->", self.stiffness[:, 0], stretch, stretch))

@@ -335,6 +335,8 @@ class SceneBuilder:
         path: str | os.PathLike[str] | None = None,
         linear_damping: float | None = None,
         angular_damping: float | None = None,
+        push: Sequence[Mapping[str, Any]] | None = None,
+        anchor: Mapping[str, Any] | None = None,
         color: Vector | None = None,
         name: str | None = None,
     ) -> int:
@@ -346,7 +348,10 @@ class SceneBuilder:
         origin at ``position`` [m], turned by ``orientation`` (a unit quaternion (w, x, y, z),
         body to world), its centre of mass moving at ``velocity`` [m/s] and spinning at
         ``angular_velocity`` [rad/s] (world frame); ``linear_damping`` and
-        ``angular_damping`` [1/s] damp its momenta (see :mod:`visviva.model.scene_rigid`).
+        ``angular_damping`` [1/s] damp its momenta; ``push`` is a list of forces at its
+        points (``{"force": ..., "point": ..., "start": ..., "duration": ...}``) and
+        ``anchor`` holds one of its points at a world point by a spring (``{"point": ...,
+        "at": ..., "stiffness": ..., "damping": ...}``; see :mod:`visviva.model.scene_rigid`).
         Its state is ``body_position`` (the centre of mass), ``body_orientation``,
         ``body_momentum`` and ``body_angular_momentum``."""
         given = _given(locals())

@@ -15,13 +15,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import ModelError
-from ..forces.body_forces import BodyDamping, BodyForce, BodyGravity
+from ..forces.body_forces import BodyAnchor, BodyDamping, BodyForce, BodyGravity, BodyPush
+from ..geometry.quaternions import quaternion_matrix
 from ..rigid.bodies import BodyStart, RigidBodies
 from ..rigid.mass_properties import MassProperties
 from ..rigid.shapes import mass_properties
 from .parts import Located
 from .scene import Scene
-from .scene_rigid import DIMENSIONS, RigidBody
+from .scene_rigid import DIMENSIONS, Anchor, Push, RigidBody
 
 __all__ = ["rigid_bodies"]
 
@@ -49,13 +50,52 @@ def rigid_bodies(scene: Scene, names: list[str]) -> tuple[RigidBodies | None, li
         shapes,
         [e.linear_damping for _, e in chosen],
         [e.angular_damping for _, e in chosen],
+        [e.color for _, e in chosen],
     )
     forces: list[BodyForce] = []
     if any(scene.world.gravity):
         forces.append(BodyGravity(scene.world.gravity, bodies.mass))
     if bodies.linear_damping.any() or bodies.angular_damping.any():
         forces.append(BodyDamping(bodies.linear_damping, bodies.angular_damping))
+    pushes = [(b, p) for b, (_, e) in enumerate(chosen) for p in e.push]
+    if pushes:
+        forces.append(_pushes(pushes, bodies))
+    anchors = [(b, e.anchor) for b, (_, e) in enumerate(chosen) if e.anchor is not None]
+    if anchors:
+        forces.append(_anchors(anchors, bodies))
     return bodies, forces
+
+
+def _arm(point: Any, bodies: RigidBodies, body: int) -> np.ndarray:
+    """A point given in a body's own axes, from its centre of mass (the centre itself for
+    ``None``)."""
+    return np.zeros(3) if point is None else np.asarray(point) - bodies.center[body]
+
+
+def _pushes(pushes: list[tuple[int, Push]], bodies: RigidBodies) -> BodyPush:
+    return BodyPush(
+        [b for b, _ in pushes],
+        [p.force for _, p in pushes],
+        [_arm(p.point, bodies, b) for b, p in pushes],
+        [p.start for _, p in pushes],
+        [np.inf if p.duration is None else p.start + p.duration for _, p in pushes],
+    )
+
+
+def _anchors(anchors: list[tuple[int, Anchor]], bodies: RigidBodies) -> BodyAnchor:
+    arms = [_arm(a.point, bodies, b) for b, a in anchors]
+    rotations = quaternion_matrix(bodies.orientation[[b for b, _ in anchors]])
+    starts = bodies.position[[b for b, _ in anchors]] + np.einsum("kij,kj->ki", rotations, arms)
+    return BodyAnchor(
+        [b for b, _ in anchors],
+        arms,
+        [start if a.at is None else a.at for start, (_, a) in zip(starts, anchors, strict=True)],
+        [a.stiffness for _, a in anchors],
+        [a.damping for _, a in anchors],
+        bodies.mass,
+        bodies.moments,
+        bodies.axes,
+    )
 
 
 def _mass_properties(index: int, entity: RigidBody) -> Any:

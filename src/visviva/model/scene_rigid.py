@@ -21,6 +21,10 @@ mesh        ``vertices`` and ``triangles`` (counter-clockwise seen from outside)
 ``position`` is where the body's own origin goes (the shape's centre for the primitives but
 the cone, whose origin is its base's centre; a mesh's coordinate origin); the state's
 ``body_position`` is its centre of mass.
+
+A body may be pushed (``[[entities.push]]``: a force [N] in the world frame at a point of the
+body, given in its own axes, for a while) and anchored (``[entities.anchor]``: a point of the
+body held at a world point by a stiff damped spring, a ball joint by penalty).
 """
 
 from __future__ import annotations
@@ -33,7 +37,7 @@ from pydantic_core import PydanticCustomError
 from .scene_bodies import FilePath
 from .scene_fields import Color, Finite, Index, Name, NonNegative, Positive, Strict, Vector
 
-__all__ = ["BODY_SHAPES", "RigidBody"]
+__all__ = ["BODY_SHAPES", "Anchor", "Push", "RigidBody"]
 
 BodyShape = Literal["box", "sphere", "ellipsoid", "cylinder", "capsule", "cone", "mesh"]
 BODY_SHAPES: tuple[str, ...] = BodyShape.__args__  # type: ignore[attr-defined]
@@ -50,6 +54,28 @@ DIMENSIONS: dict[str, tuple[str, ...]] = {
 }
 _ALL_DIMENSIONS = ("size", "radius", "height")
 Quaternion = tuple[Finite, Finite, Finite, Finite]
+
+
+class Push(Strict):
+    """A force on the body at one of its points for a while (``[[entities.push]]``)."""
+
+    force: Vector = Field(description="the force, world frame [N]")
+    point: Vector | None = Field(
+        None, description="where it acts, in the body's own axes [m] (default: centre of mass)"
+    )
+    start: NonNegative = Field(0.0, description="when it starts [s]")
+    duration: Positive | None = Field(None, description="how long it acts [s] (default: ever)")
+
+
+class Anchor(Strict):
+    """A point of the body held at a world point by a damped spring (``[entities.anchor]``)."""
+
+    point: Vector = Field(description="the anchored point, in the body's own axes [m]")
+    at: Vector | None = Field(
+        None, description="the world point it is held at [m] (default: where it starts)"
+    )
+    stiffness: Positive = Field(description="k of the spring [N/m]")
+    damping: NonNegative = Field(0.0, description="c of its damper [N s/m]")
 
 
 class RigidBody(Strict):
@@ -81,6 +107,8 @@ class RigidBody(Strict):
     angular_velocity: Vector = Field((0.0, 0.0, 0.0), description="world frame [rad/s]")
     linear_damping: NonNegative = Field(0.0, description="P' = F − γ P: γ [1/s]")
     angular_damping: NonNegative = Field(0.0, description="L' = τ − γ L: γ [1/s]")
+    push: list[Push] = Field(default_factory=list, description="forces at points, for a while")
+    anchor: Anchor | None = Field(None, description="a point held by a spring")
     color: Color = Field((0.8, 0.8, 0.8), description="sRGB colour in [0, 1]")
 
     @model_validator(mode="after")

@@ -218,8 +218,8 @@ def scene_system(model: Model) -> System:
             total += 0.0 if value is None else float(value)
         if motion is not None:
             total += motion.kinetic_energy(q, v)
-            x = _body_parts(q, v, end, b)[0]
-            total += sum(f.potential(t, x) for f in model.body_forces)
+            x, orientation, _, _ = _body_parts(q, v, end, b)
+            total += sum(f.potential(t, x, orientation) for f in model.body_forces)
         return total
 
     def potential(t: float, q: np.ndarray) -> float:
