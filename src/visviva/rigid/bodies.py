@@ -20,7 +20,10 @@ from ..geometry.quaternions import matrix_quaternion, quaternion_matrix
 from .mass_properties import MassProperties
 from .motion import BodyMotion
 
-__all__ = ["BodyStart", "RigidBodies"]
+__all__ = ["DEFAULT_COLOR", "BodyStart", "RigidBodies"]
+
+#: The colour of a body that is given none: a light grey, sRGB (the scene entity's default).
+DEFAULT_COLOR = (0.8, 0.8, 0.8)
 
 
 @dataclass(frozen=True)
@@ -49,6 +52,7 @@ class RigidBodies:
         linear_damping: ``(B,)`` γ of ``P' = F − γ P`` [1/s].
         angular_damping: ``(B,)`` γ of ``L' = τ − γ L`` [1/s].
         shapes: Each body's shape and dimensions, for drawing (``{"shape": ..., ...}``).
+        color: ``(B, 3)`` the colour each body is drawn in, sRGB in [0, 1].
         position: ``(B, 3)`` initial centres of mass [m].
         orientation: ``(B, 4)`` initial orientations.
         momentum: ``(B, 3)`` initial ``P`` [kg·m/s].
@@ -64,6 +68,7 @@ class RigidBodies:
     linear_damping: np.ndarray
     angular_damping: np.ndarray
     shapes: tuple[dict[str, Any], ...]
+    color: np.ndarray
     position: np.ndarray
     orientation: np.ndarray
     momentum: np.ndarray
@@ -78,9 +83,11 @@ class RigidBodies:
         shapes: Sequence[dict[str, Any]],
         linear_damping: Sequence[float],
         angular_damping: Sequence[float],
+        colors: Sequence[Sequence[float]] | None = None,
     ) -> RigidBodies:
         """The bodies with these mass properties (about the centre of mass, in each body's
-        axes), starts, shapes and damping rates."""
+        axes), starts, shapes, damping rates and colours (sRGB in [0, 1]; default
+        :data:`DEFAULT_COLOR`)."""
         moments, axes, orientation, position, momentum, spin = [], [], [], [], [], []
         for mp, start in zip(properties, starts, strict=True):
             principal, frame = mp.principal()
@@ -109,6 +116,10 @@ class RigidBodies:
             linear_damping=np.array(linear_damping, dtype=np.float64),
             angular_damping=np.array(angular_damping, dtype=np.float64),
             shapes=tuple(shapes),
+            color=stacked(
+                [np.asarray(c) for c in colors] if colors is not None else [DEFAULT_COLOR] * count,
+                3,
+            ),
             position=stacked(position, 3),
             orientation=stacked(orientation, 4),
             momentum=stacked(momentum, 3),
