@@ -202,6 +202,7 @@ def _load_builtins() -> None:
         constrained_pendulum,
         dahlquist,
         double_pendulum,
+        dzhanibekov,
         fireworks,
         flag,
         fountain,
