@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
+
 from visviva.demos import run_demo
 
 
@@ -25,3 +27,19 @@ def test_dzhanibekov_only_the_intermediate_axis_flips_and_l_is_kept(tmp_path):
     assert data["max_relative_energy_change"] < 1e-6
     moments = data["principal_moments_kg_m2"]
     assert moments == sorted(moments)  # the mesh's x, y, z are its principal axes, in order
+
+
+def test_top_precesses_at_the_steady_rate_and_does_not_topple(tmp_path):
+    """1 s of the spinning top: the mean precession rate is within 2 % of the slow steady
+    precession Ω = (I₃ω − √(I₃²ω² − 4 I₁' M g d cos θ)) / (2 I₁' cos θ) (0.3 % measured over
+    4 s) and within 10 % of the fast-top M g d / (I₃ ω); the tilt stays within 0.3 ± 0.05 rad;
+    the apex's spring holds the centre of mass at d = 3h/4 to 0.1 %."""
+    run_demo("top", tmp_path, duration=1.0)
+    data = summary(tmp_path)
+    rate = data["precession_rate_rad_per_s"]
+    assert abs(rate / data["steady_precession_rad_per_s"] - 1.0) < 0.02
+    assert abs(rate / data["gyroscopic_formula_rad_per_s"] - 1.0) < 0.10
+    low, high = data["tilt_range_deg"]
+    assert low > np.degrees(0.25) and high < np.degrees(0.35)
+    near, far = data["apex_distance_to_centre_m"]
+    assert abs(near / 0.09 - 1.0) < 1e-3 and abs(far / 0.09 - 1.0) < 1e-3

@@ -218,4 +218,5 @@ def _load_builtins() -> None:
         spring_pendulum,
         stiffness_study,
         sun_earth_moon,
+        top,
     )
