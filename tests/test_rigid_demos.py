@@ -43,3 +43,20 @@ def test_top_precesses_at_the_steady_rate_and_does_not_topple(tmp_path):
     assert low > np.degrees(0.25) and high < np.degrees(0.35)
     near, far = data["apex_distance_to_centre_m"]
     assert abs(near / 0.09 - 1.0) < 1e-3 and abs(far / 0.09 - 1.0) < 1e-3
+
+
+def test_rotation_drift_renormalizing_keeps_rotations_and_the_splitting_keeps_energy(tmp_path):
+    """5 s at h = 0.01 s: explicit Euler's matrix and quaternion are no longer rotations
+    (‖RᵀR − E‖ > 0.1); renormalized they are, to round-off, but explicit Euler's energy has
+    grown (> 1 %); the splitting stays a rotation with its energy within 1e-5 and is the
+    closest to the reference (by a factor 100 at least)."""
+    run_demo("rotation-drift", tmp_path, duration=5.0)
+    data = summary(tmp_path)
+    shape, energy = data["final_not_a_rotation"], data["final_energy_error"]
+    error = data["final_orientation_error"]
+    assert shape["matrix"] > 0.1 and shape["quaternion"] > 0.1
+    for kept in ("matrix + Gram–Schmidt", "quaternion + normalization", "splitting"):
+        assert shape[kept] < 1e-14
+    assert energy["quaternion + normalization"] > 0.01
+    assert abs(energy["splitting"]) < 1e-5
+    assert 100 * error["splitting"] < min(v for k, v in error.items() if k != "splitting")

@@ -214,6 +214,7 @@ def _load_builtins() -> None:
         pendulum,
         refinement_study,
         rock,
+        rotation_drift,
         snow,
         spring_pendulum,
         stiffness_study,
