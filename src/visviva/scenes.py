@@ -261,7 +261,7 @@ def _simulate_streaming(
         "playback_speed": model.output_speed,
         "playback_trail": model.output_trail,
         "compiled": False,
-    }
+    } | model.recording_attrs()
     run = _Run()
     failure: SimulationError | Interrupted | None = None
     simulation = Simulation(model)
@@ -380,6 +380,8 @@ def _counts(model: Model, run: _Run) -> dict[str, int]:
     counts = {}
     if model.particle_count:
         counts["particles"] = model.particle_count
+    if model.body_count:
+        counts["bodies"] = model.body_count
     if model.systems:
         counts["degrees_of_freedom"] = model.coordinate_count
         if run.points and run.points != model.particle_count:

@@ -12,6 +12,9 @@ Per frame (:func:`frame_fields`), following the recording convention of
     alive                 (P,) bool    with emitters: which points hold a live particle
     radius                (P,) [m]     with emitters: radii as they grow and shrink
     color                 (P, 3)       with colour ramps: sRGB colours in [0, 1]
+    body_position         (B, 3) [m]   each rigid body's own origin (its surface's coordinates
+                                       start there), not its centre of mass as in the state
+    body_orientation      (B, 4)       unit quaternions (w, x, y, z), body to world
 
 Once (:func:`static_fields`): the radii and colours that do not change, particle masses, and
 what to draw between points (point indices, the systems' shifted past the particles):
@@ -20,6 +23,18 @@ what to draw between points (point indices, the systems' shifted past the partic
                           :mod:`visviva.deformables.surfaces`)
     edges   (E, 2) int64  the stretch springs of the bodies without a surface (ropes, hair,
                           spring graphs), then the systems' links
+
+and the rigid bodies' surfaces in their own axes (:func:`visviva.rigid.surfaces.body_surface`),
+body after body, with their colours and centres of mass (see
+:mod:`visviva.simulation.body_geometry`; their names go in the attributes,
+:func:`recording_attrs`):
+
+    body_vertices         (V, 3) [m]     body_triangles        (T, 3) int64
+    body_vertex_start     (B + 1,) int64 body_triangle_start   (B + 1,) int64
+    body_color            (B, 3)         body_center           (B, 3) [m]
+
+Recording the origin rather than the centre of mass lets every output place a body's surface
+with its transform alone (``origin + R(q) v``), as USD and glTF transforms do.
 
 A body with a surface is drawn by it alone, not by its springs too. The video draws lines
 1.5 px wide whatever the mesh: on a 20 × 20 cloth they made a clear wireframe, but on a 1 m
@@ -35,15 +50,18 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..deformables.topology import STRETCH
+from ..geometry.quaternions import quaternion_rotate
 from ..particles.emitters import ramp_values
+from ..rigid.surfaces import body_surface
 from .parts import body_networks
 from .systems import SYSTEMS
 
 if TYPE_CHECKING:
     from ..ode.state import State
+    from ..rigid.bodies import RigidBodies
     from .model import Model, SystemInstance
 
-__all__ = ["frame_fields", "static_fields"]
+__all__ = ["frame_fields", "recording_attrs", "static_fields"]
 
 
 def _system_points(model: Model, state: State) -> list[np.ndarray]:
@@ -103,6 +121,11 @@ def frame_fields(model: Model, state: State) -> dict[str, np.ndarray]:
             fields["color"] = np.concatenate([_colors(model, state), np.ones((extra, 3))]).astype(
                 np.float32
             )
+    if model.bodies is not None:
+        orientation = state["body_orientation"]
+        center = quaternion_rotate(orientation, model.bodies.center)
+        fields["body_position"] = state["body_position"] - center
+        fields["body_orientation"] = np.array(orientation)
     return fields
 
 
@@ -154,7 +177,31 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
         static["edges"] = np.concatenate(edges)
     if faces:
         static["faces"] = np.concatenate(faces)
+    if model.bodies is not None:
+        static |= _body_surfaces(model.bodies)
     return static
+
+
+def _body_surfaces(bodies: RigidBodies) -> dict[str, np.ndarray]:
+    """The rigid bodies' drawing surfaces, body after body, and their colours and centres."""
+    surfaces = [body_surface(shape) for shape in bodies.shapes]
+    vertex_start = np.cumsum([0] + [v.shape[0] for v, _ in surfaces], dtype=np.int64)
+    triangle_start = np.cumsum([0] + [t.shape[0] for _, t in surfaces], dtype=np.int64)
+    return {
+        "body_vertices": np.concatenate([v for v, _ in surfaces]).astype(np.float64),
+        "body_triangles": np.concatenate(
+            [t + first for (_, t), first in zip(surfaces, vertex_start, strict=False)]
+        ).astype(np.int64),
+        "body_vertex_start": vertex_start,
+        "body_triangle_start": triangle_start,
+        "body_color": np.array(bodies.color, dtype=np.float64),
+        "body_center": np.array(bodies.center, dtype=np.float64),
+    }
+
+
+def recording_attrs(model: Model) -> dict[str, list[str]]:
+    """Attributes a recording keeps of the scene besides its arrays: the bodies' names."""
+    return {} if model.bodies is None else {"body_names": list(model.bodies.names)}
 
 
 def _body_topology(model: Model) -> tuple[list[np.ndarray], list[np.ndarray]]:

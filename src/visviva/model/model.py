@@ -208,9 +208,11 @@ class Model:
 
     @property
     def has_geometry(self) -> bool:
-        """True if runs of this model record drawable ``points``."""
-        return self.particle_count > 0 or any(
-            SYSTEMS[s.system].draw is not None for s in self.systems
+        """True if runs of this model record something to draw: ``points`` or rigid bodies."""
+        return (
+            self.particle_count > 0
+            or self.body_count > 0
+            or any(SYSTEMS[s.system].draw is not None for s in self.systems)
         )
 
     def system(self) -> System:
@@ -252,10 +254,19 @@ class Model:
 
         return static_fields(self)
 
+    def recording_attrs(self) -> dict[str, Any]:
+        """Attributes a recording keeps of the scene besides its arrays (see :mod:`.frames`)."""
+        from .frames import recording_attrs
+
+        return recording_attrs(self)
+
     def units(self) -> dict[str, str]:
         """Units of the recorded fields and static arrays."""
         return {
             "points": "m",
+            "body_position": "m",
+            "body_vertices": "m",
+            "body_center": "m",
             "velocities": "m/s",
             "radius": "m",
             "mass": "kg",

@@ -29,6 +29,15 @@ and, per frame:
                             static/radius)
     fields/color            float32 (frames, P, 3): colours that change over time, sRGB in
                             [0, 1] (instead of static/color)
+
+Rigid bodies keep their surfaces once and a transform per frame (the full list is in
+:mod:`visviva.simulation.body_geometry`; a recording may hold bodies without points):
+
+    fields/body_position    float64 (frames, B, 3) [m]: each body's own origin, world frame
+    fields/body_orientation float64 (frames, B, 4): unit quaternions (w, x, y, z), body to world
+    static/body_vertices    float64 (V, 3) [m]: the bodies' surfaces in their own axes, with
+                            body_triangles (T, 3), body_vertex_start and body_triangle_start
+                            (B + 1,), body_color (B, 3), body_center (B, 3) [m]
 """
 
 from __future__ import annotations
@@ -40,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ModelError
+from .body_geometry import BodyGeometry, read_bodies
 
 __all__ = ["Geometry", "Recording"]
 
@@ -68,6 +78,7 @@ class Geometry:
             invisible, shape ``(P,)``, or ``None`` (drawn to scale).
         alive: Which points exist in each frame, shape ``(frames, P)`` bool, or ``None`` (all
             of them, always). Outputs draw only the live points of each frame.
+        bodies: The rigid bodies' surfaces and transforms, or ``None``.
     """
 
     points: np.ndarray
@@ -77,6 +88,7 @@ class Geometry:
     color: np.ndarray | None = None
     display_radius: np.ndarray | None = None
     alive: np.ndarray | None = None
+    bodies: BodyGeometry | None = None
 
     @property
     def to_scale(self) -> bool:
@@ -201,16 +213,20 @@ class Recording:
     def geometry(self) -> Geometry:
         """The drawable geometry (see the module docstring), checked for consistent shapes.
 
+        A recording of rigid bodies alone has ``points`` of shape ``(frames, 0, 3)``.
+
         Raises:
-            ModelError: If the recording has no ``points`` field or its static arrays do not
-                fit the points.
+            ModelError: If the recording has neither a ``points`` field nor rigid bodies, or
+                its static arrays do not fit the points or the bodies.
         """
-        if "points" not in self.fields:
+        bodies = read_bodies(self.fields, self.static, self.attrs)
+        if "points" not in self.fields and bodies is None:
             raise ModelError(
-                "this recording has no geometry to show (no `points` field): it comes from a "
-                "run of an abstract system; record a scene with particles or bodies instead"
+                "this recording has no geometry to show (no `points` field, no bodies): it "
+                "comes from a run of an abstract system; record a scene with particles or "
+                "bodies instead"
             )
-        points = self.fields["points"]
+        points = self.fields.get("points", np.zeros((self.frames, 0, 3)))
         if points.ndim != 3 or points.shape[2] != 3:
             raise ModelError(f"`points` must have shape (frames, P, 3) (got {points.shape})")
         frames, count = points.shape[:2]
@@ -243,7 +259,7 @@ class Recording:
                 if value.size and (value.min() < 0 or value.max() >= count):
                     raise ModelError(f"`{name}` refers to points outside 0..{count - 1}")
             topology[name] = value
-        return Geometry(points, **per_point, **topology, alive=alive)
+        return Geometry(points, **per_point, **topology, alive=alive, bodies=bodies)
 
     def __repr__(self) -> str:
         shapes = ", ".join(f"{k}{tuple(v.shape)}" for k, v in self.fields.items())

@@ -283,7 +283,8 @@ class Simulation:
                 "substeps": self.substeps,
                 "scene_name": self.model.name,
                 "steps": self.system.counters.accepted_steps,
-            } | self.system.counters.as_dict()
+            }
+            attrs |= self.system.counters.as_dict() | self.model.recording_attrs()
             return Recording(
                 np.array(times),
                 fields,

@@ -12,8 +12,9 @@ then takes the steps:
    lies behind; only the points on no face are spheres, the others are the faces' vertices);
 4. the time label ``t = 1.234 s`` is stamped in the top-left corner.
 
-A geometry kind is a *layer*: an object with ``cast_shadows`` and ``draw``. Rigid bodies will
-be a new layer, not a change to the others.
+A geometry kind is a *layer*: an object with ``cast_shadows`` and ``draw``. Rigid bodies are
+one (:class:`~visviva.viz.body_layer.BodyLayer`: each body's surface placed by its transform,
+shaded like the faces, in its colour); the framing and the ground include them.
 
 Points that are born and die (:mod:`visviva.viz.lifetimes`): each frame draws and shadows only
 its live points, at that frame's radius and colour; a trail goes back no further than the start
@@ -31,7 +32,9 @@ import numpy as np
 
 from ..simulation.recording import Geometry
 from . import ground, raster
+from .body_layer import BodyLayer
 from .lifetimes import Appearance, life_starts
+from .shading import LIGHT, MATERIAL, lit_sides
 from .timescale import format_time
 
 if TYPE_CHECKING:
@@ -39,8 +42,6 @@ if TYPE_CHECKING:
 
 __all__ = ["FramePainter", "drawn_bounds"]
 
-#: Direction towards the light (world frame, Y up): from above, a little from the left front.
-LIGHT = np.array([-0.3, 1.0, 0.35]) / np.linalg.norm([-0.3, 1.0, 0.35])
 #: Colours, RGB in [0, 1]; points, edges and faces match the web viewer's.
 SPHERE_COLOUR = (0x2F / 255, 0x6F / 255, 0xB3 / 255)
 EDGE_COLOUR = (0x1D / 255, 0x27 / 255, 0x33 / 255)
@@ -48,8 +49,6 @@ FACE_COLOUR = (0xD9 / 255, 0x82 / 255, 0x2B / 255)
 FACE_BACK_COLOUR = (0.62, 0.56, 0.50)
 #: Sky at the zenith, sky at the horizon, the two ground tones.
 ENVIRONMENT = ((0.50, 0.66, 0.86), (0.90, 0.92, 0.95), (0.80, 0.79, 0.76), (0.74, 0.73, 0.70))
-#: Ambient light from below and from above, diffuse, specular (Blinn-Phong exponent 32).
-MATERIAL = (0.30, 0.52, 0.62, 0.30)
 #: Rays per pixel along each axis for the (once per clip) sky and ground.
 BACKGROUND_SAMPLES = 3
 #: Ground haze: the ground is fully hazed at a few times this multiple of the camera distance.
@@ -76,10 +75,18 @@ NEAR_FRACTION = 1e-3
 
 
 def drawn_bounds(geometry: Geometry) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper corners [m] of the box holding every live point of every frame as
-    drawn: each point padded by its drawn radius in that frame. Dead points count for nothing;
-    with no live point at all, both corners are the origin."""
-    return Appearance.of(geometry).live_bounds(geometry.points)
+    """Lower and upper corners [m] of the box holding everything drawn in every frame: each
+    live point padded by its drawn radius in that frame, and every rigid body's surface. Dead
+    points count for nothing; with nothing drawn at all, both corners are the origin."""
+    look = Appearance.of(geometry)
+    boxes = []
+    if geometry.points.shape[1] and (look.alive is None or look.alive.any()):
+        boxes.append(look.live_bounds(geometry.points))
+    if geometry.bodies is not None and geometry.bodies.vertices.shape[0]:
+        boxes.append(geometry.bodies.bounds())
+    if not boxes:
+        return np.zeros(3), np.zeros(3)
+    return np.min([low for low, _ in boxes], axis=0), np.max([high for _, high in boxes], axis=0)
 
 
 def _live_radii(look: Appearance) -> np.ndarray:
@@ -343,12 +350,7 @@ class _Faces:
         )
         length = np.linalg.norm(normal, axis=1, keepdims=True)
         normal = np.divide(normal, length, out=np.zeros_like(normal), where=length > 0.0)
-        below, above, diffuse = MATERIAL[0], MATERIAL[1], MATERIAL[2]
-        sides = []
-        for sign in (1.0, -1.0):
-            n = sign * normal
-            ambient = below + (above - below) * (0.5 + 0.5 * n[:, 1])
-            sides.append(ambient + diffuse * np.maximum(n @ LIGHT, 0.0))
+        sides = lit_sides(normal)
         raster.draw_triangles(
             color,
             depth,
@@ -386,11 +388,13 @@ class FramePainter:
         self.default_colour = np.tile(
             np.array(SPHERE_COLOUR, dtype=np.float32), (geometry.points.shape[1], 1)
         )
-        low, high = look.live_bounds(geometry.points)
+        low, high = drawn_bounds(geometry)
         scene = max(float(np.linalg.norm(high - low)), 1e-9)
         stage = _Stage(camera, self.width, self.height, min(0.0, float(low[1])), scene)
         self.stage = stage
         self.layers: list[_Layer] = []
+        if geometry.bodies is not None:
+            self.layers.append(BodyLayer(geometry.bodies))
         if geometry.faces is not None and len(geometry.faces):
             self.layers.append(_Faces(geometry.faces))
         if geometry.edges is not None and len(geometry.edges):

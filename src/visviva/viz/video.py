@@ -21,7 +21,8 @@ recorded radius and colour (or the viewer's default radius and blue; a recording
 radii, for bodies too small to see, are drawn instead and the label says "sizes not to
 scale"), only the points alive in the frame (particles of emitters are born and die; see
 :mod:`visviva.viz.lifetimes`), optional trails behind the points, edges as lines, faces as
-Gouraud-shaded triangles, shadows from a light above, and the time of the recorded frame
+Gouraud-shaded triangles, rigid bodies as their surfaces placed by each frame's transform and
+shaded the same way in their colours, shadows from a light above, and the time of the recorded frame
 shown in the unit that reads best, ``t = 1.234 s`` or ``t = 182.6 days``. Output frame ``k``
 shows the recorded frame nearest ``t0 + k/fps`` (:func:`visviva.io.timeline.frames_at_rate`),
 so the video plays in real time whatever the recording's frame spacing.
@@ -209,13 +210,13 @@ def render_video(
     Args:
         recording: A recording with drawable geometry (``points``, optional ``radius``,
             ``color``, ``edges``, ``faces``, and ``alive``, ``radius`` and ``color`` per frame
-            for points that are born and die; see :meth:`Recording.geometry`).
+            for points that are born and die; rigid bodies; see :meth:`Recording.geometry`).
         path: Output file; ``.mp4`` or ``.gif`` chooses the format. Its directory must exist.
             Written atomically: a temporary file renamed when complete.
         fps: Output frames per second [1/s]; at most 50 for GIF.
         size: ``(width, height)`` [px]; both even for mp4 (yuv420p halves the colour planes).
-        camera: The view; default :meth:`Camera.framing` of the bounds of the live points of
-            all frames, so that everything stays in view for the whole clip.
+        camera: The view; default :meth:`Camera.framing` of the bounds of the live points and
+            the bodies of all frames, so that everything stays in view for the whole clip.
         progress: Show a progress bar on stderr for long renders; ``None`` (default): only
             when stderr is a terminal.
         speed: Simulated seconds per second of video (1: real time; 86400: a day per
@@ -323,7 +324,8 @@ def _checked_size(size: Any, *, even: bool) -> tuple[int, int]:
 
 
 def _check_finite(geometry: Geometry) -> None:
-    """Refuse non-finite live positions and bad radii; dead points may hold anything."""
+    """Refuse non-finite live positions, body transforms and bad radii; dead points may hold
+    anything."""
     points, radius, alive = geometry.points, geometry.radius, geometry.alive
     bad = ~np.isfinite(points).all(axis=2)
     if alive is not None:
@@ -333,6 +335,12 @@ def _check_finite(geometry: Geometry) -> None:
         raise ModelError(
             f"`points` must be finite to be drawn: frame {frame}, point {point} is "
             f"{describe(points[frame, point])}; cut the recording before the run diverged"
+        )
+    bad_body = None if geometry.bodies is None else geometry.bodies.nonfinite()
+    if bad_body is not None:
+        raise ModelError(
+            f"the transforms of the bodies must be finite to be drawn: frame {bad_body[0]}, "
+            f"body {bad_body[1]} is not; cut the recording before the run diverged"
         )
     if radius is None:
         return

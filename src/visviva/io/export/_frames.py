@@ -12,8 +12,9 @@ The drawable parts follow the recording's convention (``points``, ``radius``, ``
 :class:`visviva.viz.lifetimes.Appearance`, as the video and the viewer read them: each writer
 asks which points are alive in an output frame (:meth:`ExportFrames.alive_at`), their radius
 and colour there, and, if its format keeps every slot in every frame, where a dead slot is held
-(:meth:`ExportFrames.held_points_at`). A future kind (rigid bodies: a position and a
-quaternion per body per frame) becomes one more field here and one more part in each writer.
+(:meth:`ExportFrames.held_points_at`). Rigid bodies (:mod:`visviva.simulation.body_geometry`)
+are a surface each and a transform per frame (:meth:`ExportFrames.body_transforms_at`);
+formats without transforms place their vertices (:meth:`ExportFrames.body_vertices_at`).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import numpy as np
 
 from ..._validation import real_number
 from ...errors import ModelError
+from ...simulation.body_geometry import BodyGeometry, continuous_orientations
 from ...simulation.recording import Geometry, Recording
 from ...viz.lifetimes import Appearance, held_frames, held_points
 from ..timeline import MAX_OUTPUT_FRAMES, frames_at_rate
@@ -125,6 +127,35 @@ class ExportFrames:
         """Point-index triangles, int64 ``(F, 3)``, or ``None`` if there are none."""
         return _topology(self.geometry.faces)
 
+    @property
+    def bodies(self) -> BodyGeometry | None:
+        """The rigid bodies, or ``None``."""
+        return self.geometry.bodies
+
+    @cached_property
+    def _orientations(self) -> np.ndarray:
+        bodies = self.geometry.bodies
+        if bodies is None:
+            return np.zeros((self.count, 0, 4))
+        return continuous_orientations(bodies.orientation[self.shown])
+
+    def body_transforms_at(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Each rigid body's own origin [m] ``(B, 3)`` and orientation ``(B, 4)`` (unit
+        quaternions (w, x, y, z), body to world) at output frame ``k``, float64. The signs of
+        the quaternions are chosen so that each is in the hemisphere of the output frame
+        before (the same rotations: see
+        :func:`~visviva.simulation.body_geometry.continuous_orientations`)."""
+        if self.geometry.bodies is None:
+            return np.zeros((0, 3)), np.zeros((0, 4))
+        return self.geometry.bodies.position[self.shown[k]], self._orientations[k]
+
+    def body_vertices_at(self, k: int) -> np.ndarray:
+        """Every rigid body's surface vertices [m] placed at output frame ``k``, float64
+        ``(V, 3)``, world frame (none without bodies)."""
+        if self.geometry.bodies is None:
+            return np.zeros((0, 3))
+        return self.geometry.bodies.world_vertices(int(self.shown[k]))
+
     def points_at(self, k: int) -> np.ndarray:
         """Positions [m] at output frame ``k``: float64, shape ``(P, 3)``, world frame, Y up."""
         return np.asarray(self.geometry.points[self.shown[k]], dtype=np.float64)
@@ -199,15 +230,16 @@ def prepare(recording: Recording, fps: float | None, speed: float = 1.0) -> Expo
     """Check ``recording`` and ``fps`` and choose the recorded frame of every output frame.
 
     Args:
-        recording: A recording with a ``points`` field (see :meth:`Recording.geometry`).
+        recording: A recording with ``points`` or rigid bodies (see
+            :meth:`Recording.geometry`).
         fps: Output frames per second [1/s], or ``None`` for :func:`default_fps` of the
             recording played at ``speed``.
         speed: Simulated seconds per second of playback.
 
     Raises:
-        ModelError: If the recording has no points or no frames, ``fps`` is not a positive
-            number or gives more than :data:`MAX_OUTPUT_FRAMES` frames, or a shown frame holds
-            a non-finite position of a live point.
+        ModelError: If the recording has no points and no bodies, or no frames, ``fps`` is
+            not a positive number or gives more than :data:`MAX_OUTPUT_FRAMES` frames, or a
+            shown frame holds a non-finite position of a live point or transform of a body.
     """
     if not isinstance(recording, Recording):
         raise ModelError(
@@ -216,10 +248,10 @@ def prepare(recording: Recording, fps: float | None, speed: float = 1.0) -> Expo
         )
     geometry = recording.geometry()
     points = geometry.points
-    if points.shape[1] == 0:
+    if points.shape[1] == 0 and geometry.bodies is None:
         raise ModelError(
-            f"the recording's `points` field holds no points (shape {points.shape}); "
-            "there is nothing to export"
+            f"the recording's `points` field holds no points (shape {points.shape}) and it has "
+            "no bodies; there is nothing to export"
         )
     time = recording.time
     if time.size == 0:
@@ -241,4 +273,12 @@ def prepare(recording: Recording, fps: float | None, speed: float = 1.0) -> Expo
                 f"point {point} ({points[k, point].tolist()}): the run diverged there; re-run "
                 "it with a smaller step, or export a recording that ends before that frame"
             )
+    bad_body = None if geometry.bodies is None else geometry.bodies.nonfinite(np.unique(shown))
+    if bad_body is not None:
+        k, body = bad_body
+        raise ModelError(
+            f"the transform of body {body} in recorded frame {k} (t = {time[k]:g} s) is not "
+            "finite: the run diverged there; re-run it with a smaller step, or export a "
+            "recording that ends before that frame"
+        )
     return ExportFrames(geometry, time, shown, rate, _scene_name(recording.attrs), speed)

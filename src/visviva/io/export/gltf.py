@@ -1,7 +1,8 @@
-"""glTF 2.0 export: moving bodies as animated sphere nodes, anything else as morph targets.
+"""glTF 2.0 export: moving bodies as animated sphere nodes, anything else as morph targets,
+rigid bodies as nodes moved by their transforms.
 
 Follows the Khronos glTF 2.0 specification (sections cited as § of version 2.0.1), written
-with ``pygltflib``. Two layouts, chosen by what the recording shows:
+with ``pygltflib``. The recording's points take one of two layouts, chosen by what it shows:
 
 * **Bodies** — points without edges or faces, at most :data:`MAX_BODY_NODES` of them (planets,
   stars of a small cluster, the bobs of a pendulum drawn as points): one node per point
@@ -34,7 +35,11 @@ point is moved onto the live point of the largest radius in the same frame (onto
 the first-born point's, in a frame with no live point at all), so it adds no dot of its own
 and no extent; its ``_RADIUS`` and ``COLOR_0`` are those of its first life.
 
-Both: glTF time starts at 0 (the recording's first frame); every ``POSITION`` accessor and the
+Rigid bodies (:mod:`._gltf_rigid`) are added beside either layout, or alone: one node per
+body showing its surface, with ``translation`` and ``rotation`` channels and no per-frame
+vertex data. The document has one animation, ``simulation``, holding every channel.
+
+All: glTF time starts at 0 (the recording's first frame); every ``POSITION`` accessor and the
 animation input have ``min`` and ``max`` (§ 3.6.2.5, § 3.11); buffer views start on 4-byte
 boundaries (§ 3.6.2.4); the scene's rate, speed and start time are in ``asset.extras``.
 glTF carries no scene frame rate or frame range: importers sample the animation at their own
@@ -58,6 +63,8 @@ from ..._version import __version__
 from ...errors import ModelError
 from ._files import all_or_nothing
 from ._frames import ExportFrames
+from ._gltf_buffer import GltfBuffer, linear_rgb
+from ._gltf_rigid import add_rigid_bodies
 
 __all__ = ["MAX_BODY_NODES", "MAX_GLTF_BYTES", "MAX_MORPH_FRAMES", "gltf_size", "write_gltf"]
 
@@ -168,69 +175,6 @@ def _check_size(frames: ExportFrames, index_count: int) -> None:
     )
 
 
-class _Buffer:
-    """The binary buffer with its views and accessors, filled part by part."""
-
-    def __init__(self) -> None:
-        self.parts: list[bytes] = []
-        self.views: list[Any] = []
-        self.accessors: list[Any] = []
-        self.size = 0
-
-    def view(self, data: np.ndarray, **options: Any) -> int:
-        import pygltflib as gl
-
-        raw = np.ascontiguousarray(data).tobytes()
-        self.views.append(
-            gl.BufferView(buffer=0, byteOffset=self.size, byteLength=len(raw), **options)
-        )
-        self.parts.append(raw)
-        self.size += len(raw)  # every part is whole 4-byte values: the next stays aligned
-        return len(self.views) - 1
-
-    def accessor(self, **fields: Any) -> int:
-        import pygltflib as gl
-
-        self.accessors.append(gl.Accessor(**fields))
-        return len(self.accessors) - 1
-
-    def floats(self, values: np.ndarray, kind: str, *, bounds: bool = False, **view: Any) -> int:
-        """An accessor of float32 ``values`` (``(count,)`` SCALAR or ``(count, 3)`` VEC3)."""
-        import pygltflib as gl
-
-        values = np.asarray(values, dtype="<f4")
-        extremes: dict[str, Any] = {}
-        if bounds:
-            rows = values.reshape(len(values), -1)
-            extremes = {"min": rows.min(axis=0).tolist(), "max": rows.max(axis=0).tolist()}
-        return self.accessor(
-            bufferView=self.view(values, **view),
-            componentType=gl.FLOAT,
-            count=len(values),
-            type=kind,
-            **extremes,
-        )
-
-    def indices(self, values: np.ndarray) -> int:
-        import pygltflib as gl
-
-        return self.accessor(
-            bufferView=self.view(np.asarray(values, dtype="<u4"), target=gl.ELEMENT_ARRAY_BUFFER),
-            componentType=gl.UNSIGNED_INT,
-            count=int(values.size),
-            type=gl.SCALAR,
-        )
-
-    def blob(self) -> bytes:
-        return b"".join(self.parts)
-
-
-def _linear(srgb: np.ndarray) -> np.ndarray:
-    """sRGB values in [0, 1] as linear ones (IEC 61966-2-1), which glTF colours are."""
-    srgb = np.asarray(srgb, dtype=np.float64)
-    return np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
-
-
 class _Layout:
     """What one layout adds to the document: nodes (root first), meshes, materials and the
     animation."""
@@ -246,7 +190,9 @@ class _Layout:
         )
 
 
-def _sphere_meshes(frames: ExportFrames, data: _Buffer) -> tuple[list[Any], list[Any], np.ndarray]:
+def _sphere_meshes(
+    frames: ExportFrames, data: GltfBuffer
+) -> tuple[list[Any], list[Any], np.ndarray]:
     """The unit-sphere meshes (one per distinct colour, sharing the sphere's accessors), their
     materials, and the mesh each point shows."""
     import pygltflib as gl
@@ -271,7 +217,7 @@ def _sphere_meshes(frames: ExportFrames, data: _Buffer) -> tuple[list[Any], list
                 gl.Material(
                     name=f"colour_{j:03d}",
                     pbrMetallicRoughness=gl.PbrMetallicRoughness(
-                        baseColorFactor=[*_linear(colour).tolist(), 1.0],
+                        baseColorFactor=[*linear_rgb(colour).tolist(), 1.0],
                         metallicFactor=0.0,
                         roughnessFactor=0.5,
                     ),
@@ -293,7 +239,7 @@ def _sphere_meshes(frames: ExportFrames, data: _Buffer) -> tuple[list[Any], list
     return meshes, materials, np.ravel(which)
 
 
-def _bodies(frames: ExportFrames, data: _Buffer) -> _Layout:
+def _bodies(frames: ExportFrames, data: GltfBuffer) -> _Layout:
     """Nodes (root first), sphere meshes, materials and the animation of the bodies layout."""
     import pygltflib as gl
 
@@ -360,7 +306,7 @@ def _collapsed_points_at(frames: ExportFrames, k: int, gathering: int) -> np.nda
     return positions
 
 
-def _mesh(frames: ExportFrames, data: _Buffer) -> _Layout:
+def _mesh(frames: ExportFrames, data: GltfBuffer) -> _Layout:
     """Node, mesh with morph targets and the weight animation of the mesh layout."""
     import pygltflib as gl
 
@@ -392,7 +338,7 @@ def _mesh(frames: ExportFrames, data: _Buffer) -> _Layout:
     colours = frames.look.first_color()
     colour = None
     if colours is not None:
-        colour = data.floats(_linear(colours), gl.VEC3, target=gl.ARRAY_BUFFER)
+        colour = data.floats(linear_rgb(colours), gl.VEC3, target=gl.ARRAY_BUFFER)
     mesh_primitives = []
     for mode, indices in primitives:
         attributes = gl.Attributes(POSITION=base)
@@ -458,8 +404,23 @@ def write_gltf(frames: ExportFrames, path: Path, *, binary: bool) -> list[Path]:
     """
     import pygltflib as gl
 
-    data = _Buffer()
-    layout = (_bodies if _as_bodies(frames) else _mesh)(frames, data)
+    data = GltfBuffer()
+    nodes: list[Any] = []
+    meshes: list[Any] = []
+    materials: list[Any] = []
+    samplers: list[Any] = []
+    channels: list[Any] = []
+    roots = []
+    if frames.point_count:
+        layout = (_bodies if _as_bodies(frames) else _mesh)(frames, data)
+        nodes, meshes, materials = layout.nodes, layout.meshes, layout.materials
+        samplers, channels = layout.animation.samplers, layout.animation.channels
+        roots.append(0)
+    if frames.bodies is not None:
+        animation = (samplers, channels)
+        roots.append(
+            add_rigid_bodies(frames, frames.bodies, data, nodes, meshes, materials, animation)
+        )
     document = gl.GLTF2(
         asset=gl.Asset(
             generator=f"visviva {__version__}",
@@ -473,13 +434,13 @@ def write_gltf(frames: ExportFrames, path: Path, *, binary: bool) -> list[Path]:
             },
         ),
         scene=0,
-        scenes=[gl.Scene(nodes=[0])],
-        nodes=layout.nodes,
-        meshes=layout.meshes,
-        materials=layout.materials,
+        scenes=[gl.Scene(nodes=roots)],
+        nodes=nodes,
+        meshes=meshes,
+        materials=materials,
         accessors=data.accessors,
         bufferViews=data.views,
-        animations=[layout.animation],
+        animations=[gl.Animation(name="simulation", samplers=samplers, channels=channels)],
     )
     blob = data.blob()
     if binary:

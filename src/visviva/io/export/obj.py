@@ -19,6 +19,13 @@ Python's ``repr``, the shortest decimal that reads back as the same float64, so 
 the recording's positions exactly (``%.9g`` would only keep float32 precision) at the cost of a
 few more characters than needed for display. Units are metres, Y up.
 
+Rigid bodies follow the points: their surfaces' vertices, placed where the frame puts each
+body (``origin + R(q) v``, float64 like the points), then, after the points' edges and
+triangles, one group per body (``g NAME``) with its triangles. Groups, not ``o`` objects:
+Blender's OBJ importer splits objects into separate meshes by default but keeps groups in one,
+so the first file of a sequence still matches a PC2 cache of the same points and vertices,
+in the same order (:mod:`.pc2`).
+
 Points that are born and die (particles of emitters): each file holds only the points alive in
 its frame, in point order, with a comment saying how many of the recording's slots they are;
 edges and triangles are kept where all their points are alive, renumbered to match. Vertex
@@ -74,6 +81,21 @@ def _topology_text(frames: ExportFrames, live: np.ndarray | None = None) -> str:
     return "".join(lines)
 
 
+def _body_text(frames: ExportFrames, first: int) -> str:
+    """One ``g`` group per rigid body with its ``f`` lines, its vertices numbered after
+    ``first`` vertices (1-based indices)."""
+    bodies = frames.bodies
+    if bodies is None:
+        return ""
+    lines: list[str] = []
+    for b, name in enumerate(bodies.names):
+        lines.append(f"g {_object_name(name)}\n")
+        _, triangles = bodies.surface(b)
+        start = first + int(bodies.vertex_start[b]) + 1
+        lines.extend(f"f {a} {c} {d}\n" for a, c, d in (triangles + start).tolist())
+    return "".join(lines)
+
+
 def _object_name(name: str) -> str:
     """``name`` as one OBJ token (OBJ statements split on white space)."""
     return re.sub(r"\s+", "_", name)
@@ -95,6 +117,7 @@ def write_obj_sequence(frames: ExportFrames, path: Path) -> list[Path]:
     if created:
         path.mkdir()
     topology = _topology_text(frames)
+    body_faces = _body_text(frames, frames.point_count)
     vertex_line = "v %r %r %r\n"
     name = _object_name(frames.name)
     try:
@@ -113,9 +136,13 @@ def write_obj_sequence(frames: ExportFrames, path: Path) -> list[Path]:
                     positions = positions[live]
                     header += f"# {positions.shape[0]} of {frames.point_count} points alive\n"
                     topology = _topology_text(frames, live)
+                    body_faces = _body_text(frames, positions.shape[0])
+                if frames.bodies is not None:
+                    positions = np.concatenate([positions, frames.body_vertices_at(k)])
                 values = tuple(positions.ravel().tolist())
                 vertices = (vertex_line * positions.shape[0]) % values
-                temporary.write_text(header + vertices + topology, encoding="utf-8")
+                text = header + vertices + topology + body_faces
+                temporary.write_text(text, encoding="utf-8")
     except BaseException:
         if created:
             # Only the directory this call made, and only if nothing else appeared in it.

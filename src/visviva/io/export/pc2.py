@@ -5,7 +5,7 @@ The PC2 ("Point Cache 2") layout, as read by Blender's Mesh Cache modifier and w
 
     char[12]  signature      b"POINTCACHE2\\0"
     int32     file version   1
-    int32     point count    P
+    int32     point count    P (+ V, the rigid bodies' vertices)
     float32   start frame    0.0: sample 0 is output frame 0
     float32   sample rate    1.0: frames between samples (one sample per output frame)
     int32     sample count   N
@@ -15,6 +15,10 @@ Positions are float32 [m] in visviva's frame (Y up, unconverted): in Blender, ap
 to a mesh imported from the first file of an OBJ export, which keeps the point order and puts
 the Y-up to Z-up rotation on the object (see ``docs/export.md``). A cache holds no topology and
 no time unit: set the scene's frame rate to the export's ``fps``.
+
+Rigid bodies add their surfaces' vertices after the points, placed where each frame puts
+their body (``origin + R(q) v``): the order of an OBJ export's vertices (:mod:`.obj`), so the
+cache animates the bodies of the mesh imported from its first file as well as the points.
 
 The point count is fixed by the format. Points that are born and die (particles of emitters)
 keep their slot in every sample: a dead point is written where it was last alive, or, before
@@ -51,9 +55,13 @@ def write_pc2(frames: ExportFrames, path: Path) -> list[Path]:
     Returns:
         ``[path]``.
     """
-    header = _HEADER.pack(PC2_SIGNATURE, _VERSION, frames.point_count, 0.0, 1.0, frames.count)
+    vertices = 0 if frames.bodies is None else frames.bodies.vertices.shape[0]
+    count = frames.point_count + vertices
+    header = _HEADER.pack(PC2_SIGNATURE, _VERSION, count, 0.0, 1.0, frames.count)
     with all_or_nothing([path]) as (temporary,), temporary.open("wb") as file:
         file.write(header)
         for k in range(frames.count):
             file.write(np.ascontiguousarray(frames.held_points_at(k), dtype="<f4").tobytes())
+            if vertices:
+                file.write(np.ascontiguousarray(frames.body_vertices_at(k), dtype="<f4").tobytes())
     return [path]

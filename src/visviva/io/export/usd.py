@@ -32,8 +32,18 @@ Written with Pixar's ``usd-core`` (``pxr``), following the UsdGeom schemas (open
   itself, not a cage to be smoothed), ``doubleSided`` (cloth has no inside), time-sampled
   ``points`` and ``extent``.
 
-Point-based ``points`` are float32 (``point3f[]``), so positions keep float32 precision. A
-future rigid body becomes one more part: an ``Xform`` with time-sampled translate and orient ops.
+* ``/World/bodies/NAME`` (``UsdGeom.Xform``), one per rigid body (its name made a valid,
+  unique prim name): the ops ``xformOp:translate`` (``double3``, the body's own origin [m])
+  and ``xformOp:orient`` (``quatd``, (w, x, y, z), body to world), time-sampled, in that
+  order, so a point ``v`` of the body is at ``translate + R(orient) v``; the quaternions' signs
+  keep each sample in the hemisphere of the one before, so interpolation turns the short way.
+  Its child ``surface`` (``UsdGeom.Mesh``) is static: the surface in the body's own axes, with
+  vertex ``normals``, ``extent``, ``orientation = rightHanded``, ``subdivisionScheme = none``
+  and a constant ``primvars:displayColor``. No vertex moves per frame: the animation is the
+  transform alone, which Blender imports as object keyframes and Houdini as a transform.
+
+Point-based ``points`` are float32 (``point3f[]``), so positions keep float32 precision; the
+bodies' transforms are float64 (double and ``quatd``), exactly as recorded.
 """
 
 from __future__ import annotations
@@ -45,6 +55,7 @@ from typing import Any
 import numpy as np
 
 from ..._version import __version__
+from ...simulation.body_geometry import BodyGeometry
 from ._files import all_or_nothing
 from ._frames import ExportFrames
 
@@ -177,6 +188,62 @@ def _add_mesh(stage: Any, frames: ExportFrames, faces: np.ndarray) -> Callable[[
     return _animate(prim, frames, None if used.size == frames.point_count else used, 0.0)
 
 
+def _prim_names(names: tuple[str, ...]) -> list[str]:
+    """``names`` as valid prim names (``Tf.MakeValidIdentifier``), made unique by a suffix."""
+    from pxr import Tf
+
+    chosen: list[str] = []
+    for name in names:
+        base = Tf.MakeValidIdentifier(name)
+        unique, n = base, 1
+        while unique in chosen:
+            unique, n = f"{base}_{n}", n + 1
+        chosen.append(unique)
+    return chosen
+
+
+def _add_bodies(stage: Any, frames: ExportFrames, bodies: BodyGeometry) -> Callable[[int], None]:
+    """One ``Xform`` per rigid body with a static ``surface`` mesh; a writer of the
+    transforms' time samples."""
+    from pxr import Gf, UsdGeom, Vt
+
+    UsdGeom.Xform.Define(stage, "/World/bodies")
+    ops = []
+    for b, name in enumerate(_prim_names(bodies.names)):
+        xform = UsdGeom.Xform.Define(stage, f"/World/bodies/{name}")
+        ops.append(
+            (
+                xform.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble),
+                xform.AddOrientOp(UsdGeom.XformOp.PrecisionDouble),
+            )
+        )
+        mesh = UsdGeom.Mesh.Define(stage, f"/World/bodies/{name}/surface")
+        vertices, triangles = bodies.surface(b)
+        first, last = bodies.vertex_start[b], bodies.vertex_start[b + 1]
+        counts = np.full(triangles.shape[0], 3, dtype=np.int32)
+        mesh.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(vertices.astype(np.float32)))
+        mesh.CreateExtentAttr(Vt.Vec3fArray.FromNumpy(_extent(vertices, 0.0)))
+        mesh.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(counts))
+        mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(triangles.ravel().astype(np.int32)))
+        normals = bodies.normals[first:last].astype(np.float32)
+        mesh.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(normals))
+        mesh.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
+        mesh.CreateOrientationAttr(UsdGeom.Tokens.rightHanded)
+        mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+        colour = mesh.CreateDisplayColorPrimvar(UsdGeom.Tokens.constant)
+        colour.Set(Vt.Vec3fArray([Gf.Vec3f(*bodies.color[b].tolist())]))
+
+    def write(k: int) -> None:
+        position, orientation = frames.body_transforms_at(k)
+        for (translate, orient), x, q in zip(
+            ops, position.tolist(), orientation.tolist(), strict=True
+        ):
+            translate.Set(Gf.Vec3d(*x), k)
+            orient.Set(Gf.Quatd(q[0], Gf.Vec3d(q[1], q[2], q[3])), k)
+
+    return write
+
+
 def write_usd(frames: ExportFrames, path: Path, *, encoding: str) -> list[Path]:
     """Write the resampled recording as a USD stage (see the module docstring), atomically.
 
@@ -215,6 +282,8 @@ def write_usd(frames: ExportFrames, path: Path, *, encoding: str) -> list[Path]:
         writers.append(_add_edges(stage, frames, frames.edges))
     if frames.faces is not None:
         writers.append(_add_mesh(stage, frames, frames.faces))
+    if frames.bodies is not None:
+        writers.append(_add_bodies(stage, frames, frames.bodies))
     for k in range(frames.count):
         for write in writers:
             write(k)

@@ -47,6 +47,16 @@ MAX_POSITION_BYTES = 64 * 2**20
 _EVEN_SPACING_RTOL = 1e-6
 #: Bytes per point per frame: three float32 coordinates.
 _BYTES_PER_POINT_FRAME = 12
+#: Bytes per rigid body per frame: a float32 position and quaternion.
+_BYTES_PER_BODY_FRAME = 28
+
+
+def _frame_bytes(geometry: Geometry) -> int:
+    """Bytes of float32 positions and transforms one frame holds (at least 1)."""
+    bodies = 0 if geometry.bodies is None else geometry.bodies.count
+    return max(
+        1, geometry.points.shape[1] * _BYTES_PER_POINT_FRAME + bodies * _BYTES_PER_BODY_FRAME
+    )
 
 
 def _recorded_rate(time: np.ndarray) -> float | None:
@@ -96,7 +106,7 @@ def default_fps(recording: Recording, speed: float = 1.0) -> float:
         fps = FALLBACK_FPS
     else:
         fps = rate / max(1, math.ceil(rate / MAX_DEFAULT_FPS * (1.0 - _EVEN_SPACING_RTOL)))
-    frame_bytes = max(1, geometry.points.shape[1]) * _BYTES_PER_POINT_FRAME
+    frame_bytes = _frame_bytes(geometry)
     budget_frames = MAX_POSITION_BYTES // frame_bytes
     span = float(time[-1] - time[0])
     if budget_frames < 1:
@@ -120,8 +130,7 @@ def _check_fps(recording: Recording, fps: float | None, speed: float) -> float:
     if fps is None:
         return default_fps(recording, speed)
     value = real_number("fps", fps, positive=True, unit=" frames/s")
-    points = recording.geometry().points.shape[1]
-    size = _frame_count(recording.time, value, speed) * max(1, points) * _BYTES_PER_POINT_FRAME
+    size = _frame_count(recording.time, value, speed) * _frame_bytes(recording.geometry())
     if size > MAX_POSITION_BYTES:
         raise ModelError(
             f"`fps` = {value:g} frames/s embeds {size / 2**20:.0f} MiB of positions, more than "
@@ -146,7 +155,8 @@ def _check_target(path: str | os.PathLike[str]) -> Path:
 
 
 def _check_finite(geometry: Geometry) -> None:
-    """Refuse frames with a non-finite live position (dead points are never drawn)."""
+    """Refuse frames with a non-finite live position or body transform (dead points are never
+    drawn)."""
     finite = np.isfinite(geometry.points).all(axis=2)
     if geometry.alive is not None:
         finite |= ~geometry.alive
@@ -156,6 +166,13 @@ def _check_finite(geometry: Geometry) -> None:
         raise ModelError(
             f"`points` of recorded frame {frame} are not finite; the viewer can only show "
             "finite positions (cut the recording before the blow-up)"
+        )
+    bad_body = None if geometry.bodies is None else geometry.bodies.nonfinite()
+    if bad_body is not None:
+        raise ModelError(
+            f"the transform of body {bad_body[1]} in recorded frame {bad_body[0]} is not "
+            "finite; the viewer can only show finite positions (cut the recording before the "
+            "blow-up)"
         )
 
 
@@ -187,14 +204,15 @@ def write_viewer(
 ) -> Path:
     """Write ``recording``'s animation as one self-contained HTML file.
 
-    The page plays the points (spheres of ``static["radius"]``), edges (lines) and faces
-    (a shaded surface) of :meth:`Recording.geometry` in real time (points that are born and
+    The page plays the points (spheres of ``static["radius"]``), edges (lines), faces
+    (a shaded surface) and rigid bodies (their surfaces, moved by their transforms) of
+    :meth:`Recording.geometry` in real time (points that are born and
     die only while alive, at each frame's radius and colour), with an orbit camera, a
     play/pause button (and the space bar), a frame slider, the time ``t`` [s] of the recorded
     frame shown, a speed selector and a legend. See ``docs/viewer.md``.
 
     Args:
-        recording: A recording with a ``points`` field.
+        recording: A recording with ``points`` or rigid bodies.
         path: File to write (conventionally ``.html``); its directory must exist. Written
             atomically: a partial file never appears under this name.
         fps: Playback rate [frames/s]; output frame ``k`` shows the recorded frame nearest

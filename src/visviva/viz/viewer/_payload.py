@@ -25,11 +25,18 @@ born), so they neither stretch the position grid nor cost differences; the page 
 them.
 
 Each kind of geometry is one *layer* with its own encoder here and its own builder in
-``viewer.js`` (``LAYERS``): ``points`` (moving spheres), ``edges`` (lines between points) and
-``faces`` (triangles between points). With faces, the points layer's ``spheres`` lists the
-points drawn as spheres (``uint32``): those on no face (:meth:`Geometry.off_faces`). A new
-kind (rigid bodies: a position and a quaternion per body per frame) is a new encoder and a new
-builder, with nothing else changed.
+``viewer.js`` (``LAYERS``): ``points`` (moving spheres; absent when the recording has rigid
+bodies alone), ``edges`` (lines between points), ``faces`` (triangles between points) and
+``bodies``. With faces, the points layer's ``spheres`` lists the points drawn as spheres
+(``uint32``): those on no face (:meth:`Geometry.off_faces`).
+
+The ``bodies`` layer holds each rigid body's surface once, in its own axes (``vertices``
+float32 ``(V, 3)`` [m], ``triangles`` uint32 ``(T, 3)`` numbered among each body's own
+vertices, ``vertex_start`` and ``triangle_start`` uint32 ``(B + 1,)``, 8-bit sRGB ``colors``,
+``names``) and its transform at every shown frame: ``positions`` float32 ``(frames, B, 3)``
+[m], the body's own origin, and ``orientations`` float32 ``(frames, B, 4)``, unit quaternions
+(w, x, y, z). The page moves each body's mesh by its object transform: 28 bytes per body per
+frame, however fine its surface.
 """
 
 from __future__ import annotations
@@ -41,7 +48,9 @@ from typing import Any
 
 import numpy as np
 
+from ...simulation.body_geometry import BodyGeometry
 from ...simulation.recording import Geometry
+from ..frame import drawn_bounds
 from ..lifetimes import Appearance, held_frames, held_points, life_starts
 from ..timescale import time_unit
 
@@ -55,7 +64,7 @@ __all__ = [
 ]
 
 PAYLOAD_FORMAT = "visviva.viewer"
-PAYLOAD_VERSION = 3
+PAYLOAD_VERSION = 4
 #: Quantization levels of a position coordinate, and of a radius that changes: 16 bits.
 POSITION_LEVELS = 65535
 
@@ -180,6 +189,23 @@ def quantized_positions(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, str
     return origin, step, _difference_planes(levels)
 
 
+def _bodies_layer(bodies: BodyGeometry, shown: np.ndarray) -> dict[str, Any]:
+    """The rigid bodies' surfaces and their transforms at the shown frames (module docstring)."""
+    owner = np.repeat(np.arange(bodies.count), np.diff(bodies.triangle_start))
+    local = bodies.triangles - bodies.vertex_start[owner][:, None]
+    return {
+        "count": bodies.count,
+        "names": list(bodies.names),
+        "vertices": _base64(bodies.vertices, "<f4"),
+        "triangles": _base64(local, "<u4"),
+        "vertex_start": _base64(bodies.vertex_start, "<u4"),
+        "triangle_start": _base64(bodies.triangle_start, "<u4"),
+        "colors": _base64(np.round(255 * bodies.color), "u1"),
+        "positions": _base64(bodies.position[shown], "<f4"),
+        "orientations": _base64(bodies.orientation[shown], "<f4"),
+    }
+
+
 def _index_layer(indices: np.ndarray) -> dict[str, Any]:
     return {"count": int(indices.shape[0]), "indices": _base64(indices, "<u4")}
 
@@ -193,14 +219,17 @@ def _legend(attrs: dict[str, Any], geometry: Geometry, fps: float) -> list[list[
         ):
             text = f"{value:.6g}" if isinstance(value, (float, np.floating)) else str(value)
             rows.append([label, text + unit])
-    parts = [f"{geometry.points.shape[1]} points"]
-    if geometry.alive is not None:
+    parts = [f"{geometry.points.shape[1]} points"] if geometry.points.shape[1] else []
+    if geometry.alive is not None and parts:
         most = int(geometry.alive.sum(axis=1).max(initial=0))
         parts[0] = f"up to {most} of {parts[0]} at once"
     for name in ("edges", "faces"):
         value = getattr(geometry, name)
         if value is not None:
             parts.append(f"{value.shape[0]} {name}")
+    if geometry.bodies is not None:
+        count = geometry.bodies.count
+        parts.append(f"{count} rigid bod{'y' if count == 1 else 'ies'}")
     rows.append(["shows", ", ".join(parts)])
     rows.append(["playback", f"{fps:.6g} frames/s"])
     if not geometry.to_scale:
@@ -232,14 +261,18 @@ def encode_payload(
     Returns:
         A JSON-serialisable dict (see the module docstring).
     """
-    # The live points as drawn: the page's camera, grid and light are placed from this box.
-    low, high = Appearance.of(geometry).live_bounds(geometry.points)
-    layers: dict[str, Any] = {"points": _points_layer(geometry, shown, trail_frames)}
+    # Everything as drawn: the page's camera, grid and light are placed from this box.
+    low, high = drawn_bounds(geometry)
+    layers: dict[str, Any] = {}
+    if geometry.points.shape[1]:
+        layers["points"] = _points_layer(geometry, shown, trail_frames)
     unit, seconds, decimals = time_unit(float(time[-1] - time[0]))
     if geometry.edges is not None and geometry.edges.shape[0]:
         layers["edges"] = _index_layer(geometry.edges)
     if geometry.faces is not None and geometry.faces.shape[0]:
         layers["faces"] = _index_layer(geometry.faces)
+    if geometry.bodies is not None:
+        layers["bodies"] = _bodies_layer(geometry.bodies, shown)
     return {
         "format": PAYLOAD_FORMAT,
         "version": PAYLOAD_VERSION,

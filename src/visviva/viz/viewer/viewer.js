@@ -5,8 +5,9 @@
  * elapsed wall-clock time (k = floor(elapsed * fps * speed)), never by counting redraws, so it
  * runs in real time however fast the machine draws. Y is up, lengths in metres.
  *
- * Each kind of geometry is one entry of LAYERS (points, edges, faces): a builder that adds
- * its objects to the scene and returns an update() called after every frame change.
+ * Each kind of geometry is one entry of LAYERS (points, edges, faces, bodies): a builder that
+ * adds its objects to the scene and returns an update() called after every frame change. A
+ * recording of rigid bodies alone has no points layer.
  *
  * Points that are born and die come with per-frame alive bits (and, with a trail, birth bits),
  * radii and colours when the recording has them: a frame draws only its live points, at that
@@ -125,10 +126,11 @@
   const frames = data.frames;
   const fps = data.fps;
   const times = decode(data.times, Float64Array);
-  const pointData = data.layers.points;
+  const pointData = data.layers.points || { count: 0 }; // none with rigid bodies alone
   const pointCount = pointData.count;
   const stride = pointCount * 3;
-  const allPositions = await decodePositions(pointData, frames, stride); // (frames, P, 3) [m]
+  const allPositions = pointCount ? await decodePositions(pointData, frames, stride)
+    : new Float32Array(0); // (frames, P, 3) [m]
   // Present only for points that are born and die, or whose radii or colours change.
   const alive = pointData.alive ? await decodeBits(pointData.alive, frames, pointCount, true)
     : null; // (frames, P) 0/1
@@ -324,9 +326,48 @@
       scene.add(mesh);
       return function update() { geometry.computeVertexNormals(); };
     },
+    /* Rigid bodies: one mesh per body, its surface in its own axes (normals computed once),
+     * moved every frame by its object transform, a position and a quaternion: no vertex of a
+     * rigid body changes in its own axes, so none is sent or touched per frame. */
+    bodies(layer) {
+      const count = layer.count;
+      const vertices = decode(layer.vertices, Float32Array);
+      const triangles = decode(layer.triangles, Uint32Array);
+      const vertexStart = decode(layer.vertex_start, Uint32Array);
+      const triangleStart = decode(layer.triangle_start, Uint32Array);
+      const rgb = decode(layer.colors, Uint8Array);
+      const positions = decode(layer.positions, Float32Array); // (frames, B, 3) [m]
+      const orientations = decode(layer.orientations, Float32Array); // (frames, B, 4) w, x, y, z
+      if (positions.length !== 3 * frames * count || orientations.length !== 4 * frames * count) {
+        throw new Error("corrupt body data");
+      }
+      for (let b = 0; b < count; b++) {
+        const geometry = new THREE.BufferGeometry();
+        geometry.setAttribute("position", new THREE.BufferAttribute(
+          vertices.slice(3 * vertexStart[b], 3 * vertexStart[b + 1]), 3));
+        geometry.setIndex(new THREE.BufferAttribute(
+          triangles.slice(3 * triangleStart[b], 3 * triangleStart[b + 1]), 1));
+        geometry.computeVertexNormals();
+        const material = new THREE.MeshLambertMaterial({ color: srgb(rgb, b) });
+        const mesh = new THREE.Mesh(geometry, material);
+        mesh.name = layer.names[b];
+        scene.add(mesh);
+        bodyMeshes.push(mesh);
+      }
+      return function update() {
+        for (let b = 0; b < count; b++) {
+          const i = frame * count + b;
+          bodyMeshes[b].position.fromArray(positions, 3 * i);
+          // three.js orders a quaternion (x, y, z, w); the recording (w, x, y, z).
+          bodyMeshes[b].quaternion.set(orientations[4 * i + 1], orientations[4 * i + 2],
+            orientations[4 * i + 3], orientations[4 * i]);
+        }
+      };
+    },
   };
 
   let pointMesh = null; // the points layer's instanced mesh, read back by visviva.drawn()
+  const bodyMeshes = []; // the bodies layer's meshes, read back by visviva.bodies()
   const updates = [];
   for (const [name, layer] of Object.entries(data.layers)) {
     if (!(name in LAYERS)) throw new Error("this viewer cannot draw layer " + name);
@@ -516,6 +557,7 @@
     /* The spheres drawn in the frame shown: centres [m], radii [m] and 8-bit sRGB colours
      * (null for the default colour), read back from the instanced mesh. */
     drawn: () => {
+      if (!pointMesh) return { count: 0, centres: [], radii: [], colours: null };
       const m = pointMesh.instanceMatrix.array;
       const c = pointMesh.instanceColor;
       const out = { count: pointMesh.count, centres: [], radii: [], colours: c ? [] : null };
@@ -529,6 +571,13 @@
       }
       return out;
     },
+    /* The rigid bodies as drawn in the frame shown: each mesh's name, position [m] and
+     * orientation (w, x, y, z), read back from its object transform. */
+    bodies: () => bodyMeshes.map((mesh) => ({
+      name: mesh.name,
+      position: mesh.position.toArray(),
+      orientation: [mesh.quaternion.w, mesh.quaternion.x, mesh.quaternion.y, mesh.quaternion.z],
+    })),
     ready: false,
     readyTime: null, // performance.now() [ms since navigation start] at the first draw
   };
