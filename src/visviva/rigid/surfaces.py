@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["body_surface"]
+__all__ = ["body_surface", "unit_sphere"]
 
 #: Segments around the axis of a round shape, and along a quarter circle of its profile.
 AROUND = 32
@@ -36,7 +36,7 @@ def body_surface(shape: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
         return _box(np.asarray(shape["size"], dtype=np.float64))
     arc = np.linspace(-0.5 * np.pi, 0.5 * np.pi, 2 * QUARTER + 1)
     if kind in ("sphere", "ellipsoid"):
-        vertices, triangles = _revolved(np.cos(arc), np.sin(arc))
+        vertices, triangles = unit_sphere()
         scale = np.full(3, shape["radius"]) if kind == "sphere" else np.asarray(shape["size"])
         return vertices * scale, triangles
     r, h = float(shape["radius"]), float(shape["height"])
@@ -53,6 +53,15 @@ def body_surface(shape: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
         heights[QUARTER + 1 :] += h / 2
         return _revolved(radii, heights)
     raise ValueError(f"no surface for shape {kind!r}")
+
+
+def unit_sphere(around: int = AROUND, quarter: int = QUARTER) -> tuple[np.ndarray, np.ndarray]:
+    """A sphere of radius 1 m: ``around`` segments about y, ``quarter`` along each quarter
+    circle from the equator to a pole. Pushing its vertices along their directions by any
+    positive amount keeps it closed and free of crossings (a star-shaped surface: each
+    triangle stays inside the cone of its three directions)."""
+    arc = np.linspace(-0.5 * np.pi, 0.5 * np.pi, 2 * quarter + 1)
+    return _revolved(np.cos(arc), np.sin(arc), around)
 
 
 def _box(size: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -72,10 +81,12 @@ def _box(size: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * np.array(vertices) * size, np.array(triangles, dtype=np.int64)
 
 
-def _revolved(radii: np.ndarray, heights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _revolved(
+    radii: np.ndarray, heights: np.ndarray, around: int = AROUND
+) -> tuple[np.ndarray, np.ndarray]:
     """The surface of revolution about +y of the profile ``(radii, heights)``, bottom to top;
     a point on the axis (r = 0) is one vertex, where the neighbouring ring closes as a fan."""
-    angle = np.linspace(0.0, 2.0 * np.pi, AROUND, endpoint=False)
+    angle = np.linspace(0.0, 2.0 * np.pi, around, endpoint=False)
     rows: list[np.ndarray] = []  # each profile point's vertex indices
     vertices: list[np.ndarray] = []
     count = 0
@@ -87,21 +98,21 @@ def _revolved(radii: np.ndarray, heights: np.ndarray) -> tuple[np.ndarray, np.nd
             rows.append(np.array([count]))
             count += 1
         else:
-            ring = np.stack([r * np.cos(angle), np.full(AROUND, y), -r * np.sin(angle)], axis=1)
+            ring = np.stack([r * np.cos(angle), np.full(around, y), -r * np.sin(angle)], axis=1)
             vertices.append(ring)
-            rows.append(np.arange(count, count + AROUND))
-            count += AROUND
+            rows.append(np.arange(count, count + around))
+            count += around
     triangles = []
     points = list(zip(radii, heights, strict=True))
     for i, (below, above) in enumerate(pairwise(rows)):
         if points[i] == points[i + 1] or (below.shape[0] == 1 and above.shape[0] == 1):
             continue  # a corner given twice: the faces on either side share no vertex
         if below.shape[0] == 1:  # a fan up from a pole
-            triangles += [[below[0], above[(k + 1) % AROUND], above[k]] for k in range(AROUND)]
+            triangles += [[below[0], above[(k + 1) % around], above[k]] for k in range(around)]
         elif above.shape[0] == 1:  # a fan closing at a pole
-            triangles += [[below[k], below[(k + 1) % AROUND], above[0]] for k in range(AROUND)]
+            triangles += [[below[k], below[(k + 1) % around], above[0]] for k in range(around)]
         else:
-            for k in range(AROUND):
-                n = (k + 1) % AROUND
+            for k in range(around):
+                n = (k + 1) % around
                 triangles += [[below[k], above[n], above[k]], [below[k], below[n], above[n]]]
     return np.concatenate(vertices), np.array(triangles, dtype=np.int64)
