@@ -144,3 +144,29 @@ def test_kepler_demo_glb_is_small_and_right_in_blender(tmp_path):
             np.testing.assert_allclose(
                 y_up(view["frames"][str(k)][key]), expected[k], rtol=0, atol=tolerance
             )
+
+
+def test_rigid_bodies_in_usd_and_gltf(tmp_path):
+    """Each body is one object named after it, placed by its transform: USD's time-sampled
+    translate and orient (read through a Transform Cache constraint), glTF's node channels."""
+    from test_rigid_outputs import NAMES, placed, scene, surfaces
+
+    recording = vv.Simulation(scene().build()).record(until=0.5)
+    shown = frames_at_rate(recording.time, FPS)
+    frames = [0, shown.size // 2, shown.size - 1]
+    (usd,) = export_recording(recording, tmp_path / "bodies.usdc", fps=FPS)
+    (glb,) = export_recording(recording, tmp_path / "bodies.glb", fps=FPS)
+    origin, orientation = recording["body_position"][shown], recording["body_orientation"][shown]
+    tolerance = 2e-6 * max(1.0, float(np.abs(origin).max()))  # float32 vertices and transforms
+    for view in (blender_view(usd, frames), blender_view(glb, frames)):
+        for k in frames:
+            objects = view["frames"][str(k)]
+            for b, (name, (vertices, _)) in enumerate(zip(NAMES, surfaces(), strict=True)):
+                expected = placed(origin[k, b], orientation[k, b], vertices)
+                actual = y_up(objects[name])
+                # A box's corners are three vertices each (flat faces), so match both ways
+                # rather than one to one.
+                assert actual.shape == expected.shape
+                distance = np.linalg.norm(actual[:, None, :] - expected[None, :, :], axis=-1)
+                assert distance.min(axis=0).max() <= tolerance
+                assert distance.min(axis=1).max() <= tolerance

@@ -241,7 +241,7 @@ def test_usd_has_an_xform_per_body_with_the_recorded_transforms_and_a_static_sur
             if previous is not None:  # interpolation turns the short way
                 assert written @ previous >= 0.0
             previous = written
-        mesh = UsdGeom.Mesh(stage.GetPrimAtPath(f"/World/bodies/{name}/surface"))
+        mesh = UsdGeom.Mesh(stage.GetPrimAtPath(f"/World/bodies/{name}/{name}"))
         points = np.array(mesh.GetPointsAttr().Get(), dtype=np.float64)
         assert points.shape == vertices.shape
         assert list(mesh.GetFaceVertexIndicesAttr().Get()) == triangles.ravel().tolist()

@@ -37,10 +37,11 @@ Written with Pixar's ``usd-core`` (``pxr``), following the UsdGeom schemas (open
   and ``xformOp:orient`` (``quatd``, (w, x, y, z), body to world), time-sampled, in that
   order, so a point ``v`` of the body is at ``translate + R(orient) v``; the quaternions' signs
   keep each sample in the hemisphere of the one before, so interpolation turns the short way.
-  Its child ``surface`` (``UsdGeom.Mesh``) is static: the surface in the body's own axes, with
+  Its child ``NAME`` (``UsdGeom.Mesh``) is static: the surface in the body's own axes, with
   vertex ``normals``, ``extent``, ``orientation = rightHanded``, ``subdivisionScheme = none``
   and a constant ``primvars:displayColor``. No vertex moves per frame: the animation is the
-  transform alone, which Blender imports as object keyframes and Houdini as a transform.
+  transform alone: Blender imports each body as one object named ``NAME`` whose Transform
+  Cache constraint reads the ops from the file.
 
 Point-based ``points`` are float32 (``point3f[]``), so positions keep float32 precision; the
 bodies' transforms are float64 (double and ``quatd``), exactly as recorded.
@@ -203,7 +204,7 @@ def _prim_names(names: tuple[str, ...]) -> list[str]:
 
 
 def _add_bodies(stage: Any, frames: ExportFrames, bodies: BodyGeometry) -> Callable[[int], None]:
-    """One ``Xform`` per rigid body with a static ``surface`` mesh; a writer of the
+    """One ``Xform`` per rigid body with a static mesh of its surface; a writer of the
     transforms' time samples."""
     from pxr import Gf, UsdGeom, Vt
 
@@ -217,7 +218,9 @@ def _add_bodies(stage: Any, frames: ExportFrames, bodies: BodyGeometry) -> Calla
                 xform.AddOrientOp(UsdGeom.XformOp.PrecisionDouble),
             )
         )
-        mesh = UsdGeom.Mesh.Define(stage, f"/World/bodies/{name}/surface")
+        # The mesh takes the body's name too: Blender merges an Xform with its one child mesh
+        # into one object named after the child ("surface.001" ... helps no one).
+        mesh = UsdGeom.Mesh.Define(stage, f"/World/bodies/{name}/{name}")
         vertices, triangles = bodies.surface(b)
         first, last = bodies.vertex_start[b], bodies.vertex_start[b + 1]
         counts = np.full(triangles.shape[0], 3, dtype=np.int32)
