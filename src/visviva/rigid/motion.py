@@ -142,37 +142,115 @@ def _rates(q, v, inverse_mass, inverse_inertia, axes, out):  # pragma: no cover 
         out[k], out[k + 1], out[k + 2], out[k + 3] = 0.5 * dw, 0.5 * dx, 0.5 * dy, 0.5 * dz
 
 
+#: Largest ``|½θ|`` the series of :func:`_half_angle` takes: its first omitted terms,
+#: ``0.4¹⁶/16!`` and ``0.4¹⁷/17!``, are below 1e-19. A larger turn in one step (over 0.8 rad
+#: about one axis) takes the library's ``sin`` and ``cos`` in a second pass.
+SERIES_LIMIT = 0.4
+
+
 @njit(cache=True, inline="always")
-def _turn(w, x, y, z, px, py, pz, axis, angle):  # pragma: no cover - compiled
-    """One exact sub-flow of the splitting: the body turns by ``angle`` about its principal
-    ``axis``: ``q ← q ⊗ (cos ½θ, sin ½θ e)``, and ``Π`` turns by ``−θ`` about ``e`` (``L``
-    stays)."""
-    c, s = np.cos(0.5 * angle), np.sin(0.5 * angle)
-    ex, ey, ez = (
-        (1.0, 0.0, 0.0) if axis == 0 else ((0.0, 1.0, 0.0) if axis == 1 else (0.0, 0.0, 1.0))
-    )
-    w, x, y, z = multiply(w, x, y, z, c, s * ex, s * ey, s * ez)
-    px, py, pz = rotate(c, -s * ex, -s * ey, -s * ez, px, py, pz)
-    return w, x, y, z, px, py, pz
+def _half_angle(angle):  # pragma: no cover - compiled
+    """``(cos ½θ, sin ½θ)`` by Taylor series to round-off, and whether ``|½θ|`` is past
+    :data:`SERIES_LIMIT` (no call and no branch, so the bodies' loop can be vectorized)."""
+    x = 0.5 * angle
+    u = x * x
+    # Horner, nested from the highest terms: cos to x¹⁴/14!, sin to x¹⁵/15!, multiplying by
+    # the reciprocals of k (k − 1) (divisions would take most of the step's time).
+    c = 1.0 - u * 0.005494505494505495
+    c = 1.0 - u * 0.007575757575757576 * c
+    c = 1.0 - u * 0.011111111111111112 * c
+    c = 1.0 - u * 0.017857142857142856 * c
+    c = 1.0 - u * 0.03333333333333333 * c
+    c = 1.0 - u * 0.08333333333333333 * c
+    c = 1.0 - u * 0.5 * c
+    s = 1.0 - u * 0.004761904761904762
+    s = 1.0 - u * 0.00641025641025641 * s
+    s = 1.0 - u * 0.00909090909090909 * s
+    s = 1.0 - u * 0.013888888888888888 * s
+    s = 1.0 - u * 0.023809523809523808 * s
+    s = 1.0 - u * 0.05 * s
+    s = 1.0 - u * 0.16666666666666666 * s
+    return c, x * s, abs(x) > SERIES_LIMIT
 
 
-@njit(cache=True, parallel=True)
-def _drift(q, v, h, inverse_mass, inverse_inertia, axes, out):  # pragma: no cover - compiled
+@njit(cache=True, inline="always")
+def _library_half_angle(angle):  # pragma: no cover - compiled
+    """``(cos ½θ, sin ½θ, False)`` by the library (the second pass of :func:`_drift`)."""
+    return np.cos(0.5 * angle), np.sin(0.5 * angle), False
+
+
+@njit(cache=True, inline="always")
+def _turn(w, x, y, z, px, py, pz, axis, angle, half_angle):  # pragma: no cover - compiled
+    """One exact sub-flow of the splitting: the body turns by ``θ = angle`` about its
+    principal ``axis`` (0, 1, 2; a constant at each call, so the branches fold away):
+    ``q ← q ⊗ (cos ½θ, sin ½θ e)``, and ``Π`` turns by ``−θ`` about ``e`` (``L`` stays).
+    Written out per axis: the generic product would multiply by the zeros of ``e``. Also
+    returns whether the angle was too large for ``half_angle`` (:func:`_half_angle` or
+    :func:`_library_half_angle`, a compiled function resolved when compiling)."""
+    c, s, wide = half_angle(angle)
+    cos, sin = c * c - s * s, 2.0 * s * c  # of θ itself
+    if axis == 0:
+        q = (w * c - x * s, x * c + w * s, y * c + z * s, z * c - y * s)
+        return (*q, px, py * cos + pz * sin, pz * cos - py * sin, wide)
+    if axis == 1:
+        q = (w * c - y * s, x * c - z * s, y * c + w * s, z * c + x * s)
+        return (*q, px * cos - pz * sin, py, pz * cos + px * sin, wide)
+    q = (w * c - z * s, x * c + y * s, y * c - x * s, z * c + w * s)
+    return (*q, px * cos + py * sin, py * cos - px * sin, pz, wide)
+
+
+def _drift(q, v, h, inverse_mass, inverse_inertia, axes, out):
+    """The bodies' drift into ``out``: every body with the series, then again with the
+    library's ``sin`` and ``cos`` those that turned too far for it (none, in a sane step)."""
+    wide = np.empty(inverse_mass.shape[0], dtype=np.bool_)
+    if _drift_bodies(q, v, h, inverse_mass, inverse_inertia, axes, out, wide):
+        _drift_wide(q, v, h, inverse_mass, inverse_inertia, axes, out, np.flatnonzero(wide))
+
+
+# fmt: off
+@njit(cache=True, inline="always", error_model="numpy")
+def _drift_one(
+    q, v, h, inverse_mass, inverse_inertia, axes, out, b, count, half_angle,
+):  # pragma: no cover - compiled
+    """Body ``b``'s drift into ``out`` (see the module docstring); whether a turn was too
+    large for ``half_angle``."""
+    m, k = 3 * count + 3 * b, 3 * count + 4 * b
+    for a in range(3):
+        out[3 * b + a] = q[3 * b + a] + h * v[3 * b + a] * inverse_mass[b]
+    w, x, y, z = _principal(q, b, count, axes)
+    px, py, pz = rotate_back(w, x, y, z, v[m], v[m + 1], v[m + 2])
+    i1, i2, i3 = inverse_inertia[b, 0], inverse_inertia[b, 1], inverse_inertia[b, 2]
+    # T₁(h/2) T₂(h/2) T₃(h) T₂(h/2) T₁(h/2); each angle from the Π of its moment.
+    w, x, y, z, px, py, pz, w1 = _turn(w, x, y, z, px, py, pz, 0, 0.5 * h * px * i1, half_angle)
+    w, x, y, z, px, py, pz, w2 = _turn(w, x, y, z, px, py, pz, 1, 0.5 * h * py * i2, half_angle)
+    w, x, y, z, px, py, pz, w3 = _turn(w, x, y, z, px, py, pz, 2, h * pz * i3, half_angle)
+    w, x, y, z, px, py, pz, w4 = _turn(w, x, y, z, px, py, pz, 1, 0.5 * h * py * i2, half_angle)
+    w, x, y, z, px, py, pz, w5 = _turn(w, x, y, z, px, py, pz, 0, 0.5 * h * px * i1, half_angle)
+    # Back to the body's own axes: q = (q ⊗ r) ⊗ r⁻¹.
+    w, x, y, z = multiply(w, x, y, z, axes[b, 0], -axes[b, 1], -axes[b, 2], -axes[b, 3])
+    out[k], out[k + 1], out[k + 2], out[k + 3] = normalized(w, x, y, z)
+    return w1 | w2 | w3 | w4 | w5
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def _drift_bodies(q, v, h, inverse_mass, inverse_inertia, axes, out, wide):  # pragma: no cover
     count = inverse_mass.shape[0]
+    too_far = 0
     for b in prange(count):
-        for a in range(3):
-            out[3 * b + a] = q[3 * b + a] + h * v[3 * b + a] * inverse_mass[b]
-        k, m = 3 * count + 4 * b, 3 * count + 3 * b
-        w, x, y, z = _principal(q, b, count, axes)
-        px, py, pz = rotate_back(w, x, y, z, v[m], v[m + 1], v[m + 2])
-        # T₁(h/2) T₂(h/2) T₃(h) T₂(h/2) T₁(h/2); each angle from the Π of its moment.
-        for axis, fraction in ((0, 0.5), (1, 0.5), (2, 1.0), (1, 0.5), (0, 0.5)):
-            held = px if axis == 0 else (py if axis == 1 else pz)
-            angle = fraction * h * held * inverse_inertia[b, axis]
-            w, x, y, z, px, py, pz = _turn(w, x, y, z, px, py, pz, axis, angle)
-        # Back to the body's own axes: q = (q ⊗ r) ⊗ r⁻¹.
-        w, x, y, z = multiply(w, x, y, z, axes[b, 0], -axes[b, 1], -axes[b, 2], -axes[b, 3])
-        out[k], out[k + 1], out[k + 2], out[k + 3] = normalized(w, x, y, z)
+        flag = _drift_one(q, v, h, inverse_mass, inverse_inertia, axes, out, b, count, _half_angle)
+        wide[b] = flag
+        too_far += flag
+    return too_far > 0
+
+
+@njit(cache=True, error_model="numpy")
+def _drift_wide(q, v, h, inverse_mass, inverse_inertia, axes, out, which):  # pragma: no cover
+    count = inverse_mass.shape[0]
+    for b in which:
+        _drift_one(
+            q, v, h, inverse_mass, inverse_inertia, axes, out, b, count, _library_half_angle,
+        )
+# fmt: on
 
 
 @njit(cache=True)
