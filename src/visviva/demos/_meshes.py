@@ -3,6 +3,7 @@
 * :func:`t_handle`: Dzhanibekov's wing nut as a T-shaped prism — a T in the x–y plane (a stem
   and a bar across its top) extruded along z. Three different principal moments, one of them
   in the middle: the shape that flips.
+* :func:`bunny`: a rabbit-like lump (a sphere pushed out along its directions), for throwing.
 * :func:`prism`: any simple polygon (counter-clockwise, triangulated by the caller) extruded
   into a closed, outward mesh.
 """
@@ -11,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["prism", "t_handle"]
+__all__ = ["bunny", "prism", "t_handle"]
 
 
 def prism(
@@ -51,3 +52,27 @@ def t_handle(
     # The stem's two triangles, then the bar's four, all on the outline's own corners.
     cover = np.array([[0, 1, 2], [0, 2, 7], [2, 3, 4], [2, 4, 7], [7, 4, 5], [7, 5, 6]])
     return prism(outline, cover, thickness)
+
+
+def bunny(size: float = 0.2) -> tuple[np.ndarray, np.ndarray]:
+    """A rabbit-like lump about ``size`` [m] long, nose along +x, ears up: a sphere whose
+    every vertex is pushed along its direction to ``r(d)`` — an ellipsoidal body, a head, two
+    long ears and a tail as bumps of ``r`` (a star-shaped surface, so closed and free of
+    crossings whatever the bumps; :func:`visviva.rigid.surfaces.unit_sphere`). Generated, not
+    scanned: nothing downloads."""
+    from ..rigid.surfaces import unit_sphere
+
+    directions, triangles = unit_sphere(around=96, quarter=24)
+    x, y, z = directions.T
+    body = 1.0 / np.sqrt((x / 0.5) ** 2 + (y / 0.36) ** 2 + (z / 0.32) ** 2)
+    radius = body.copy()
+    for toward, height, width in (
+        ((1.0, 0.55, 0.0), 0.22, 0.45),  # head
+        ((0.45, 1.0, 0.28), 0.55, 0.11),  # ears
+        ((0.45, 1.0, -0.28), 0.55, 0.11),
+        ((-1.0, 0.25, 0.0), 0.1, 0.3),  # tail
+    ):
+        axis = np.asarray(toward) / np.linalg.norm(toward)
+        angle = np.arccos(np.clip(directions @ axis, -1.0, 1.0))
+        radius += height * np.exp(-((angle / width) ** 2))
+    return directions * (size * radius)[:, None], triangles
