@@ -5,9 +5,11 @@ checks everything first: the format, the target path, the recording's geometry a
 rate; then one writer module writes the files, each atomically (see ``_files.py``):
 
 ==========  ============================================================================
-``usd``     :mod:`.usd`: time-sampled ``Points`` / ``BasisCurves`` / ``Mesh`` under ``/World``
-``glb``     :mod:`.gltf`: a mesh with one morph target per frame and a STEP weight animation
-``obj``     :mod:`.obj`: one Wavefront OBJ file per frame
+``usd``     :mod:`.usd`: time-sampled ``Points`` / ``BasisCurves`` / ``Mesh`` under ``/World``,
+            an ``Xform`` with time-sampled translate and orient per rigid body
+``glb``     :mod:`.gltf`: a mesh with one morph target per frame and a STEP weight animation,
+            or sphere nodes; a node per rigid body with translation and rotation channels
+``obj``     :mod:`.obj`: one Wavefront OBJ file per frame (rigid bodies placed, a group each)
 ``pc2``     :mod:`.pc2`: a point cache for Blender's Mesh Cache modifier and 3ds Max
 ==========  ============================================================================
 
@@ -17,6 +19,8 @@ metres, Y up, as recorded; ``docs/export.md`` shows how to import each file. Par
 born and die (a recording's ``alive``) never appear as points while dead: USD and OBJ write only
 the live points of each frame, glTF hides dead ones (a sphere scaled to 0, or a vertex moved
 onto a live point), PC2 holds them where they were last alive (see each writer's module).
+Rigid bodies (:mod:`visviva.simulation.body_geometry`) are a surface each and a transform per
+frame: USD and glTF write the transforms and a static mesh, OBJ and PC2 the placed vertices.
 """
 
 from __future__ import annotations
@@ -39,10 +43,10 @@ __all__ = [
 
 #: Export format → one-line description (for ``visviva export --help``).
 EXPORT_FORMATS: dict[str, str] = {
-    "usd": "USD stage (.usd/.usdc binary, .usda text): time-sampled points, curves, mesh",
+    "usd": "USD stage (.usd/.usdc binary, .usda text): time-sampled points, curves, mesh, bodies",
     "usda": "USD stage as text (.usda, or .usd)",
     "usdc": "USD stage as binary crate (.usdc, or .usd)",
-    "glb": "glTF 2.0 binary (.glb): one morph target per frame, STEP weight animation",
+    "glb": "glTF 2.0 binary (.glb): morph targets or sphere nodes; body nodes' transforms",
     "gltf": "glTF 2.0 (.gltf JSON with a .bin beside it, or .glb binary)",
     "obj": "Wavefront OBJ sequence, one file per frame (NAME_0000.obj... or DIR/frame_0000.obj)",
     "pc2": "PC2 point cache (.pc2) for Blender's Mesh Cache modifier and 3ds Max",
@@ -147,7 +151,7 @@ def export_recording(
 
     Args:
         recording: A recording with a ``points`` field (and optionally ``radius``, ``edges``,
-            ``faces``; see :meth:`visviva.Recording.geometry`).
+            ``faces``), rigid bodies, or both (see :meth:`visviva.Recording.geometry`).
         path: Target file. Its suffix chooses the format when ``to`` is not given and must
             fit it when it is (:data:`EXPORT_FORMATS`). For ``obj``, a path ending in ``.obj``
             gets ``STEM_0000.obj`` … next to it; any other path is a directory (created if
@@ -168,8 +172,8 @@ def export_recording(
 
     Raises:
         ModelError: Before anything is written, for an unknown format, a suffix that does not
-            fit it, a missing directory, a recording without points, an invalid ``fps``, a
-            non-finite position, or a glTF buffer over
+            fit it, a missing directory, a recording without points or bodies, an invalid
+            ``fps``, a non-finite position or body transform, or a glTF buffer over
             :data:`visviva.io.export.gltf.MAX_GLTF_BYTES`.
 
     Example:
