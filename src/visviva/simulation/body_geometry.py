@@ -44,8 +44,9 @@ __all__ = ["BODY_FIELDS", "BodyGeometry", "continuous_orientations"]
 #: The recording's per-frame body fields and the static arrays every body recording has.
 BODY_FIELDS = ("body_position", "body_orientation")
 _BODY_STATIC = ("body_vertices", "body_triangles", "body_vertex_start", "body_triangle_start")
-#: Frames transformed at once when bounding every frame (about 12·V·_CHUNK bytes of work).
-_CHUNK = 64
+#: Vertices transformed at once when bounding every frame: their gathered rotation matrices
+#: take 72 bytes each (19 MB), whatever the number of bodies.
+_VERTICES_AT_ONCE = 2**18
 #: The colour drawn for a body the recording gives none (the scene entity's default too), sRGB.
 DEFAULT_BODY_COLOR = (0.8, 0.8, 0.8)
 
@@ -123,10 +124,12 @@ class BodyGeometry:
         low, high = np.full(3, np.inf), np.full(3, -np.inf)
         if self.vertices.shape[0] == 0:
             return np.zeros(3), np.zeros(3)
-        for first in range(0, self.position.shape[0], _CHUNK):
-            rotation = quaternion_matrix(self.orientation[first : first + _CHUNK])
+        chunk = max(1, _VERTICES_AT_ONCE // self.vertices.shape[0])  # frames at once
+        for first in range(0, self.position.shape[0], chunk):
+            rows = slice(first, first + chunk)
+            rotation = quaternion_matrix(self.orientation[rows])
             turned = np.einsum("fvij,vj->fvi", rotation[:, self.owner], self.vertices)
-            world = turned + self.position[first : first + _CHUNK][:, self.owner]
+            world = turned + self.position[rows][:, self.owner]
             low = np.minimum(low, world.min(axis=(0, 1)))
             high = np.maximum(high, world.max(axis=(0, 1)))
         return low, high
