@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from visviva.demos import run_demo
 
@@ -74,3 +75,19 @@ def test_bunny_throw_flies_the_parabola_exactly_and_keeps_l(tmp_path):
     assert abs(mass - data["mass_kg"]) < 4 * error
     assert max(abs(z) for z in data["sampled_inertia_z_scores"]) < 4
     assert data["triangles"] > 5000
+
+
+def test_bottle_flip_same_flick_different_inertia(tmp_path):
+    """The flick chosen for one turn lands the bottle upright within 10° (it turns a little
+    while pushed); the same flick turns the other bottles in inverse proportion to their
+    moments of inertia (same L, ω = L / I, within 1 %), L is constant in flight and ω is L / I
+    to round-off."""
+    run_demo("bottle-flip", tmp_path)
+    data = summary(tmp_path)
+    turned, moments = data["turned_at_landing_deg"], data["moment_about_flip_axis_kg_m2"]
+    assert abs(turned["just right"] - 360.0) < 10.0
+    for other in ("slimmer, taller", "squatter"):
+        expected = turned["just right"] * moments["just right"] / moments[other]
+        assert turned[other] == pytest.approx(expected, rel=0.01)
+    assert data["angular_momentum_change_in_flight"] == 0.0
+    assert data["max_spin_error_vs_L_over_I_rad_per_s"] < 1e-12

@@ -196,6 +196,7 @@ def _interrupted_run_name(output: JobOutput, error: Interrupted) -> str:
 
 def _load_builtins() -> None:
     from . import (  # noqa: F401 - registers the demos
+        bottle_flip,
         bunny_throw,
         circular,
         cloth_drape,
