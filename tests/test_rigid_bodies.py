@@ -7,6 +7,7 @@ and the builder refuses what no body can be, naming the entity and the field.
 """
 
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -272,3 +273,13 @@ def test_a_spinning_top_on_an_anchor_precesses_at_m_g_d_over_i3_omega():
     theory = 9.81 * mass * (height / 4) / (0.3 * mass * radius**2 * spin)
     assert rate == pytest.approx(theory, rel=0.03)
     assert max(pivot) < 3 * mass * 9.81 / anchor["stiffness"]
+
+
+def test_the_example_scene_of_bodies_validates_and_names_its_bodies():
+    from typer.testing import CliRunner
+
+    from visviva.cli.main import app
+
+    scene = Path(__file__).parents[1] / "examples" / "scenes" / "spinning_bodies.toml"
+    result = CliRunner().invoke(app, ["validate", str(scene)])
+    assert result.exit_code == 0 and "3 rigid bodies" in result.stdout

@@ -105,6 +105,8 @@ def validate_command(scene: SceneArgument) -> None:
     model = load_model(scene)
     held = [f"{model.particle_count} particles"] if model.particle_count else []
     held += [f"system {s.system}" for s in model.systems]
+    if model.body_count:
+        held.append(f"{model.body_count} rigid bod{'y' if model.body_count == 1 else 'ies'}")
     what = ", ".join(held)
     typer.echo(f"{scene}: valid ({what}, method {model.integration.method})")
 
