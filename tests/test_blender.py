@@ -156,7 +156,7 @@ def test_rigid_bodies_in_usd_and_gltf(tmp_path):
     frames = [0, shown.size // 2, shown.size - 1]
     (usd,) = export_recording(recording, tmp_path / "bodies.usdc", fps=FPS)
     (glb,) = export_recording(recording, tmp_path / "bodies.glb", fps=FPS)
-    origin, orientation = recording["body_position"][shown], recording["body_orientation"][shown]
+    origin, orientation = recording["body_origin"][shown], recording["body_orientation"][shown]
     tolerance = 2e-6 * max(1.0, float(np.abs(origin).max()))  # float32 vertices and transforms
     for view in (blender_view(usd, frames), blender_view(glb, frames)):
         for k in frames:

@@ -129,7 +129,7 @@ def shown_transforms(recording: vv.Recording) -> tuple[np.ndarray, np.ndarray]:
     """Each body's recorded origin ``(N, B, 3)`` [m] and orientation ``(N, B, 4)`` at the
     output frames."""
     shown = frames_at_rate(recording.time, FPS)
-    return recording["body_position"][shown], recording["body_orientation"][shown]
+    return recording["body_origin"][shown], recording["body_orientation"][shown]
 
 
 def placed(origin: np.ndarray, orientation: np.ndarray, vertices: np.ndarray) -> np.ndarray:
@@ -153,15 +153,15 @@ def surfaces() -> list[tuple[np.ndarray, np.ndarray]]:
 def test_the_run_records_each_surface_once_and_each_transform_per_frame(run):
     _, recording = run
     frames = recording.frames
-    assert recording["body_position"].shape == (frames, 3, 3)
+    assert recording["body_origin"].shape == (frames, 3, 3)
     assert recording["body_orientation"].shape == (frames, 3, 4)
-    assert recording.units["body_position"] == "m" and recording.units["body_vertices"] == "m"
+    assert recording.units["body_origin"] == "m" and recording.units["body_vertices"] == "m"
     np.testing.assert_allclose(np.linalg.norm(recording["body_orientation"], axis=2), 1.0, 1e-12)
     # Nothing of a body's surface is recorded per frame: the fields are points and transforms.
     assert set(recording.fields) == {
         "points",
         "velocities",
-        "body_position",
+        "body_origin",
         "body_orientation",
         "energy",
     }
@@ -175,9 +175,9 @@ def test_the_run_records_each_surface_once_and_each_transform_per_frame(run):
         start = last
     np.testing.assert_array_equal(static["body_color"], [RED, GREEN, YELLOW])
     assert recording.attrs["body_names"] == NAMES
-    # body_position is each body's own origin: where the scene put it at the start.
+    # body_origin is each body's own origin: where the scene put it at the start.
     starts = [[0.0, 1.0, 0.0], [0.8, 1.5, 0.0], [-0.6, 1.4, 0.3]]
-    np.testing.assert_allclose(recording["body_position"][0], starts, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(recording["body_origin"][0], starts, rtol=0, atol=1e-15)
     np.testing.assert_allclose(static["body_center"][2], [0.075] * 3, rtol=1e-12)
 
 
@@ -189,7 +189,7 @@ def test_the_recorded_origin_and_the_states_centre_of_mass_agree(run):
     state = simulation.state
     for b in range(3):
         origin, orientation = (
-            recording["body_position"][-1, b],
+            recording["body_origin"][-1, b],
             recording["body_orientation"][-1, b],
         )
         centre = placed(origin, orientation, recording.static["body_center"][b])
@@ -201,7 +201,7 @@ def test_a_recording_round_trips_the_body_fields(tmp_path):
     recording = vv.Simulation(scene().build()).record(until=0.1)
     path = vv.io.save_recording(recording, tmp_path / "bodies.h5")
     again = vv.io.load_recording(path)
-    for name in ("body_position", "body_orientation"):
+    for name in ("body_origin", "body_orientation"):
         assert again[name].dtype == np.float64
         np.testing.assert_array_equal(again[name], recording[name])
     assert set(again.static) == set(recording.static)
@@ -209,7 +209,7 @@ def test_a_recording_round_trips_the_body_fields(tmp_path):
         assert again.static[name].dtype == value.dtype
         np.testing.assert_array_equal(again.static[name], value)
     assert again.attrs["body_names"] == NAMES
-    assert again.units["body_position"] == "m"
+    assert again.units["body_origin"] == "m"
     bodies = again.geometry().bodies
     assert bodies is not None and bodies.names == tuple(NAMES)
 
@@ -447,7 +447,7 @@ def test_bodies_alone_go_to_every_output(tmp_path, browser):
             placed(x, q, surface)
             for k in range(recording.frames)
             for x, q, (surface, _) in zip(
-                recording["body_position"][k],
+                recording["body_origin"][k],
                 recording["body_orientation"][k],
                 surfaces(),
                 strict=True,

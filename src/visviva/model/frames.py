@@ -12,7 +12,7 @@ Per frame (:func:`frame_fields`), following the recording convention of
     alive                 (P,) bool    with emitters: which points hold a live particle
     radius                (P,) [m]     with emitters: radii as they grow and shrink
     color                 (P, 3)       with colour ramps: sRGB colours in [0, 1]
-    body_position         (B, 3) [m]   each rigid body's own origin (its surface's coordinates
+    body_origin           (B, 3) [m]   each rigid body's own origin (its surface's coordinates
                                        start there), not its centre of mass as in the state
     body_orientation      (B, 4)       unit quaternions (w, x, y, z), body to world
 
@@ -124,7 +124,7 @@ def frame_fields(model: Model, state: State) -> dict[str, np.ndarray]:
     if model.bodies is not None:
         orientation = state["body_orientation"]
         center = quaternion_rotate(orientation, model.bodies.center)
-        fields["body_position"] = state["body_position"] - center
+        fields["body_origin"] = state["body_position"] - center
         fields["body_orientation"] = np.array(orientation)
     return fields
 

@@ -264,7 +264,7 @@ class Model:
         """Units of the recorded fields and static arrays."""
         return {
             "points": "m",
-            "body_position": "m",
+            "body_origin": "m",
             "body_vertices": "m",
             "body_center": "m",
             "velocities": "m/s",

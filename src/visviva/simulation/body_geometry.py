@@ -3,7 +3,7 @@
 A rigid body moves without changing shape, so a recording keeps its surface once and a
 transform per frame (:mod:`visviva.simulation.recording` lists every name):
 
-    fields/body_position        float64 (frames, B, 3) [m]: each body's own origin (where its
+    fields/body_origin          float64 (frames, B, 3) [m]: each body's own origin (where its
                                 surface's coordinates start) in the world frame. Not the centre
                                 of mass, which is the state's ``body_position``:
                                 ``origin + R(q) static/body_center``
@@ -22,7 +22,7 @@ transform per frame (:mod:`visviva.simulation.recording` lists every name):
     static/body_center          float64 (B, 3) [m]: centre of mass in the body's axes (optional)
     attrs["body_names"]         list of B strings (optional)
 
-Vertex ``v`` of body ``b`` is at ``body_position[k, b] + R(body_orientation[k, b]) v`` in frame
+Vertex ``v`` of body ``b`` is at ``body_origin[k, b] + R(body_orientation[k, b]) v`` in frame
 ``k``: exporters write the surface once and the transform per frame, which is all a rigid
 animation needs (USD xform ops, glTF node channels, the viewer's object matrices).
 """
@@ -42,7 +42,7 @@ from ..geometry.quaternions import quaternion_matrix
 __all__ = ["BODY_FIELDS", "BodyGeometry", "continuous_orientations"]
 
 #: The recording's per-frame body fields and the static arrays every body recording has.
-BODY_FIELDS = ("body_position", "body_orientation")
+BODY_FIELDS = ("body_origin", "body_orientation")
 _BODY_STATIC = ("body_vertices", "body_triangles", "body_vertex_start", "body_triangle_start")
 #: Vertices transformed at once when bounding every frame: their gathered rotation matrices
 #: take 72 bytes each (19 MB), whatever the number of bodies.
@@ -191,10 +191,10 @@ def read_bodies(
             f"the recording has rigid bodies ({', '.join(present)}) but not "
             f"{', '.join(missing)}; a body needs a surface and a transform per frame"
         )
-    position, orientation = fields["body_position"], fields["body_orientation"]
+    position, orientation = fields["body_origin"], fields["body_orientation"]
     frames = position.shape[0] if position.ndim == 3 else -1
     count = position.shape[1] if position.ndim == 3 else -1
-    _shape("body_position", position, (frames, count, 3))
+    _shape("body_origin", position, (frames, count, 3))
     _shape("body_orientation", orientation, (frames, count, 4))
     vertices, triangles = static["body_vertices"], static["body_triangles"]
     _shape("body_vertices", vertices, (vertices.shape[0] if vertices.ndim else -1, 3))

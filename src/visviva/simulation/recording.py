@@ -33,7 +33,7 @@ and, per frame:
 Rigid bodies keep their surfaces once and a transform per frame (the full list is in
 :mod:`visviva.simulation.body_geometry`; a recording may hold bodies without points):
 
-    fields/body_position    float64 (frames, B, 3) [m]: each body's own origin, world frame
+    fields/body_origin      float64 (frames, B, 3) [m]: each body's own origin, world frame
     fields/body_orientation float64 (frames, B, 4): unit quaternions (w, x, y, z), body to world
     static/body_vertices    float64 (V, 3) [m]: the bodies' surfaces in their own axes, with
                             body_triangles (T, 3), body_vertex_start and body_triangle_start
