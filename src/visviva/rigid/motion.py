@@ -143,15 +143,16 @@ def _rates(q, v, inverse_mass, inverse_inertia, axes, out):  # pragma: no cover 
 
 
 #: Largest ``|½θ|`` the series of :func:`_half_angle` takes: its first omitted terms,
-#: ``0.4¹⁶/16!`` and ``0.4¹⁷/17!``, are below 1e-19. A larger turn in one step (over 0.8 rad
-#: about one axis) takes the library's ``sin`` and ``cos`` in a second pass.
+#: ``0.4¹⁶/16!`` and ``0.4¹⁷/17!``, are below 1e-19. A body that may turn further in one step
+#: (``½ h |L| / I_min`` above it: no sub-turn's half angle can be larger, since ``|Π| = |L|``)
+#: takes the library's ``sin`` and ``cos``.
 SERIES_LIMIT = 0.4
 
 
 @njit(cache=True, inline="always")
 def _half_angle(angle):  # pragma: no cover - compiled
-    """``(cos ½θ, sin ½θ)`` by Taylor series to round-off, and whether ``|½θ|`` is past
-    :data:`SERIES_LIMIT` (no call and no branch, so the bodies' loop can be vectorized)."""
+    """``(cos ½θ, sin ½θ)`` by Taylor series to round-off for ``|½θ| ≤`` :data:`SERIES_LIMIT`
+    (no call: a step's five turns would otherwise spend most of their time in the library)."""
     x = 0.5 * angle
     u = x * x
     # Horner, nested from the highest terms: cos to x¹⁴/14!, sin to x¹⁵/15!, multiplying by
@@ -170,13 +171,14 @@ def _half_angle(angle):  # pragma: no cover - compiled
     s = 1.0 - u * 0.023809523809523808 * s
     s = 1.0 - u * 0.05 * s
     s = 1.0 - u * 0.16666666666666666 * s
-    return c, x * s, abs(x) > SERIES_LIMIT
+    return c, x * s
 
 
 @njit(cache=True, inline="always")
 def _library_half_angle(angle):  # pragma: no cover - compiled
-    """``(cos ½θ, sin ½θ, False)`` by the library (the second pass of :func:`_drift`)."""
-    return np.cos(0.5 * angle), np.sin(0.5 * angle), False
+    """``(cos ½θ, sin ½θ)`` by the library (for a body turning fast, see
+    :data:`SERIES_LIMIT`)."""
+    return np.cos(0.5 * angle), np.sin(0.5 * angle)
 
 
 @njit(cache=True, inline="always")
@@ -184,73 +186,58 @@ def _turn(w, x, y, z, px, py, pz, axis, angle, half_angle):  # pragma: no cover 
     """One exact sub-flow of the splitting: the body turns by ``θ = angle`` about its
     principal ``axis`` (0, 1, 2; a constant at each call, so the branches fold away):
     ``q ← q ⊗ (cos ½θ, sin ½θ e)``, and ``Π`` turns by ``−θ`` about ``e`` (``L`` stays).
-    Written out per axis: the generic product would multiply by the zeros of ``e``. Also
-    returns whether the angle was too large for ``half_angle`` (:func:`_half_angle` or
-    :func:`_library_half_angle`, a compiled function resolved when compiling)."""
-    c, s, wide = half_angle(angle)
+    Written out per axis: the generic product would multiply by the zeros of ``e``.
+    ``half_angle``: :func:`_half_angle` or :func:`_library_half_angle` (a compiled function,
+    resolved when compiling)."""
+    c, s = half_angle(angle)
     cos, sin = c * c - s * s, 2.0 * s * c  # of θ itself
     if axis == 0:
         q = (w * c - x * s, x * c + w * s, y * c + z * s, z * c - y * s)
-        return (*q, px, py * cos + pz * sin, pz * cos - py * sin, wide)
+        return (*q, px, py * cos + pz * sin, pz * cos - py * sin)
     if axis == 1:
         q = (w * c - y * s, x * c - z * s, y * c + w * s, z * c + x * s)
-        return (*q, px * cos - pz * sin, py, pz * cos + px * sin, wide)
+        return (*q, px * cos - pz * sin, py, pz * cos + px * sin)
     q = (w * c - z * s, x * c + y * s, y * c - x * s, z * c + w * s)
-    return (*q, px * cos + py * sin, py * cos - px * sin, pz, wide)
+    return (*q, px * cos + py * sin, py * cos - px * sin, pz)
 
 
-def _drift(q, v, h, inverse_mass, inverse_inertia, axes, out):
-    """The bodies' drift into ``out``: every body with the series, then again with the
-    library's ``sin`` and ``cos`` those that turned too far for it (none, in a sane step)."""
-    wide = np.empty(inverse_mass.shape[0], dtype=np.bool_)
-    if _drift_bodies(q, v, h, inverse_mass, inverse_inertia, axes, out, wide):
-        _drift_wide(q, v, h, inverse_mass, inverse_inertia, axes, out, np.flatnonzero(wide))
+@njit(cache=True, inline="always")
+def _free_turns(w, x, y, z, px, py, pz, h, i1, i2, i3, half_angle):  # pragma: no cover
+    """The free rotation over ``h``: T₁(h/2) T₂(h/2) T₃(h) T₂(h/2) T₁(h/2), each angle from
+    the Π of its moment (``i1, i2, i3`` the inverse principal moments)."""
+    w, x, y, z, px, py, pz = _turn(w, x, y, z, px, py, pz, 0, 0.5 * h * px * i1, half_angle)
+    w, x, y, z, px, py, pz = _turn(w, x, y, z, px, py, pz, 1, 0.5 * h * py * i2, half_angle)
+    w, x, y, z, px, py, pz = _turn(w, x, y, z, px, py, pz, 2, h * pz * i3, half_angle)
+    w, x, y, z, px, py, pz = _turn(w, x, y, z, px, py, pz, 1, 0.5 * h * py * i2, half_angle)
+    return _turn(w, x, y, z, px, py, pz, 0, 0.5 * h * px * i1, half_angle)
 
 
-# fmt: off
 @njit(cache=True, inline="always", error_model="numpy")
-def _drift_one(
-    q, v, h, inverse_mass, inverse_inertia, axes, out, b, count, half_angle,
-):  # pragma: no cover - compiled
-    """Body ``b``'s drift into ``out`` (see the module docstring); whether a turn was too
-    large for ``half_angle``."""
+def drift_body(q, v, h, inverse_mass, inverse_inertia, axes, out, b, count):  # pragma: no cover
+    """Body ``b``'s drift into ``out`` (see the module docstring; ``out`` may be ``q``)."""
     m, k = 3 * count + 3 * b, 3 * count + 4 * b
     for a in range(3):
         out[3 * b + a] = q[3 * b + a] + h * v[3 * b + a] * inverse_mass[b]
     w, x, y, z = _principal(q, b, count, axes)
     px, py, pz = rotate_back(w, x, y, z, v[m], v[m + 1], v[m + 2])
     i1, i2, i3 = inverse_inertia[b, 0], inverse_inertia[b, 1], inverse_inertia[b, 2]
-    # T₁(h/2) T₂(h/2) T₃(h) T₂(h/2) T₁(h/2); each angle from the Π of its moment.
-    w, x, y, z, px, py, pz, w1 = _turn(w, x, y, z, px, py, pz, 0, 0.5 * h * px * i1, half_angle)
-    w, x, y, z, px, py, pz, w2 = _turn(w, x, y, z, px, py, pz, 1, 0.5 * h * py * i2, half_angle)
-    w, x, y, z, px, py, pz, w3 = _turn(w, x, y, z, px, py, pz, 2, h * pz * i3, half_angle)
-    w, x, y, z, px, py, pz, w4 = _turn(w, x, y, z, px, py, pz, 1, 0.5 * h * py * i2, half_angle)
-    w, x, y, z, px, py, pz, w5 = _turn(w, x, y, z, px, py, pz, 0, 0.5 * h * px * i1, half_angle)
+    fastest = max(i1, i2, i3) * np.sqrt(px * px + py * py + pz * pz)  # |L| / I_min [rad/s]
+    if 0.5 * h * fastest <= SERIES_LIMIT:
+        w, x, y, z, px, py, pz = _free_turns(w, x, y, z, px, py, pz, h, i1, i2, i3, _half_angle)
+    else:
+        w, x, y, z, px, py, pz = _free_turns(
+            w, x, y, z, px, py, pz, h, i1, i2, i3, _library_half_angle
+        )
     # Back to the body's own axes: q = (q ⊗ r) ⊗ r⁻¹.
     w, x, y, z = multiply(w, x, y, z, axes[b, 0], -axes[b, 1], -axes[b, 2], -axes[b, 3])
     out[k], out[k + 1], out[k + 2], out[k + 3] = normalized(w, x, y, z)
-    return w1 | w2 | w3 | w4 | w5
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def _drift_bodies(q, v, h, inverse_mass, inverse_inertia, axes, out, wide):  # pragma: no cover
+def _drift(q, v, h, inverse_mass, inverse_inertia, axes, out):  # pragma: no cover - compiled
     count = inverse_mass.shape[0]
-    too_far = 0
     for b in prange(count):
-        flag = _drift_one(q, v, h, inverse_mass, inverse_inertia, axes, out, b, count, _half_angle)
-        wide[b] = flag
-        too_far += flag
-    return too_far > 0
-
-
-@njit(cache=True, error_model="numpy")
-def _drift_wide(q, v, h, inverse_mass, inverse_inertia, axes, out, which):  # pragma: no cover
-    count = inverse_mass.shape[0]
-    for b in which:
-        _drift_one(
-            q, v, h, inverse_mass, inverse_inertia, axes, out, b, count, _library_half_angle,
-        )
-# fmt: on
+        drift_body(q, v, h, inverse_mass, inverse_inertia, axes, out, b, count)
 
 
 @njit(cache=True)

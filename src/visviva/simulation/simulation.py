@@ -115,9 +115,10 @@ class Simulation:
             integrator steps.
         divergence_limit: Largest allowed ``|component|`` before the run counts as diverged
             (default ``1e10 × max(1, max |initial state|)``).
-        compiled: ``None`` to take the fused particle step when the scene has one
-            (:mod:`visviva.particles.fused`: one parallel pass per step), ``False`` for the
-            generic pipeline, ``True`` to require the fused step.
+        compiled: ``None`` to take the fused step when the scene has one (one parallel pass
+            per step: :mod:`visviva.particles.fused` for particles,
+            :mod:`visviva.rigid.fused` for rigid bodies), ``False`` for the generic pipeline,
+            ``True`` to require the fused step.
 
     Raises:
         ModelError: If the method cannot integrate the scene or an argument is invalid.
@@ -133,6 +134,7 @@ class Simulation:
         compiled: bool | None = None,
     ) -> None:
         from ..particles.fused import FusedParticles
+        from ..rigid.fused import FusedBodies
 
         settings = model.integration
         self.model = model
@@ -145,11 +147,15 @@ class Simulation:
         if divergence_limit is not None:
             divergence_limit = real_number("divergence_limit", divergence_limit, positive=True)
         watch = DivergenceWatch(self.system, self.integrator, self.dt, state, divergence_limit)
-        fused = None if compiled is False else FusedParticles.of(model, self.integrator.name)
+        fused = None
+        if compiled is not False:
+            method = self.integrator.name
+            fused = FusedParticles.of(model, method) or FusedBodies.of(model, method)
         if compiled and fused is None:
             raise ModelError(
                 "compiled=True needs a scene made only of particles under field forces, with "
-                "colliders and emitters, stepped by 'symplectic_euler'; this one has no fused step"
+                "colliders and emitters, or only of rigid bodies under gravity and damping, "
+                "stepped by 'symplectic_euler'; this one has no fused step"
             )
         self._stepper = Stepper(self.system, self.integrator, watch, model.stages, fused)
         self._state = state
