@@ -298,6 +298,9 @@ def test_the_fused_step_of_free_bodies_is_the_generic_pipelines():
             orientation=rng.normal(size=4) / 2.0 + [1, 0, 0, 0], velocity=rng.normal(size=3),
             angular_velocity=5 * rng.normal(size=3), linear_damping=0.1,
         )  # fmt: skip
+    # One spinning fast enough (40 rad/s: ½ h |L|/I_min > 0.05) to leave the short series:
+    # the fused step's general path takes it.
+    builder.add_body("box", size=(0.1, 0.2, 0.3), density=500.0, angular_velocity=(40, 5, 1))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the random quaternions are normalized
         model = builder.build()
