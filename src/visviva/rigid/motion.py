@@ -174,6 +174,24 @@ def _half_angle(angle):  # pragma: no cover - compiled
     return c, x * s
 
 
+#: Largest ``|½θ|`` the short series of :func:`_small_half_angle` takes (to x⁸/8! and x⁹/9!:
+#: the first omitted term, ``0.05¹⁰/10!``, is 3e-20): the turns of an ordinary step.
+SMALL_LIMIT = 0.05
+
+
+@njit(cache=True, inline="always")
+def _small_half_angle(angle):  # pragma: no cover - compiled
+    """``(cos ½θ, sin ½θ)`` for ``|½θ| ≤`` :data:`SMALL_LIMIT`, evaluated in Estrin's form
+    (the powers of ``x²`` side by side, not one after the other as Horner's rule has them):
+    a step's five turns follow one another, so their latency is the step's time."""
+    x = 0.5 * angle
+    u = x * x
+    v = u * u
+    c = (1.0 - 0.5 * u) + v * ((1.0 / 24.0 - u * (1.0 / 720.0)) + v * (1.0 / 40320.0))
+    s = (1.0 - u * (1.0 / 6.0)) + v * ((1.0 / 120.0 - u * (1.0 / 5040.0)) + v * (1.0 / 362880.0))
+    return c, x * s
+
+
 @njit(cache=True, inline="always")
 def _library_half_angle(angle):  # pragma: no cover - compiled
     """``(cos ½θ, sin ½θ)`` by the library (for a body turning fast, see
@@ -222,7 +240,12 @@ def drift_body(q, v, h, inverse_mass, inverse_inertia, axes, out, b, count):  # 
     px, py, pz = rotate_back(w, x, y, z, v[m], v[m + 1], v[m + 2])
     i1, i2, i3 = inverse_inertia[b, 0], inverse_inertia[b, 1], inverse_inertia[b, 2]
     fastest = max(i1, i2, i3) * np.sqrt(px * px + py * py + pz * pz)  # |L| / I_min [rad/s]
-    if 0.5 * h * fastest <= SERIES_LIMIT:
+    largest = 0.5 * h * fastest  # no sub-turn's |½θ| can be larger
+    if largest <= SMALL_LIMIT:
+        w, x, y, z, px, py, pz = _free_turns(
+            w, x, y, z, px, py, pz, h, i1, i2, i3, _small_half_angle
+        )
+    elif largest <= SERIES_LIMIT:
         w, x, y, z, px, py, pz = _free_turns(w, x, y, z, px, py, pz, h, i1, i2, i3, _half_angle)
     else:
         w, x, y, z, px, py, pz = _free_turns(
