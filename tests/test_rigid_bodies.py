@@ -327,3 +327,33 @@ def test_a_fused_blow_up_stops_with_the_last_good_state():
         simulation.step(1000)
     state = simulation.state
     assert np.isfinite(state["body_momentum"]).all() and np.abs(state["body_momentum"]).max() > 1
+
+
+def test_the_derived_views_are_p_over_m_r_of_q_and_omega_from_l():
+    """sim.bodies(): v = P/M, R = R(q), I⁻¹ = R I_body⁻¹ Rᵀ and ω = I⁻¹ L, against the
+    box's closed-form inertia; ω agrees with the kinematics' own, and changes while L stays."""
+    q = np.array([0.8, 0.2, -0.4, 0.4])
+    q /= np.linalg.norm(q)
+    omega = np.array([0.5, -1.0, 2.0])
+    simulation = vv.Simulation(
+        _scene(gravity=(0, 0, 0), orientation=q, velocity=(1, 2, 3), angular_velocity=omega).build()
+    )
+    views = simulation.bodies()
+    np.testing.assert_allclose(views.velocity[0], [1, 2, 3], rtol=1e-15)
+    np.testing.assert_allclose(views.rotation[0], quaternion_matrix(q), atol=1e-15)
+    mass = 0.4 * 0.2 * 0.1 * 500.0
+    body = mass / 12.0 * np.diag([0.2**2 + 0.1**2, 0.4**2 + 0.1**2, 0.4**2 + 0.2**2])
+    rotation = quaternion_matrix(q)
+    np.testing.assert_allclose(
+        views.inverse_inertia[0], rotation @ np.linalg.inv(body) @ rotation.T, rtol=1e-12
+    )
+    np.testing.assert_allclose(views.angular_velocity[0], omega, rtol=1e-12)
+    simulation.step(100)
+    later = simulation.bodies().angular_velocity[0]
+    q_, v_ = simulation.raw_state.parts
+    np.testing.assert_allclose(later, simulation.system.kinematics.angular_velocity(q_, v_)[0])
+    assert np.abs(later - omega).max() > 0.1  # ω wanders; L does not
+    with pytest.raises(vv.ModelError, match="no rigid bodies"):
+        particles = vv.SceneBuilder(name="p")
+        particles.add_particles(positions=[[0.0, 0.0, 0.0]])
+        vv.Simulation(particles.build()).bodies()

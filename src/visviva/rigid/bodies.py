@@ -20,10 +20,24 @@ from ..geometry.quaternions import matrix_quaternion, quaternion_matrix
 from .mass_properties import MassProperties
 from .motion import BodyMotion
 
-__all__ = ["DEFAULT_COLOR", "BodyStart", "RigidBodies"]
+__all__ = ["DEFAULT_COLOR", "BodyStart", "BodyViews", "RigidBodies"]
 
 #: The colour of a body that is given none: a light grey, sRGB (the scene entity's default).
 DEFAULT_COLOR = (0.8, 0.8, 0.8)
+
+
+@dataclass(frozen=True)
+class BodyViews:
+    """What the bodies' state ``(x, q, P, L)`` implies, every array's first axis the body
+    (Baraff & Witkin's notes, §2): the velocity of the centre of mass ``v = P/M`` ``(B, 3)``
+    [m/s], the rotation matrix ``R(q)`` ``(B, 3, 3)`` (body axes to world), the world inverse
+    inertia ``I⁻¹ = R I_body⁻¹ Rᵀ`` ``(B, 3, 3)`` [1/(kg·m²)] and the angular velocity
+    ``ω = I⁻¹ L`` ``(B, 3)`` [rad/s]: not conserved by a free body, whose ``L`` is."""
+
+    velocity: np.ndarray
+    rotation: np.ndarray
+    inverse_inertia: np.ndarray
+    angular_velocity: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -129,6 +143,22 @@ class RigidBodies:
     @property
     def count(self) -> int:
         return int(self.mass.shape[0])
+
+    def views(
+        self, orientation: np.ndarray, momentum: np.ndarray, angular_momentum: np.ndarray
+    ) -> BodyViews:
+        """The derived quantities of the bodies' state (orientations ``(B, 4)``, momenta and
+        angular momenta ``(B, 3)``, world frame): see :class:`BodyViews`."""
+        q = np.asarray(orientation, dtype=np.float64)
+        rotation = quaternion_matrix(q / np.linalg.norm(q, axis=1, keepdims=True))
+        # The inertia is I_body in the body's axes: I⁻¹ = R I_body⁻¹ Rᵀ.
+        inverse = rotation @ np.linalg.inv(self.inertia) @ rotation.transpose(0, 2, 1)
+        return BodyViews(
+            velocity=np.asarray(momentum) / self.mass[:, None],
+            rotation=rotation,
+            inverse_inertia=inverse,
+            angular_velocity=np.einsum("bij,bj->bi", inverse, angular_momentum),
+        )
 
     def motion(self, offset: int) -> BodyMotion:
         """The bodies' kinematics after ``offset`` entries that move as ``q' = v``."""

@@ -47,6 +47,7 @@ from .watch import DivergenceWatch
 
 if TYPE_CHECKING:
     from ..model import Model
+    from ..rigid.bodies import BodyViews
 
 __all__ = ["CHECKPOINT_FORMAT", "Simulation", "SimulationState"]
 
@@ -196,6 +197,20 @@ class Simulation:
         if gap < 0.0:
             raise ModelError(f"`gap` must be >= 0 (got {gap!r} m)")
         return self.model.contacts(self._current(), gap)
+
+    def bodies(self) -> BodyViews:
+        """What the rigid bodies' state implies now: ``v``, ``R``, the world inverse inertia
+        and ``ω`` of each body (:class:`~visviva.rigid.bodies.BodyViews`).
+
+        Raises:
+            ModelError: If the scene has no rigid bodies.
+        """
+        if self.model.bodies is None:
+            raise ModelError("this scene has no rigid bodies (add one with add_body)")
+        state = self._current()
+        return self.model.bodies.views(
+            state["body_orientation"], state["body_momentum"], state["body_angular_momentum"]
+        )
 
     def energy(self) -> float:
         """Kinetic plus potential energy [J] of the live particles and the systems."""
