@@ -301,6 +301,8 @@ def test_the_fused_step_of_free_bodies_is_the_generic_pipelines():
     # One spinning fast enough (40 rad/s: ½ h |L|/I_min > 0.05) to leave the short series:
     # the fused step's general path takes it.
     builder.add_body("box", size=(0.1, 0.2, 0.3), density=500.0, angular_velocity=(40, 5, 1))
+    # And an isotropic one, which turns about L in one exact turn (the general path too).
+    builder.add_body("sphere", radius=0.1, density=500.0, angular_velocity=(1, -2, 3))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the random quaternions are normalized
         model = builder.build()
@@ -357,3 +359,44 @@ def test_the_derived_views_are_p_over_m_r_of_q_and_omega_from_l():
         particles = vv.SceneBuilder(name="p")
         particles.add_particles(positions=[[0.0, 0.0, 0.0]])
         vv.Simulation(particles.build()).bodies()
+
+
+def test_kinematic_and_static_bodies_move_as_given_whatever_acts():
+    """Under gravity and damping, a kinematic box moves at its velocity and turns at its
+    angular velocity (about a fixed axis, even though a box spun off its principal axes would
+    tumble), and a static one stays put; a dynamic sphere falls. The energy counts neither
+    driven body's height (gravity does not pull them)."""
+    omega = np.array([0.3, 1.0, -0.5])
+    builder = _scene(
+        motion="kinematic", velocity=(1.0, 0.0, 0.0), angular_velocity=omega,
+        linear_damping=2.0, angular_damping=2.0,
+    )  # fmt: skip
+    builder.add_body("sphere", radius=0.1, density=100.0, motion="static", position=(0, 5, 0))
+    builder.add_body("sphere", radius=0.1, density=100.0, position=(0, 5, 1))
+    simulation = vv.Simulation(builder.build())
+    start = simulation.state["body_position"].copy()
+    energy = simulation.energy()
+    simulation.step(100)  # 1 s
+    x, q = simulation.state["body_position"], simulation.state["body_orientation"]
+    np.testing.assert_allclose(x[0], start[0] + [1.0, 0.0, 0.0], atol=1e-12)
+    angle = np.linalg.norm(omega)  # turned by |ω| t about ω/|ω|
+    expected = np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * omega / angle])
+    np.testing.assert_allclose(q[0], expected, atol=1e-12)
+    np.testing.assert_array_equal(x[1], start[1])
+    assert x[2, 1] < start[2, 1] - 4.0  # the dynamic sphere fell about ½ g t² = 4.9 m
+    # The energy changes by the falling sphere's alone: symplectic Euler's exact offset under a
+    # constant force, ΔE = −½ M g² h t (v_n = n h g, x_n − x_0 = h² g n (n + 1)/2).
+    sphere = 100.0 * 4.0 / 3.0 * np.pi * 0.1**3
+    assert simulation.energy() - energy == pytest.approx(-0.5 * sphere * 9.81**2 * 0.01, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        ({"motion": "static", "velocity": (1.0, 0.0, 0.0)}, "static body does not move"),
+        ({"motion": "kinematic", "push": [{"force": (1.0, 0.0, 0.0)}]}, "not by forces"),
+    ],
+)
+def test_driven_bodies_refuse_what_would_move_them_otherwise(body, message):
+    with pytest.raises(vv.SceneError, match=message):
+        _scene(**body).build()

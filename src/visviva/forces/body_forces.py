@@ -65,7 +65,7 @@ class BodyGravity:
 
     Args:
         gravity: ``g`` [m/s²], ``(3,)``.
-        mass: ``(B,)`` masses [kg].
+        mass: ``(B,)`` masses [kg] (0 for a body gravity does not move: a kinematic one).
     """
 
     conservative = True
@@ -73,7 +73,8 @@ class BodyGravity:
 
     def __init__(self, gravity: Sequence[float], mass: np.ndarray) -> None:
         self.gravity = vector("gravity", gravity, unit="m/s²")
-        self._weight = np.asarray(mass, dtype=np.float64)[:, None] * self.gravity[None, :]
+        self.mass = np.asarray(mass, dtype=np.float64)
+        self._weight = self.mass[:, None] * self.gravity[None, :]
 
     def accumulate_wrench(self, t, x, q, momentum, angular_momentum, force, torque) -> None:  # type: ignore[no-untyped-def]
         """Add ``M g`` [N] to ``force`` (no torque)."""

@@ -337,6 +337,7 @@ class SceneBuilder:
         angular_damping: float | None = None,
         push: Sequence[Mapping[str, Any]] | None = None,
         anchor: Mapping[str, Any] | None = None,
+        motion: str | None = None,
         color: Vector | None = None,
         name: str | None = None,
     ) -> int:
@@ -351,7 +352,9 @@ class SceneBuilder:
         ``angular_damping`` [1/s] damp its momenta; ``push`` is a list of forces at its
         points (``{"force": ..., "point": ..., "start": ..., "duration": ...}``) and
         ``anchor`` holds one of its points at a world point by a spring (``{"point": ...,
-        "at": ..., "stiffness": ..., "damping": ...}``; see :mod:`visviva.model.scene_rigid`).
+        "at": ..., "stiffness": ..., "damping": ...}``). ``motion``: ``"dynamic"`` (the
+        default), ``"kinematic"`` (moves at its velocities whatever acts on it) or
+        ``"static"`` (see :mod:`visviva.model.scene_rigid`).
         Its state is ``body_position`` (the centre of mass), ``body_orientation``,
         ``body_momentum`` and ``body_angular_momentum``."""
         given = _given(locals())

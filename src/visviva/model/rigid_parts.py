@@ -40,7 +40,7 @@ def rigid_bodies(scene: Scene, names: list[str]) -> tuple[RigidBodies | None, li
         return None, []
     properties, starts, shapes = [], [], []
     for index, entity in chosen:
-        properties.append(_mass_properties(index, entity))
+        properties.append(_driven(entity, _mass_properties(index, entity)))
         starts.append(_start(index, entity))
         shapes.append({"shape": entity.shape, **_shape(entity)})
     bodies = RigidBodies.of(
@@ -48,13 +48,15 @@ def rigid_bodies(scene: Scene, names: list[str]) -> tuple[RigidBodies | None, li
         properties,
         starts,
         shapes,
-        [e.linear_damping for _, e in chosen],
-        [e.angular_damping for _, e in chosen],
+        [e.linear_damping if e.motion == "dynamic" else 0.0 for _, e in chosen],
+        [e.angular_damping if e.motion == "dynamic" else 0.0 for _, e in chosen],
         [e.color for _, e in chosen],
     )
+    # Forces move dynamic bodies only: the others move as they are given.
+    dynamic = np.array([e.motion == "dynamic" for _, e in chosen])
     forces: list[BodyForce] = []
-    if any(scene.world.gravity):
-        forces.append(BodyGravity(scene.world.gravity, bodies.mass))
+    if any(scene.world.gravity) and dynamic.any():
+        forces.append(BodyGravity(scene.world.gravity, np.where(dynamic, bodies.mass, 0.0)))
     if bodies.linear_damping.any() or bodies.angular_damping.any():
         forces.append(BodyDamping(bodies.linear_damping, bodies.angular_damping))
     pushes = [(b, p) for b, (_, e) in enumerate(chosen) for p in e.push]
@@ -114,6 +116,18 @@ def _mass_properties(index: int, entity: RigidBody) -> Any:
         field = "vertices" if entity.shape == "mesh" else DIMENSIONS[entity.shape][0]
         raise Located(f"{where}.{field}", str(error)) from None
     return properties
+
+
+def _driven(entity: RigidBody, properties: MassProperties) -> MassProperties:
+    """A kinematic or static body's properties with its inertia made isotropic (the mean of
+    its principal moments): nothing turns it, and with ``L = Ī ω`` it turns at the constant
+    ``ω`` it is given, about a fixed axis, as a kinematic body must."""
+    if entity.motion == "dynamic":
+        return properties
+    mean = float(np.trace(properties.inertia)) / 3.0
+    return MassProperties(
+        properties.mass, properties.center_of_mass, mean * np.eye(3), properties.volume
+    )
 
 
 def _shape(entity: RigidBody) -> dict[str, Any]:

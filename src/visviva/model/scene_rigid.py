@@ -22,6 +22,10 @@ mesh        ``vertices`` and ``triangles`` (counter-clockwise seen from outside)
 the cone, whose origin is its base's centre; a mesh's coordinate origin); the state's
 ``body_position`` is its centre of mass.
 
+A body's ``motion`` is ``"dynamic"`` (forces and torques move it), ``"kinematic"`` (it moves
+at its ``velocity`` and turns at its ``angular_velocity`` forever, whatever acts on it, like
+an animated obstacle) or ``"static"`` (it stays where it is put).
+
 A body may be pushed (``[[entities.push]]``: a force [N] in the world frame at a point of the
 body, given in its own axes, for a while) and anchored (``[entities.anchor]``: a point of the
 body held at a world point by a stiff damped spring, a ball joint by penalty).
@@ -105,6 +109,9 @@ class RigidBody(Strict):
     )
     velocity: Vector = Field((0.0, 0.0, 0.0), description="of the centre of mass [m/s]")
     angular_velocity: Vector = Field((0.0, 0.0, 0.0), description="world frame [rad/s]")
+    motion: Literal["dynamic", "kinematic", "static"] = Field(
+        "dynamic", description="dynamic (forces move it), kinematic (moves as given), static"
+    )
     linear_damping: NonNegative = Field(0.0, description="P' = F − γ P: γ [1/s]")
     angular_damping: NonNegative = Field(0.0, description="L' = τ − γ L: γ [1/s]")
     push: list[Push] = Field(default_factory=list, description="forces at points, for a while")
@@ -148,6 +155,19 @@ class RigidBody(Strict):
                     "one_mesh",
                     "give the mesh either as `path` (a mesh file) or as `vertices` and `triangles`",
                 )
+        if self.motion == "static" and (any(self.velocity) or any(self.angular_velocity)):
+            raise PydanticCustomError(
+                "static_moving",
+                "a static body does not move: leave out `velocity` and `angular_velocity`, or "
+                'make it motion = "kinematic" to move it at them',
+            )
+        if self.motion != "dynamic" and (self.push or self.anchor is not None):
+            raise PydanticCustomError(
+                "driven_pushed",
+                "a {motion} body moves as it is given, not by forces: `push` and `anchor` "
+                'belong to motion = "dynamic"',
+                {"motion": self.motion},
+            )
         if not any(self.orientation):
             raise PydanticCustomError(
                 "zero_quaternion",

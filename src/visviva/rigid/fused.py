@@ -56,13 +56,14 @@ class FusedBodies:
         self.inverse_mass = motion.inverse_mass
         self.inverse_inertia = motion.inverse_inertia  # (B, 3), for the general path
         self.axes = motion.axes  # (B, 4)
-        self.mass = np.asarray(bodies.mass, dtype=np.float64)
+        self.mass = np.zeros(self.count)  # the masses gravity pulls (see BodyGravity)
         self.gravity = np.zeros(3)
         self.linear = np.zeros(self.count)
         self.angular = np.zeros(self.count)
         for force in model.body_forces:
             if isinstance(force, BodyGravity):
                 self.gravity += force.gravity
+                self.mass = force.mass
             else:
                 self.linear += force.linear[:, 0]
                 self.angular += force.angular[:, 0]
@@ -173,7 +174,8 @@ def _steps(
         w, x, y, z = multiply(w, x, y, z, r0, r1, r2, r3)
         px, py, pz = rotate_back(w, x, y, z, kx, ky, kz)
         fastest = max(j1[b], j2[b], j3[b]) * np.sqrt(px * px + py * py + pz * pz)
-        fits = 0.5 * h * fastest <= SMALL_LIMIT
+        # (An isotropic body's one exact turn is the general path's.)
+        fits = (0.5 * h * fastest <= SMALL_LIMIT) & ((j1[b] != j2[b]) | (j2[b] != j3[b]))
         turned = _free_turns(w, x, y, z, px, py, pz, h, j1[b], j2[b], j3[b], _small_half_angle)
         w, x, y, z, px, py, pz = turned
         w, x, y, z = multiply(w, x, y, z, r0, -r1, -r2, -r3)

@@ -241,7 +241,14 @@ def drift_body(q, v, h, inverse_mass, inverse_inertia, axes, out, b, count):  # 
     i1, i2, i3 = inverse_inertia[b, 0], inverse_inertia[b, 1], inverse_inertia[b, 2]
     fastest = max(i1, i2, i3) * np.sqrt(px * px + py * py + pz * pz)  # |L| / I_min [rad/s]
     largest = 0.5 * h * fastest  # no sub-turn's |½θ| can be larger
-    if largest <= SMALL_LIMIT:
+    if i1 == i2 == i3:
+        # An isotropic body (and every kinematic one) turns about L at ω = L/I: one exact
+        # turn, where the splitting's three would leave an O(h³) error a step.
+        norm = np.sqrt(px * px + py * py + pz * pz)
+        c, s = _library_half_angle(h * i1 * norm)
+        e = s / norm if norm > 0.0 else 0.0
+        w, x, y, z = multiply(w, x, y, z, c, e * px, e * py, e * pz)
+    elif largest <= SMALL_LIMIT:
         w, x, y, z, px, py, pz = _free_turns(
             w, x, y, z, px, py, pz, h, i1, i2, i3, _small_half_angle
         )
