@@ -400,3 +400,18 @@ def test_kinematic_and_static_bodies_move_as_given_whatever_acts():
 def test_driven_bodies_refuse_what_would_move_them_otherwise(body, message):
     with pytest.raises(vv.SceneError, match=message):
         _scene(**body).build()
+
+
+def test_a_push_at_a_world_point_turns_by_its_lever_arm_from_the_centre():
+    """A force (0, 0, 5) N at the world point 0.2 m beside a body's centre of mass for one step
+    of 0.01 s: ΔL = h (p − x) × F = 0.01 (0.2, 0, 0) × (0, 0, 5), whatever its orientation (the
+    point is fixed in space, not in the body)."""
+    q = np.array([np.cos(0.4), 0.0, np.sin(0.4), 0.0])
+    centre = np.array([1.0, 2.0, 3.0])
+    push = {"force": (0.0, 0.0, 5.0), "point": tuple(centre + [0.2, 0, 0]), "frame": "world",
+            "duration": 0.01}  # fmt: skip
+    builder = _scene(gravity=(0.0, 0.0, 0.0), orientation=q, position=centre, push=[push])
+    simulation = vv.Simulation(builder.build())
+    simulation.step(1)
+    expected = 0.01 * np.cross([0.2, 0.0, 0.0], [0.0, 0.0, 5.0])
+    np.testing.assert_allclose(simulation.state["body_angular_momentum"][0], expected, atol=1e-15)

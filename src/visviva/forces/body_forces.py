@@ -118,22 +118,26 @@ def _world_points(q: np.ndarray, body: np.ndarray, x: np.ndarray, arm: np.ndarra
 
 
 class BodyPush:
-    """Forces applied at points of bodies for a while: ``f`` [N] (world frame) at a point of
-    the body, from ``start`` to ``stop`` [s]; the body feels ``f`` and the torque ``(p − x) ×
-    f`` about its centre of mass (seed 002: a force off the centre of mass turns the body).
+    """Forces applied at points for a while: ``f`` [N] (world frame) at a point ``p`` of the
+    body (fixed in it, turning with it) or of the world (fixed in space: a jet on a stand),
+    from ``start`` to ``stop`` [s]; the body feels ``f`` and the torque ``(p − x) × f`` about
+    its centre of mass (seed 002: a force off the centre of mass turns the body).
 
     Args:
         body: ``(K,)`` the body each push acts on.
         force: ``(K, 3)`` [N].
-        arm: ``(K, 3)`` the point from the body's centre of mass, in its own axes [m].
+        arm: ``(K, 3)`` a body point from the body's centre of mass, in its own axes, or a
+            world point [m].
         start, stop: ``(K,)`` when each push acts [s] (``stop`` may be ``inf``).
+        world: ``(K,)`` which ``arm`` rows are world points (default: none).
     """
 
     conservative = False
     velocity_dependent = False
 
-    def __init__(self, body, force, arm, start, stop) -> None:  # type: ignore[no-untyped-def]
+    def __init__(self, body, force, arm, start, stop, world=None) -> None:  # type: ignore[no-untyped-def]
         self.body = np.asarray(body, dtype=np.int64)
+        self.world = np.zeros(self.body.shape[0], bool) if world is None else np.asarray(world)
         self.force = np.asarray(force, dtype=np.float64).reshape(-1, 3)
         self.arm = np.asarray(arm, dtype=np.float64).reshape(-1, 3)
         self.start = np.asarray(start, dtype=np.float64)
@@ -149,7 +153,9 @@ class BodyPush:
         if not on.any():
             return
         body = self.body[on]
-        points = _world_points(q, body, x, self.arm[on])
+        points = np.where(
+            self.world[on, None], self.arm[on], _world_points(q, body, x, self.arm[on])
+        )
         f, tau = wrench_at(x[body], points, self.force[on])
         np.add.at(force, body, f)
         np.add.at(torque, body, tau)

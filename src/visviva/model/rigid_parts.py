@@ -75,12 +75,21 @@ def _arm(point: Any, bodies: RigidBodies, body: int) -> np.ndarray:
 
 
 def _pushes(pushes: list[tuple[int, Push]], bodies: RigidBodies) -> BodyPush:
+    """The pushes: a body point as its arm from the centre of mass, a world point as it is
+    (the body's centre of mass at the start if none is given)."""
+    arms = [
+        (bodies.position[b] if p.point is None else np.asarray(p.point))
+        if p.frame == "world"
+        else _arm(p.point, bodies, b)
+        for b, p in pushes
+    ]
     return BodyPush(
         [b for b, _ in pushes],
         [p.force for _, p in pushes],
-        [_arm(p.point, bodies, b) for b, p in pushes],
+        arms,
         [p.start for _, p in pushes],
         [np.inf if p.duration is None else p.start + p.duration for _, p in pushes],
+        [p.frame == "world" for _, p in pushes],
     )
 
 

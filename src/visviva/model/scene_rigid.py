@@ -67,6 +67,9 @@ class Push(Strict):
     point: Vector | None = Field(
         None, description="where it acts, in the body's own axes [m] (default: centre of mass)"
     )
+    frame: Literal["body", "world"] = Field(
+        "body", description="`point` is a point of the body (turning with it) or of the world"
+    )
     start: NonNegative = Field(0.0, description="when it starts [s]")
     duration: Positive | None = Field(None, description="how long it acts [s] (default: ever)")
 
