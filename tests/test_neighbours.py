@@ -17,14 +17,8 @@ from numba import njit
 import visviva as vv
 from visviva.errors import ModelError
 from visviva.particles import neighbour_grid
-from visviva.particles.neighbour_grid import (
-    PARALLEL_MIN_POINTS,
-    NeighbourGrid,
-    cell_of,
-    cell_range,
-    neighbour_runs,
-    neighbours,
-)
+from visviva.particles.neighbour_cells import cell_of, cell_range, neighbour_runs
+from visviva.particles.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid, neighbours
 
 # --------------------------------------------------------------------------------------------
 # Brute force
@@ -144,6 +138,12 @@ def test_query_radius_smaller_than_the_grid():
     points = uniform_cloud(1500, 30.0)
     for query in (0.9, 0.5, 0.123, 1e-3):
         check_cloud(points, 1.0, query_radius=query)
+    # One grid, queries alternating radii: the pairs found for one radius are not reused.
+    grid = NeighbourGrid(1.0)
+    grid.update(points)
+    for query in (0.5, 1.0, None, 0.5, 0.7):
+        start, index = grid.neighbours(query)
+        assert_lists_match(start, index, points, 1.0 if query is None else query)
 
 
 def test_lists_ascending_without_the_point_itself():

@@ -35,15 +35,17 @@ atomic operation and no per-core histogram.
 **Queries.** A point's neighbours are the points of its 27 cells' buckets within ``r``:
 ``(xi − xj)² + (yi − yj)² + (zi − zj)² ≤ r²``, evaluated in float64 exactly so (this *is* the
 definition: a brute-force search written the same way gives the same sets).
-:meth:`NeighbourGrid.neighbours` gives every point's list in CSR form, each list ascending and
-without the point itself; :meth:`NeighbourGrid.pairs` every pair ``i < j`` once, in
-lexicographic order. Both count, take a prefix sum, then fill; neither branches on the
-distance test (its outcome is added), which the processor cannot predict.
+:meth:`NeighbourGrid.pairs` gives every pair ``i < j`` once, in lexicographic order;
+:meth:`NeighbourGrid.neighbours` every point's list in CSR form, ascending, without the point
+itself. Both come from one search that tests each pair once, from its end earlier in sorted
+order, then counting sorts (:mod:`~visviva.particles.neighbour_search`).
 
 **Kernels** that need neighbours every step (forces of boids and crowds, contacts) loop over
 the 27 cells themselves, without lists, on :attr:`NeighbourGrid.arrays` (a :class:`GridArrays`
-tuple Numba accepts) with :func:`cell_of` and :func:`neighbour_runs` (or :func:`cell_range`
-for one cell)::
+tuple Numba accepts) with :func:`~visviva.particles.neighbour_cells.cell_of` and
+:func:`~visviva.particles.neighbour_cells.neighbour_runs` (or
+:func:`~visviva.particles.neighbour_cells.cell_range` for one cell), imported from
+:mod:`visviva.particles.neighbour_cells`::
 
     @njit(parallel=True)
     def separation(g, radius, force):            # g = grid.arrays, after grid.update(x)
@@ -61,13 +63,13 @@ for one cell)::
                 force[g.order[s]] = ...
 
 Visiting points in sorted order keeps a cell's neighbourhood in cache for all of its points
-(the search of :meth:`~NeighbourGrid.neighbours` also reuses the runs while the cell stays the
-same). ``tests/test_neighbours.py`` runs this pattern against brute force.
+(the queries also reuse the runs while the cell stays the same). ``tests/test_neighbours.py``
+runs this pattern against brute force.
 
 **Cost.** Rebuild O(N + T) = O(N); queries O(N · k) for k points in the 27 cells (about 27/4.19
-≈ 6.4 times the neighbours within ``r`` in a uniform cloud). Memory: 48 bytes per point
-(bucket, order, sorted x, y, z) plus 16–32 bytes of table, plus, for a query's results,
-8 bytes per point and 8 per list entry (16 per pair).
+≈ 6.4 times the neighbours within ``r`` in a uniform cloud; half of them are tested). Memory:
+48 bytes per point (bucket, order, sorted x, y, z) plus 16–32 bytes of table; the queries add
+16 bytes per point and 32 per pair (found, then sorted), and the lists 16 more per pair.
 
 **Determinism.** The sort is stable (points of one bucket in ascending index), so its result
 is unique: the same positions give the same arrays whatever the number of threads, and the
@@ -82,357 +84,29 @@ underflow. Within these, the margin of ``h`` over ``r`` (2⁻¹⁰) exceeds ever
 
 from __future__ import annotations
 
-import math
-from typing import Any, NamedTuple
+from typing import Any
 
 import numba
 import numpy as np
-from numba import njit, prange
 
 from .._validation import describe, real_number
 from ..errors import ModelError
-from .random import _mix
+from .neighbour_cells import (
+    CELL_MARGIN,
+    MAX_CELLS,
+    MAX_COORDINATE,
+    MIN_RADIUS,
+    GridArrays,
+    _rebuild_parallel,
+    _rebuild_serial,
+)
+from .neighbour_search import count_pairs, find_pairs, list_pairs, order_pairs, pair_offsets
 
-__all__ = [
-    "CELL_MARGIN",
-    "GridArrays",
-    "NeighbourGrid",
-    "cell_of",
-    "cell_range",
-    "neighbour_runs",
-    "neighbours",
-]
-
-#: Cell edge over the interaction radius. The excess, 2⁻¹⁰, exceeds the rounding of
-#: ``x / h`` (at most 2⁻¹² of a cell within ``MAX_CELLS``) plus that of a distance, so any
-#: point within ``r`` lies in one of the 27 cells around a point's own.
-CELL_MARGIN = 1.0 + 2.0**-10
-
-#: Largest ``|x| / h`` accepted: cell integers stay exact and ``x / h`` rounds by < 2⁻¹².
-MAX_CELLS = 2.0**40
-
-#: Bounds of the radius and of coordinates [m]: squares of distances stay normal floats.
-MIN_RADIUS = 1e-150
-MAX_COORDINATE = 1e150
+__all__ = ["PARALLEL_MIN_POINTS", "NeighbourGrid", "neighbours"]
 
 #: Fewest points for which a rebuild or query uses every core (measured in
 #: benchmarks/bench_neighbours.py: starting a parallel region costs 10–90 µs).
 PARALLEL_MIN_POINTS = 8192
-
-#: Sorted points per parallel task of a query.
-CHUNK = 256
-
-# Odd 64-bit multipliers of a block's three integers (the golden ratio's and two of xxHash's).
-_HX = np.uint64(0x9E3779B97F4A7C15)
-_HY = np.uint64(0xC2B2AE3D27D4EB4F)
-_HZ = np.uint64(0x165667B19E3779F9)
-
-
-class GridArrays(NamedTuple):
-    """The grid after an update, for Numba kernels: ``n`` live points in bucket order.
-
-    Attributes:
-        start: First sorted position of each bucket, shape ``(T + 1,)``; bucket ``b`` holds
-            sorted positions ``start[b] .. start[b + 1] − 1``.
-        order: Index (row of ``positions``) of the point at each sorted position, ``(n,)``.
-        x, y, z: Coordinates [m] in sorted order, ``(n,)`` each.
-        inv_cell: ``1 / h`` [1/m].
-        block_mask: The table's count of blocks (a power of two) minus one: it has
-            ``T = 27 (block_mask + 1)`` buckets.
-    """
-
-    start: np.ndarray
-    order: np.ndarray
-    x: np.ndarray
-    y: np.ndarray
-    z: np.ndarray
-    inv_cell: float
-    block_mask: int
-
-
-@njit(cache=True, inline="always")
-def _bucket(cx, cy, cz, block_mask):  # pragma: no cover - compiled
-    """Bucket of cell ``(cx, cy, cz)``: 27 × (hash of its 3×3×3 block) + its slot in the block."""
-    bx, by, bz = cx // 3, cy // 3, cz // 3  # floor division, also for negative cells
-    slot = (cx - 3 * bx) + 3 * (cy - 3 * by) + 9 * (cz - 3 * bz)
-    key = np.uint64(bx) * _HX + np.uint64(by) * _HY + np.uint64(bz) * _HZ
-    return 27 * np.int64(_mix(key) & np.uint64(block_mask)) + slot
-
-
-@njit(cache=True, inline="always")
-def cell_of(x, y, z, inv_cell):  # pragma: no cover - compiled
-    """The cell integers ``floor(x / h)`` of a point (Numba; ``inv_cell = 1 / h``)."""
-    return (
-        np.int64(math.floor(x * inv_cell)),
-        np.int64(math.floor(y * inv_cell)),
-        np.int64(math.floor(z * inv_cell)),
-    )
-
-
-@njit(cache=True, inline="always")
-def cell_range(g, cx, cy, cz):  # pragma: no cover - compiled
-    """Sorted positions ``(begin, end)`` of the bucket of cell ``(cx, cy, cz)`` (Numba).
-
-    The bucket holds every point of the cell and maybe points of far cells (whose blocks
-    share a hash): a distance test keeps the right ones. The 27 cells around any cell have
-    27 different buckets, so visiting them never meets a point twice.
-    """
-    b = _bucket(cx, cy, cz, g.block_mask)
-    return g.start[b], g.start[b + 1]
-
-
-@njit(cache=True, inline="always")
-def neighbour_runs(g, cx, cy, cz, runs):  # pragma: no cover - compiled
-    """The points of the 27 cells around cell ``(cx, cy, cz)`` as runs of sorted positions.
-
-    Fills ``runs`` (a ``(27, 2)`` int64 scratch array) with ``(begin, end)`` pairs, empty
-    buckets left out and adjacent ones joined (cells of one block lie side by side), and
-    returns how many (Numba). The runs are disjoint: no point appears twice.
-    """
-    m = 0
-    for dz in range(-1, 2):
-        for dy in range(-1, 2):
-            for dx in range(-1, 2):
-                begin, end = cell_range(g, cx + dx, cy + dy, cz + dz)
-                if begin == end:
-                    continue
-                if m and runs[m - 1, 1] == begin:
-                    runs[m - 1, 1] = end
-                else:
-                    runs[m, 0], runs[m, 1] = begin, end
-                    m += 1
-    return m
-
-
-# ---------------------------------------------------------------------------------------------
-# Rebuild: keys, counting sort by bucket range, gather
-# ---------------------------------------------------------------------------------------------
-
-
-@njit(cache=True, inline="always")
-def _within(x, inv_cell):  # pragma: no cover - compiled
-    """Whether a coordinate is in the grid's range (false for NaN and infinities)."""
-    return abs(x) <= MAX_COORDINATE and abs(x) * inv_cell < MAX_CELLS
-
-
-@njit(cache=True)
-def _keys_chunk(points, alive, inv_cell, block_mask, keys, begin, end):  # pragma: no cover
-    """Buckets of rows ``begin .. end − 1`` (−1 if dead); return the first bad row or −1."""
-    for i in range(begin, end):
-        if alive.shape[0] and not alive[i]:
-            keys[i] = -1
-            continue
-        x, y, z = points[i, 0], points[i, 1], points[i, 2]
-        if not (_within(x, inv_cell) and _within(y, inv_cell) and _within(z, inv_cell)):
-            return i
-        cx, cy, cz = cell_of(x, y, z, inv_cell)
-        keys[i] = _bucket(cx, cy, cz, block_mask)
-    return -1
-
-
-@njit(cache=True)
-def _count_part(keys, start, lo, hi):  # pragma: no cover - compiled
-    """Inclusive prefix sums of the bucket counts in ``lo .. hi − 1``; return their total."""
-    for b in range(lo, hi):
-        start[b] = 0
-    for i in range(keys.shape[0]):
-        k = keys[i]
-        if lo <= k < hi:
-            start[k] += 1
-    total = 0
-    for b in range(lo, hi):
-        total += start[b]
-        start[b] = total
-    return total
-
-
-@njit(cache=True)
-def _scatter_part(keys, start, order, lo, hi, offset):  # pragma: no cover - compiled
-    """Make ``start[lo:hi]`` global and place this range's points, stably.
-
-    Each bucket's end is decremented as its points arrive from the last to the first, so it
-    ends at the bucket's first position and every bucket keeps its points in index order.
-    """
-    for b in range(lo, hi):
-        start[b] += offset
-    for i in range(keys.shape[0] - 1, -1, -1):
-        k = keys[i]
-        if lo <= k < hi:
-            start[k] -= 1
-            order[start[k]] = i
-
-
-@njit(cache=True)
-def _gather_chunk(points, order, x, y, z, begin, end):  # pragma: no cover - compiled
-    for s in range(begin, end):
-        i = order[s]
-        x[s], y[s], z[s] = points[i, 0], points[i, 1], points[i, 2]
-
-
-# One serial and one parallel driver per pass: separate functions, each with its own entry in
-# Numba's on-disk cache. The parallel one splits the buckets into ``parts`` ranges and the rows
-# into ``bad.shape[0]`` tasks; ``bad`` gets each task's first bad row (or −1).
-
-
-@njit(cache=True)
-def _rebuild_serial(points, alive, inv_cell, block_mask, keys, start, order, x, y, z, bad, parts):
-    n = points.shape[0]  # pragma: no cover - compiled
-    table = 27 * (block_mask + 1)
-    bad[0] = _keys_chunk(points, alive, inv_cell, block_mask, keys, 0, n)
-    if bad[0] >= 0:
-        return 0
-    count = _count_part(keys, start, 0, table)
-    _scatter_part(keys, start, order, 0, table, 0)
-    start[table] = count
-    _gather_chunk(points, order, x, y, z, 0, count)
-    return count
-
-
-@njit(cache=True, parallel=True)
-def _rebuild_parallel(points, alive, inv_cell, block_mask, keys, start, order, x, y, z, bad, parts):
-    n = points.shape[0]  # pragma: no cover - compiled
-    table = 27 * (block_mask + 1)
-    tasks = bad.shape[0]
-    for k in prange(tasks):
-        begin, end = k * n // tasks, (k + 1) * n // tasks
-        bad[k] = _keys_chunk(points, alive, inv_cell, block_mask, keys, begin, end)
-    for k in range(tasks):
-        if bad[k] >= 0:
-            return 0
-    totals = np.empty(parts, dtype=np.int64)
-    for p in prange(parts):
-        totals[p] = _count_part(keys, start, p * table // parts, (p + 1) * table // parts)
-    offsets = np.zeros(parts, dtype=np.int64)
-    for p in range(1, parts):
-        offsets[p] = offsets[p - 1] + totals[p - 1]
-    for p in prange(parts):
-        lo, hi = p * table // parts, (p + 1) * table // parts
-        _scatter_part(keys, start, order, lo, hi, offsets[p])
-    count = offsets[parts - 1] + totals[parts - 1]
-    start[table] = count
-    for k in prange(tasks):
-        _gather_chunk(points, order, x, y, z, k * count // tasks, (k + 1) * count // tasks)
-    return count
-
-
-# ---------------------------------------------------------------------------------------------
-# Queries: count, prefix sum, fill
-# ---------------------------------------------------------------------------------------------
-
-
-@njit(cache=True)
-def _count_chunk(g, r2, upper, start, runs, begin, end):  # pragma: no cover - compiled
-    """Store in ``start[i + 1]`` how many neighbours (``j > i`` only, if ``upper``) each point
-    at sorted positions ``begin .. end − 1`` has. Branch-free: the test's outcome is added.
-    The runs of the 27 cells are recomputed only when the cell changes from one point to the
-    next (a cell's points are neighbours in sorted order)."""
-    m = 0
-    px = py = pz = np.int64(0)
-    for s in range(begin, end):
-        xi, yi, zi = g.x[s], g.y[s], g.z[s]
-        cx, cy, cz = cell_of(xi, yi, zi, g.inv_cell)
-        if s == begin or cx != px or cy != py or cz != pz:
-            m = neighbour_runs(g, cx, cy, cz, runs)
-            px, py, pz = cx, cy, cz
-        i = g.order[s]
-        found = 0
-        for k in range(m):
-            if upper:
-                for t in range(runs[k, 0], runs[k, 1]):
-                    ex, ey, ez = xi - g.x[t], yi - g.y[t], zi - g.z[t]
-                    found += (ex * ex + ey * ey + ez * ez <= r2) & (g.order[t] > i)
-            else:
-                for t in range(runs[k, 0], runs[k, 1]):
-                    ex, ey, ez = xi - g.x[t], yi - g.y[t], zi - g.z[t]
-                    found += ex * ex + ey * ey + ez * ez <= r2
-        # Without ``upper`` the point itself was counted (its distance is 0).
-        start[i + 1] = found if upper else found - 1
-
-
-@njit(cache=True)
-def _fill_chunk(g, r2, upper, start, index, first, runs, begin, end):  # pragma: no cover
-    """Write the lists counted by :func:`_count_chunk` from ``start[i]`` on, ascending (and
-    ``i`` at the same places of ``first`` unless it is empty). Candidates go to a scratch
-    list unconditionally, the test's outcome advancing its end (no branch to mispredict);
-    the list is then sorted and copied."""
-    scratch = np.empty(64, dtype=np.int64)
-    m = 0
-    px = py = pz = np.int64(0)
-    for s in range(begin, end):
-        xi, yi, zi = g.x[s], g.y[s], g.z[s]
-        cx, cy, cz = cell_of(xi, yi, zi, g.inv_cell)
-        if s == begin or cx != px or cy != py or cz != pz:
-            m = neighbour_runs(g, cx, cy, cz, runs)
-            px, py, pz = cx, cy, cz
-            candidates = 0
-            for k in range(m):
-                candidates += runs[k, 1] - runs[k, 0]
-            if scratch.shape[0] <= candidates:
-                scratch = np.empty(2 * candidates, dtype=np.int64)
-        i = g.order[s]
-        found = 0
-        for k in range(m):
-            for t in range(runs[k, 0], runs[k, 1]):
-                ex, ey, ez = xi - g.x[t], yi - g.y[t], zi - g.z[t]
-                j = g.order[t]
-                scratch[found] = j
-                if upper:
-                    found += (ex * ex + ey * ey + ez * ez <= r2) & (j > i)
-                else:
-                    found += (ex * ex + ey * ey + ez * ez <= r2) & (t != s)
-        # Insertion sort: a list is short (tens), and ascends already within each run.
-        for a in range(1, found):
-            value = scratch[a]
-            b = a - 1
-            while b >= 0 and scratch[b] > value:
-                scratch[b + 1] = scratch[b]
-                b -= 1
-            scratch[b + 1] = value
-        base = start[i]
-        for a in range(found):
-            index[base + a] = scratch[a]
-        if first.shape[0]:
-            for a in range(found):
-                first[base + a] = i
-
-
-@njit(cache=True)
-def _search_serial(g, r2, upper, start, index, first):  # pragma: no cover - compiled
-    runs = np.empty((27, 2), dtype=np.int64)
-    n = g.order.shape[0]
-    if index.shape[0]:
-        _fill_chunk(g, r2, upper, start, index, first, runs, 0, n)
-    else:
-        _count_chunk(g, r2, upper, start, runs, 0, n)
-
-
-@njit(cache=True, parallel=True)
-def _search_parallel(g, r2, upper, start, index, first):  # pragma: no cover - compiled
-    n = g.order.shape[0]
-    fill = index.shape[0] > 0
-    for k in prange((n + CHUNK - 1) // CHUNK):
-        runs = np.empty((27, 2), dtype=np.int64)
-        b, e = k * CHUNK, min(n, (k + 1) * CHUNK)
-        if fill:
-            _fill_chunk(g, r2, upper, start, index, first, runs, b, e)
-        else:
-            _count_chunk(g, r2, upper, start, runs, b, e)
-
-
-@njit(cache=True)
-def _prefix(start, keys):  # pragma: no cover - compiled
-    """Zero the counts of dead rows (key −1), then turn the counts in ``start[1:]`` into
-    offsets: ``start[i]`` is where row ``i``'s list begins."""
-    start[0] = 0
-    for i in range(keys.shape[0]):
-        if keys[i] < 0:
-            start[i + 1] = 0
-        start[i + 1] += start[i]
-
-
-# ---------------------------------------------------------------------------------------------
-# The Python side: validation, buffers, drivers
-# ---------------------------------------------------------------------------------------------
 
 _NO_MASK = np.zeros(0, dtype=np.bool_)
 _NO_ROWS = np.zeros(0, dtype=np.int64)
@@ -510,8 +184,8 @@ class NeighbourGrid:
 
     Buffers are kept between updates and grow (by half) only when a larger cloud or result
     arrives, so a steady simulation allocates nothing per step. Query results are read-only
-    views of those buffers, valid until the next query of the same kind or the next update:
-    copy what you keep.
+    views of those buffers, valid until the next update or a query with another radius: copy
+    what you keep. The pairs found by one query serve the next with the same radius.
 
     >>> import numpy as np
     >>> grid = NeighbourGrid(1.0)
@@ -537,10 +211,14 @@ class NeighbourGrid:
         self._table = np.zeros(28, dtype=np.int64)
         self._block_mask = 0
         self._bad = np.empty(_REBUILD_TASKS, dtype=np.int64)
-        self._start = np.zeros(1, dtype=np.int64)
-        self._index = _NO_ROWS
-        self._pair_start = np.zeros(1, dtype=np.int64)
-        self._first = self._second = _NO_ROWS
+        # Queries: pairs as found (a, b) and sorted (first, second), offsets per sorted
+        # position and per row, lists; ``_found`` says for which update and radius the pairs
+        # are ready.
+        self._offsets = self._row = self._start = np.zeros(1, dtype=np.int64)
+        self._a = self._b = self._first = self._second = self._index = _NO_ROWS
+        self._pair_count = 0
+        self._generation = 0
+        self._found: tuple[int, float] | None = None
         self.arrays = self._arrays()
 
     @property
@@ -582,9 +260,11 @@ class NeighbourGrid:
         failed = bad[bad >= 0]
         if failed.size:
             self._count, self._rows = 0, 0
+            self._generation += 1
             self.arrays = self._arrays()
             self._refuse(points, int(failed[0]))
         self._rows, self._count = rows, int(count)
+        self._generation += 1
         self.arrays = self._arrays()
 
     def _refuse(self, points: np.ndarray, row: int) -> None:
@@ -609,25 +289,39 @@ class NeighbourGrid:
             )
         return value * value
 
-    def _search(self, radius: Any, upper: bool, start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Count, prefix sum, fill: ``(index, first)`` of the lists whose offsets go into
-        ``start`` (``first`` only for pairs)."""
+    def _pairs(self, radius: Any) -> int:
+        """Find and sort the pairs within ``radius`` (unless done since the last update)."""
         r2 = self._radius2(radius)
-        search = _search_parallel if self._count >= PARALLEL_MIN_POINTS else _search_serial
-        grid = self.arrays
-        search(grid, r2, upper, start, _NO_ROWS, _NO_ROWS)
-        _prefix(start, self._keys[: self._rows])
-        total = int(start[self._rows])
-        if upper:
-            self._first = _grown(self._first, total)
-            self._second = _grown(self._second, total)
-            index, first = self._second[:total], self._first[:total]
-        else:
-            self._index = _grown(self._index, total)
-            index, first = self._index[:total], _NO_ROWS
+        if self._found == (self._generation, r2):
+            return self._pair_count
+        grid, n, rows = self.arrays, self._count, self._rows
+        parallel = n >= PARALLEL_MIN_POINTS
+        parts = numba.get_num_threads() if parallel else 1
+        self._offsets = _grown(self._offsets, n + 1)
+        offsets = self._offsets[: n + 1]
+        count_pairs(grid, r2, offsets, parallel)
+        total = int(pair_offsets(offsets))
+        for name in ("_a", "_b", "_first", "_second"):
+            setattr(self, name, _grown(getattr(self, name), total))
+        a, b = self._a[:total], self._b[:total]
         if total:
-            search(grid, r2, upper, start, index, first)
-        return _read_only(index), _read_only(first)
+            find_pairs(grid, r2, offsets, a, b, parallel)
+        self._row = _grown(self._row, rows + 1)
+        first, second = self._first[:total], self._second[:total]
+        order_pairs(a, b, self._row[: rows + 1], first, second, parts, parallel)
+        self._found, self._pair_count = (self._generation, r2), total
+        return total
+
+    def pairs(self, radius: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Every pair of points within ``radius`` [m] (default: the grid's), once.
+
+        Returns:
+            ``(first, second)``, shape ``(P,)`` each, with ``first < second``, in
+            lexicographic order. Read-only views, valid until the next :meth:`update` or a
+            query with another radius.
+        """
+        total = self._pairs(radius)
+        return _read_only(self._first[:total]), _read_only(self._second[:total])
 
     def neighbours(self, radius: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Every point's neighbours within ``radius`` [m] (default: the grid's), as CSR lists.
@@ -635,24 +329,19 @@ class NeighbourGrid:
         Returns:
             ``(start, index)``: the neighbours of point ``i`` are ``index[start[i] :
             start[i + 1]]``, ascending, without ``i``; ``start`` has shape ``(N + 1,)``.
-            Read-only views, valid until the next :meth:`neighbours` or :meth:`update`.
+            Read-only views, valid until the next :meth:`update` or a query with another
+            radius.
         """
-        self._start = _grown(self._start, self._rows + 1)
-        start = self._start[: self._rows + 1]
-        index, _ = self._search(radius, False, start)
-        return _read_only(start), index
-
-    def pairs(self, radius: float | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Every pair of points within ``radius`` [m] (default: the grid's), once.
-
-        Returns:
-            ``(first, second)``, shape ``(P,)`` each, with ``first < second``, in
-            lexicographic order. Read-only views, valid until the next :meth:`pairs` or
-            :meth:`update`.
-        """
-        self._pair_start = _grown(self._pair_start, self._rows + 1)
-        second, first = self._search(radius, True, self._pair_start[: self._rows + 1])
-        return first, second
+        total = self._pairs(radius)
+        rows = self._rows
+        parallel = self._count >= PARALLEL_MIN_POINTS
+        parts = numba.get_num_threads() if parallel else 1
+        self._start = _grown(self._start, rows + 1)
+        self._index = _grown(self._index, 2 * total)
+        start, index = self._start[: rows + 1], self._index[: 2 * total]
+        first, second = self._first[:total], self._second[:total]
+        list_pairs(first, second, start, index, parts, parallel)
+        return _read_only(start), _read_only(index)
 
 
 def neighbours(positions: Any, radius: float, alive: Any = None) -> tuple[np.ndarray, np.ndarray]:
