@@ -15,7 +15,8 @@ order, as a simulation's particles are.
 
 * visviva: ``NeighbourGrid.update(positions)`` then ``grid.neighbours()`` (CSR lists, each
   ascending, without the point itself), on every core and on one thread; and the update
-  alone, the per-step cost a force kernel that loops over cells pays before its own work;
+  alone (it runs on one core), the per-step cost a force kernel that loops over cells pays
+  before its own work;
 * SciPy: ``cKDTree(positions)`` then ``tree.query_ball_point(positions, r, workers=W)`` with
   W = 2 (every core) and 1; it returns a NumPy array of Python lists (unsorted), which is
   timed as it comes: turning it into arrays (``--quick`` shows how long) is left out, to
@@ -33,9 +34,10 @@ SciPy runner with the same cores. The cost ratio is the time at the larger N ove
 the smaller (10 for linear cost). Each run checks that both give the same sets: the lists
 point by point, the pairs as sorted arrays (random reals make exact ties at r improbable).
 
-(c) Where two cores pay: the rebuild and the neighbour lists forced onto the serial and onto
-the parallel kernels at N = 1,000 … 64,000 (``--quick``: 1,000 and 8,000), the measurement
-behind ``PARALLEL_MIN_POINTS``.
+(c) Where two cores pay: ``update`` + ``neighbours()`` with the queries forced onto the serial
+and onto the parallel kernels at N = 250 … 64,000 (``--quick``: 250 and 8,000), the
+measurement behind ``PARALLEL_MIN_POINTS`` (the rebuild always runs on one core; see
+``visviva.particles.neighbour_cells`` for why).
 
 This is not a test: it prints figures and exits 1 only if a sanity check fails.
 """
@@ -146,8 +148,7 @@ def plan_for(part: str, points: np.ndarray, cores: int) -> list[tuple[str, int, 
         return [
             (f"visviva update + neighbours(), {cores} threads", cores, visviva_lists),
             ("visviva update + neighbours(), 1 thread", 1, visviva_lists),
-            (f"visviva update alone, {cores} threads", cores, update_only),
-            ("visviva update alone, 1 thread", 1, update_only),
+            ("visviva update alone (always 1 thread)", cores, update_only),
             (f"cKDTree + query_ball_point, workers={cores}", cores, tree_lists(cores)),
             ("cKDTree + query_ball_point, workers=1", 1, tree_lists(1)),
         ]
@@ -176,7 +177,7 @@ def bench_queries(args: argparse.Namespace, checks: Checks) -> dict[tuple[str, i
                 rows.append([label, f"{n:,}", fmt_time(timing.median), timing.spread, timing.busy])
             if part == "a":
                 start, index = results[plan[0][0]]
-                tree = results[plan[4][0]]
+                tree = results[plan[3][0]]
                 checks.check(
                     same_lists(start, index, tree),
                     f"N = {n:,}: visviva's lists are cKDTree's sets "
@@ -244,10 +245,10 @@ def summarise(args: argparse.Namespace, medians: dict[tuple[str, int], float]) -
         cells.append(f"{medians[(ours, large)] / medians[(ours, small)]:.1f}")
         cells.append(f"{medians[(theirs, large)] / medians[(theirs, small)]:.1f}")
         rows.append(cells)
-    update = f"visviva update alone, {cores} threads"
+    update = "visviva update alone (always 1 thread)"
     rows.append(
         [
-            f"update alone, {cores} threads (no peer)",
+            "update alone (no peer)",
             *["" for _ in args.sizes],
             f"{medians[(update, large)] / medians[(update, small)]:.1f}",
             "",
@@ -272,7 +273,7 @@ def summarise(args: argparse.Namespace, medians: dict[tuple[str, int], float]) -
 def bench_parallel(args: argparse.Namespace) -> None:
     cores = min(2, numba.config.NUMBA_NUM_THREADS)
     heading(
-        f"(c) Serial and parallel kernels ({cores} threads); now PARALLEL_MIN_POINTS = "
+        f"(c) Serial and parallel queries ({cores} threads); now PARALLEL_MIN_POINTS = "
         f"{neighbour_grid.PARALLEL_MIN_POINTS:,}"
     )
     saved = neighbour_grid.PARALLEL_MIN_POINTS
@@ -280,30 +281,39 @@ def bench_parallel(args: argparse.Namespace) -> None:
     try:
         for n in args.threshold_sizes:
             points = cloud(n, SEED + 1)
-            cells = [f"{n:,}"]
-            for threshold in (10**12, 0):  # serial kernels, then parallel ones
+            grid = NeighbourGrid(RADIUS)
+
+            def both(grid: NeighbourGrid = grid, points: np.ndarray = points) -> None:
+                grid.update(points)
+                grid.neighbours()
+
+            update = measure(partial(grid.update, points), args.repeats, f"update N = {n}")
+            medians, busy = [], []
+            for threshold in (10**12, 0):  # serial queries, then parallel ones
                 neighbour_grid.PARALLEL_MIN_POINTS = threshold
-                grid = NeighbourGrid(RADIUS)
-
-                def both(grid: NeighbourGrid = grid, points: np.ndarray = points) -> None:
-                    grid.update(points)
-                    grid.neighbours()
-
-                update = measure(partial(grid.update, points), args.repeats, f"update N = {n}")
-                lists = measure(both, args.repeats, f"update + neighbours N = {n}")
-                cells += [fmt_time(update.median), fmt_time(lists.median), lists.busy]
-            rows.append(cells)
+                timing = measure(both, args.repeats, f"update + neighbours N = {n}")
+                medians.append(timing.median)
+                busy.append(timing.busy)
+            rows.append(
+                [
+                    f"{n:,}",
+                    fmt_time(update.median),
+                    fmt_time(medians[0]),
+                    fmt_time(medians[1]),
+                    f"{medians[0] / medians[1]:.2f}",
+                    " / ".join(busy),
+                ]
+            )
     finally:
         neighbour_grid.PARALLEL_MIN_POINTS = saved
     print_table(
         [
             "N",
-            "serial update",
-            "serial update + neighbours()",
-            "busy",
-            "parallel update",
-            "parallel update + neighbours()",
-            "busy",
+            "update (1 core)",
+            "update + neighbours(), serial",
+            f"parallel ({cores} threads)",
+            "serial / parallel",
+            "others busy",
         ],
         rows,
     )
@@ -347,7 +357,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         args.retries = 0 if args.quick else 2
     args.sizes = (1_000, 10_000) if args.quick else (10_000, 100_000)
     args.threshold_sizes = (
-        (1_000, 8_000) if args.quick else (1_000, 2_000, 4_000, 8_000, 16_000, 32_000, 64_000)
+        (250, 8_000) if args.quick else (250, 500, 1_000, 2_000, 4_000, 8_000, 16_000, 64_000)
     )
     PATIENCE["retries"] = max(0, args.retries)
     PATIENCE["quiet_wait"] = max(0.0, args.quiet_wait)

@@ -26,11 +26,11 @@ the same hash: the distance test discards them.
 **The rebuild** (:meth:`NeighbourGrid.update`) is a counting sort of the points by bucket
 (Cormen, Leiserson, Rivest & Stein, *Introduction to Algorithms*, §8.2): each live point's
 bucket, a histogram, a prefix sum giving each bucket's first position, and a stable scatter
-(from the last point to the first, each bucket's end counting down); then the coordinates are
-gathered in sorted order, so a bucket's points are one contiguous run of structure-of-arrays
-memory. On two cores the buckets are split into one range per core: each core counts, sums
-and scatters the points of its range (reading every key, writing only its own), with no
-atomic operation and no per-core histogram.
+(each bucket's cursor counting up); then the coordinates are gathered in sorted order, so a
+bucket's points are one contiguous run of structure-of-arrays memory. It runs on one core:
+it is bound by the latency of its scattered reads and writes, and split over two (a chunk of
+the points and a histogram per core) it measured no faster, up to 10⁶ points. The queries,
+which compute, use both cores from ``PARALLEL_MIN_POINTS`` points on (1.7 times faster).
 
 **Queries.** A point's neighbours are the points of its 27 cells' buckets within ``r``:
 ``(xi − xj)² + (yi − yj)² + (zi − zj)² ≤ r²``, evaluated in float64 exactly so (this *is* the
@@ -97,21 +97,20 @@ from .neighbour_cells import (
     MAX_COORDINATE,
     MIN_RADIUS,
     GridArrays,
-    _rebuild_parallel,
-    _rebuild_serial,
+    _rebuild,
 )
 from .neighbour_search import count_pairs, find_pairs, list_pairs, order_pairs, pair_offsets
 
 __all__ = ["PARALLEL_MIN_POINTS", "NeighbourGrid", "neighbours"]
 
-#: Fewest points for which a rebuild or query uses every core (measured in
-#: benchmarks/bench_neighbours.py: starting a parallel region costs 10–90 µs).
-PARALLEL_MIN_POINTS = 8192
+#: Fewest live points for which a query uses every core (the rebuild always runs on one: see
+#: neighbour_cells). Measured (benchmarks/bench_neighbours.py, part (c)): at 500 points two
+#: threads count pairs in 22 µs against 36 µs on one; at 250 they tie (a parallel region
+#: costs 10–90 µs to start).
+PARALLEL_MIN_POINTS = 512
 
 _NO_MASK = np.zeros(0, dtype=np.bool_)
 _NO_ROWS = np.zeros(0, dtype=np.int64)
-#: Rows per parallel task of a rebuild's key and gather passes.
-_REBUILD_TASKS = 16
 
 
 def _check_radius(name: str, value: Any) -> float:
@@ -210,7 +209,7 @@ class NeighbourGrid:
         self._x = self._y = self._z = np.zeros(0)
         self._table = np.zeros(28, dtype=np.int64)
         self._block_mask = 0
-        self._bad = np.empty(_REBUILD_TASKS, dtype=np.int64)
+        self._hist = _NO_ROWS
         # Queries: pairs as found (a, b) and sorted (first, second), offsets per sorted
         # position and per row, lists; ``_found`` says for which update and radius the pairs
         # are ready.
@@ -249,23 +248,24 @@ class NeighbourGrid:
         blocks = _blocks(rows)
         self._table = _grown(self._table, 27 * blocks + 1)
         self._block_mask = blocks - 1
-        parallel = rows >= PARALLEL_MIN_POINTS
-        rebuild = _rebuild_parallel if parallel else _rebuild_serial
-        bad = self._bad if parallel else self._bad[:1]
-        keys = self._keys[:rows]
-        count = rebuild(
-            points, mask, self._inv_cell, self._block_mask, keys, self._table, self._order,
-            self._x, self._y, self._z, bad, numba.get_num_threads(),
+        count = _rebuild(
+            points, mask, self._inv_cell, self._block_mask, self._keys[:rows], self._table,
+            self._order, self._x, self._y, self._z, self._histogram(27 * blocks, False),
         )  # fmt: skip
-        failed = bad[bad >= 0]
-        if failed.size:
+        if count < 0:
             self._count, self._rows = 0, 0
             self._generation += 1
             self.arrays = self._arrays()
-            self._refuse(points, int(failed[0]))
-        self._rows, self._count = rows, int(count)
+            self._refuse(points, -1 - count)
+        self._rows, self._count = rows, count
         self._generation += 1
         self.arrays = self._arrays()
+
+    def _histogram(self, buckets: int, parallel: bool) -> np.ndarray:
+        """Scratch counts for a counting sort: one row of ``buckets`` per thread (1: serial)."""
+        parts = numba.get_num_threads() if parallel else 1
+        self._hist = _grown(self._hist, parts * buckets)
+        return self._hist[: parts * buckets].reshape(parts, buckets)
 
     def _refuse(self, points: np.ndarray, row: int) -> None:
         point = points[row]
@@ -296,7 +296,6 @@ class NeighbourGrid:
             return self._pair_count
         grid, n, rows = self.arrays, self._count, self._rows
         parallel = n >= PARALLEL_MIN_POINTS
-        parts = numba.get_num_threads() if parallel else 1
         self._offsets = _grown(self._offsets, n + 1)
         offsets = self._offsets[: n + 1]
         count_pairs(grid, r2, offsets, parallel)
@@ -308,7 +307,8 @@ class NeighbourGrid:
             find_pairs(grid, r2, offsets, a, b, parallel)
         self._row = _grown(self._row, rows + 1)
         first, second = self._first[:total], self._second[:total]
-        order_pairs(a, b, self._row[: rows + 1], first, second, parts, parallel)
+        hist = self._histogram(rows, parallel)
+        order_pairs(a, b, self._row[: rows + 1], first, second, hist, parallel)
         self._found, self._pair_count = (self._generation, r2), total
         return total
 
@@ -335,12 +335,11 @@ class NeighbourGrid:
         total = self._pairs(radius)
         rows = self._rows
         parallel = self._count >= PARALLEL_MIN_POINTS
-        parts = numba.get_num_threads() if parallel else 1
         self._start = _grown(self._start, rows + 1)
         self._index = _grown(self._index, 2 * total)
         start, index = self._start[: rows + 1], self._index[: 2 * total]
         first, second = self._first[:total], self._second[:total]
-        list_pairs(first, second, start, index, parts, parallel)
+        list_pairs(first, second, start, index, self._histogram(rows, parallel), parallel)
         return _read_only(start), _read_only(index)
 
 

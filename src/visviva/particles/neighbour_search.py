@@ -15,8 +15,9 @@ partners ``a < r`` from the pairs ``(a, r)``, which come first in that order and
 its partners ``b > r`` from its own pairs, ascending, so every list comes out sorted with no
 further sort.
 
-The counting sorts split the rows into one range per core: each core reads every pair and
-writes only the rows of its range, so results do not depend on the number of threads.
+The counting sorts give each core a chunk of the pairs and a histogram of its own (see
+:mod:`~visviva.particles.neighbour_cells`): their result is the serial stable sort's, whatever
+the number of threads.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .neighbour_cells import _count_part, cell_of, neighbour_runs
+from .neighbour_cells import _column_offsets, _histogram, _prefix_columns, cell_of, neighbour_runs
 
 __all__ = ["CHUNK", "count_pairs", "find_pairs", "list_pairs", "order_pairs", "pair_offsets"]
 
@@ -128,21 +129,18 @@ def find_pairs(g, r2: float, count: np.ndarray, a: np.ndarray, b: np.ndarray, pa
 
 
 # ---------------------------------------------------------------------------------------------
-# Lexicographic order, then lists
+# Lexicographic order, then lists: stable counting sorts over rows (see neighbour_cells), one
+# chunk of the pairs per core, each with its own row of ``hist`` (parts × N).
 # ---------------------------------------------------------------------------------------------
 
 
 @njit(cache=True)
-def _scatter_pairs_part(a, b, row, first, second, lo, hi, offset):  # pragma: no cover
-    """Place the pairs whose first row is in ``lo .. hi − 1``, stably (see ``_scatter_part``
-    in :mod:`~visviva.particles.neighbour_cells`)."""
-    for r in range(lo, hi):
-        row[r] += offset
-    for p in range(a.shape[0] - 1, -1, -1):
-        i = a[p]
-        if lo <= i < hi:
-            row[i] -= 1
-            first[row[i]], second[row[i]] = i, b[p]
+def _scatter_pairs(a, b, hist, p, first, second, begin, end):  # pragma: no cover - compiled
+    row = hist[p]
+    for q in range(begin, end):
+        i = a[q]
+        first[row[i]], second[row[i]] = i, b[q]
+        row[i] += 1
 
 
 @njit(cache=True)
@@ -159,97 +157,77 @@ def _sort_rows(row, second, lo, hi):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _order_pairs_serial(a, b, row, first, second, parts):  # pragma: no cover - compiled
+def _order_pairs_serial(a, b, row, first, second, hist):  # pragma: no cover - compiled
     rows = row.shape[0] - 1
-    _count_part(a, row, 0, rows)
-    _scatter_pairs_part(a, b, row, first, second, 0, rows, 0)
-    row[rows] = a.shape[0]
+    _histogram(a, hist, 0, 0, a.shape[0])
+    row[rows] = _column_offsets(hist, row, 0, rows, 0)
+    _scatter_pairs(a, b, hist, 0, first, second, 0, a.shape[0])
     _sort_rows(row, second, 0, rows)
 
 
 @njit(cache=True, parallel=True)
-def _order_pairs_parallel(a, b, row, first, second, parts):  # pragma: no cover - compiled
-    rows = row.shape[0] - 1
-    totals = np.empty(parts, dtype=np.int64)
+def _order_pairs_parallel(a, b, row, first, second, hist):  # pragma: no cover - compiled
+    rows, total, parts = row.shape[0] - 1, a.shape[0], hist.shape[0]
     for p in prange(parts):
-        totals[p] = _count_part(a, row, p * rows // parts, (p + 1) * rows // parts)
-    offsets = np.zeros(parts, dtype=np.int64)
-    for p in range(1, parts):
-        offsets[p] = offsets[p - 1] + totals[p - 1]
+        _histogram(a, hist, p, p * total // parts, (p + 1) * total // parts)
+    _prefix_columns(hist, row)
     for p in prange(parts):
-        lo, hi = p * rows // parts, (p + 1) * rows // parts
-        _scatter_pairs_part(a, b, row, first, second, lo, hi, offsets[p])
-    row[rows] = a.shape[0]
+        begin, end = p * total // parts, (p + 1) * total // parts
+        _scatter_pairs(a, b, hist, p, first, second, begin, end)
     tasks = 8 * parts
     for k in prange(tasks):
         _sort_rows(row, second, k * rows // tasks, (k + 1) * rows // tasks)
 
 
-def order_pairs(a, b, row, first, second, parts: int, parallel: bool) -> None:
+def order_pairs(a, b, row, first, second, hist, parallel: bool) -> None:
     """Pairs ``(a, b)`` into lexicographic order in ``(first, second)``; ``row`` (``N + 1``)
-    gets where each row's pairs begin. ``parts``: ranges of rows (one per thread)."""
-    (_order_pairs_parallel if parallel else _order_pairs_serial)(a, b, row, first, second, parts)
+    gets where each row's pairs begin; ``hist``: scratch of one row of ``N`` per chunk."""
+    (_order_pairs_parallel if parallel else _order_pairs_serial)(a, b, row, first, second, hist)
 
 
 @njit(cache=True)
-def _list_count_part(first, second, start, lo, hi):  # pragma: no cover - compiled
-    """Inclusive prefix sums of the list lengths of rows ``lo .. hi − 1``; return the total."""
-    for r in range(lo, hi):
-        start[r] = 0
-    for p in range(first.shape[0]):
-        i, j = first[p], second[p]
-        if lo <= i < hi:
-            start[i] += 1
-        if lo <= j < hi:
-            start[j] += 1
-    total = 0
-    for r in range(lo, hi):
-        total += start[r]
-        start[r] = total
-    return total
+def _list_histogram(first, second, hist, p, begin, end):  # pragma: no cover - compiled
+    row = hist[p]
+    for r in range(row.shape[0]):
+        row[r] = 0
+    for q in range(begin, end):
+        row[first[q]] += 1
+        row[second[q]] += 1
 
 
 @njit(cache=True)
-def _list_scatter_part(first, second, start, index, lo, hi, offset):  # pragma: no cover
-    """Place both ends of the pairs into the lists of rows ``lo .. hi − 1``, stably: the
-    entries in order are (i gets j), (j gets i) for each pair; taken from the last back."""
-    for r in range(lo, hi):
-        start[r] += offset
-    for p in range(first.shape[0] - 1, -1, -1):
-        i, j = first[p], second[p]
-        if lo <= j < hi:
-            start[j] -= 1
-            index[start[j]] = i
-        if lo <= i < hi:
-            start[i] -= 1
-            index[start[i]] = j
+def _list_scatter(first, second, hist, p, index, begin, end):  # pragma: no cover - compiled
+    """Both ends of pairs ``begin .. end − 1`` into the lists, in order: (i gets j), then
+    (j gets i)."""
+    row = hist[p]
+    for q in range(begin, end):
+        i, j = first[q], second[q]
+        index[row[i]] = j
+        row[i] += 1
+        index[row[j]] = i
+        row[j] += 1
 
 
 @njit(cache=True)
-def _list_pairs_serial(first, second, start, index, parts):  # pragma: no cover - compiled
+def _list_pairs_serial(first, second, start, index, hist):  # pragma: no cover - compiled
     rows = start.shape[0] - 1
-    _list_count_part(first, second, start, 0, rows)
-    _list_scatter_part(first, second, start, index, 0, rows, 0)
-    start[rows] = 2 * first.shape[0]
+    _list_histogram(first, second, hist, 0, 0, first.shape[0])
+    start[rows] = _column_offsets(hist, start, 0, rows, 0)
+    _list_scatter(first, second, hist, 0, index, 0, first.shape[0])
 
 
 @njit(cache=True, parallel=True)
-def _list_pairs_parallel(first, second, start, index, parts):  # pragma: no cover - compiled
-    rows = start.shape[0] - 1
-    totals = np.empty(parts, dtype=np.int64)
+def _list_pairs_parallel(first, second, start, index, hist):  # pragma: no cover - compiled
+    total, parts = first.shape[0], hist.shape[0]
     for p in prange(parts):
-        lo, hi = p * rows // parts, (p + 1) * rows // parts
-        totals[p] = _list_count_part(first, second, start, lo, hi)
-    offsets = np.zeros(parts, dtype=np.int64)
-    for p in range(1, parts):
-        offsets[p] = offsets[p - 1] + totals[p - 1]
+        _list_histogram(first, second, hist, p, p * total // parts, (p + 1) * total // parts)
+    _prefix_columns(hist, start)
     for p in prange(parts):
-        lo, hi = p * rows // parts, (p + 1) * rows // parts
-        _list_scatter_part(first, second, start, index, lo, hi, offsets[p])
-    start[rows] = 2 * first.shape[0]
+        begin, end = p * total // parts, (p + 1) * total // parts
+        _list_scatter(first, second, hist, p, index, begin, end)
 
 
-def list_pairs(first, second, start, index, parts: int, parallel: bool) -> None:
+def list_pairs(first, second, start, index, hist, parallel: bool) -> None:
     """CSR lists from lexicographically ordered pairs: ``start`` (``N + 1``), ``index``
-    (``2P``), each list ascending. ``parts``: ranges of rows (one per thread)."""
-    (_list_pairs_parallel if parallel else _list_pairs_serial)(first, second, start, index, parts)
+    (``2P``), each list ascending; ``hist``: scratch of one row of ``N`` per chunk."""
+    (_list_pairs_parallel if parallel else _list_pairs_serial)(first, second, start, index, hist)
