@@ -68,8 +68,9 @@ runs this pattern against brute force.
 
 **Cost.** Rebuild O(N + T) = O(N); queries O(N · k) for k points in the 27 cells (about 27/4.19
 ≈ 6.4 times the neighbours within ``r`` in a uniform cloud; half of them are tested). Memory:
-48 bytes per point (bucket, order, sorted x, y, z) plus 16–32 bytes of table; the queries add
-16 bytes per point and 32 per pair (found, then sorted), and the lists 16 more per pair.
+40 bytes per point (bucket, order, sorted x, y, z) plus 32–64 for the table and its counting
+sort's histogram; the queries add 16 bytes per point and 32 per pair (found, then sorted),
+and the lists 8 more per point and 16 per pair.
 
 **Determinism.** The sort is stable (points of one bucket in ascending index), so its result
 is unique: the same positions give the same arrays whatever the number of threads, and the
@@ -182,7 +183,8 @@ class NeighbourGrid:
             Cells are ``r · CELL_MARGIN`` wide.
 
     Buffers are kept between updates and grow (by half) only when a larger cloud or result
-    arrives, so a steady simulation allocates nothing per step. Query results are read-only
+    arrives, so a steady simulation allocates nothing of the cloud's size per step (the
+    compiled queries take a few small scratch arrays per task). Query results are read-only
     views of those buffers, valid until the next update or a query with another radius: copy
     what you keep. The pairs found by one query serve the next with the same radius.
 
