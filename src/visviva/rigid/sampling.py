@@ -204,12 +204,14 @@ def sampled_mass_properties(
         )
     generator = _generator(rng)
     low, high, contains = _region(shape, dims, check_intersections)
-    center = 0.5 * (low + high)
-    half = 0.5 * (high - low)
-    box_volume = float(np.prod(high - low))
+    with np.errstate(over="ignore"):  # a box beyond float64 is refused just below
+        center = 0.5 * (low + high)
+        half = 0.5 * (high - low)
+        extent = high - low
+        box_volume = float(np.prod(extent))
     if not (math.isfinite(box_volume) and box_volume > 0.0):
         raise ModelError(
-            f"the {shape}'s bounding box {describe(high - low)} m has volume {box_volume:.3g} "
+            f"the {shape}'s bounding box {describe(extent)} m has volume {box_volume:.3g} "
             "m³, beyond what float64 holds; express its dimensions in other units"
         )
 
