@@ -37,7 +37,7 @@ point by point, the pairs as sorted arrays (random reals make exact ties at r im
 (c) Where two cores pay: ``update`` + ``neighbours()`` with the queries forced onto the serial
 and onto the parallel kernels at N = 250 … 64,000 (``--quick``: 250 and 8,000), the
 measurement behind ``PARALLEL_MIN_POINTS`` (the rebuild always runs on one core; see
-``visviva.particles.neighbour_cells`` for why).
+``visviva.geometry.neighbour_cells`` for why).
 
 This is not a test: it prints figures and exits 1 only if a sanity check fails.
 """
@@ -71,8 +71,8 @@ from bench_integrators import (
     print_table,
     source_state,
 )
-from visviva.particles import neighbour_grid
-from visviva.particles.neighbour_grid import NeighbourGrid
+from visviva.geometry import neighbour_grid
+from visviva.geometry.neighbour_grid import NeighbourGrid
 
 SEED = 20261125
 RADIUS = 1.0  # m

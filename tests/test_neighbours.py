@@ -16,9 +16,9 @@ from numba import njit
 
 import visviva as vv
 from visviva.errors import ModelError
-from visviva.particles import neighbour_grid
-from visviva.particles.neighbour_cells import cell_of, cell_range, neighbour_runs
-from visviva.particles.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid, neighbours
+from visviva.geometry import neighbour_grid
+from visviva.geometry.neighbour_cells import cell_of, cell_range, neighbour_runs
+from visviva.geometry.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid, neighbours
 
 # --------------------------------------------------------------------------------------------
 # Brute force

@@ -2,14 +2,14 @@
 
 * :mod:`~visviva.particles.emitters`: an emitter in numbers (:class:`EmitterSpec`);
 * :mod:`~visviva.particles.emission`: the stage that makes particles live and die;
-* :mod:`~visviva.particles.neighbour_grid`: which points are near which, every step (a hashed
+* :mod:`~visviva.geometry.neighbour_grid`: which points are near which, every step (a hashed
   uniform grid; :func:`neighbours` and :class:`NeighbourGrid`);
 * :mod:`~visviva.particles.random`: random numbers that depend on who a particle is, not on
   when or where it was computed.
 """
 
+from ..geometry.neighbour_grid import NeighbourGrid, neighbours
 from .emission import Emission
 from .emitters import EmitterSpec
-from .neighbour_grid import NeighbourGrid, neighbours
 
 __all__ = ["Emission", "EmitterSpec", "NeighbourGrid", "neighbours"]

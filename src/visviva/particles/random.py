@@ -18,20 +18,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..geometry.hashing import mix64 as _mix
+
 __all__ = ["uniform"]
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
-_MIX1 = np.uint64(0xBF58476D1CE4E5B9)
-_MIX2 = np.uint64(0x94D049BB133111EB)
 #: 2⁻⁵³: a 53-bit integer times this is a double in [0, 1) with every bit random.
 _UNIT = 1.0 / 9007199254740992.0
-
-
-@njit(cache=True)
-def _mix(z):  # pragma: no cover - compiled
-    z = (z ^ (z >> np.uint64(30))) * _MIX1
-    z = (z ^ (z >> np.uint64(27))) * _MIX2
-    return z ^ (z >> np.uint64(31))
 
 
 @njit(cache=True)

@@ -2,7 +2,7 @@
 
 Both start from one search of *half* of each neighbourhood: the point at sorted position
 ``s`` meets only the points at sorted positions ``t > s`` in its 27 cells' runs
-(:func:`~visviva.particles.neighbour_cells.neighbour_runs`), so each pair is tested once (a
+(:func:`~visviva.geometry.neighbour_cells.neighbour_runs`), so each pair is tested once (a
 full search would test it from both ends). The search counts first, then, after a prefix sum
 over the sorted positions, writes each pair as ``(min, max)`` of the two rows. Neither pass
 branches on the distance test: its outcome is added to a count (a branch on it, taken about
@@ -16,7 +16,7 @@ its partners ``b > r`` from its own pairs, ascending, so every list comes out so
 further sort.
 
 The counting sorts give each core a chunk of the pairs and a histogram of its own (see
-:mod:`~visviva.particles.neighbour_cells`): their result is the serial stable sort's, whatever
+:mod:`~visviva.geometry.neighbour_cells`): their result is the serial stable sort's, whatever
 the number of threads.
 """
 

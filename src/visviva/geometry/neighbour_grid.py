@@ -38,14 +38,14 @@ definition: a brute-force search written the same way gives the same sets).
 :meth:`NeighbourGrid.pairs` gives every pair ``i < j`` once, in lexicographic order;
 :meth:`NeighbourGrid.neighbours` every point's list in CSR form, ascending, without the point
 itself. Both come from one search that tests each pair once, from its end earlier in sorted
-order, then counting sorts (:mod:`~visviva.particles.neighbour_search`).
+order, then counting sorts (:mod:`~visviva.geometry.neighbour_search`).
 
 **Kernels** that need neighbours every step (forces of boids and crowds, contacts) loop over
 the 27 cells themselves, without lists, on :attr:`NeighbourGrid.arrays` (a :class:`GridArrays`
-tuple Numba accepts) with :func:`~visviva.particles.neighbour_cells.cell_of` and
-:func:`~visviva.particles.neighbour_cells.neighbour_runs` (or
-:func:`~visviva.particles.neighbour_cells.cell_range` for one cell), imported from
-:mod:`visviva.particles.neighbour_cells`::
+tuple Numba accepts) with :func:`~visviva.geometry.neighbour_cells.cell_of` and
+:func:`~visviva.geometry.neighbour_cells.neighbour_runs` (or
+:func:`~visviva.geometry.neighbour_cells.cell_range` for one cell), imported from
+:mod:`visviva.geometry.neighbour_cells`::
 
     @njit(parallel=True)
     def separation(g, radius, force):            # g = grid.arrays, after grid.update(x)

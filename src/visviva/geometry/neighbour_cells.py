@@ -1,6 +1,6 @@
 """The cells of the neighbour grid: the spatial hash, the rebuild, and the pieces kernels use.
 
-:mod:`~visviva.particles.neighbour_grid` explains the design; this module holds its compiled
+:mod:`~visviva.geometry.neighbour_grid` explains the design; this module holds its compiled
 parts: the bucket of a cell (:func:`_bucket`), the stable counting sort that rebuilds the
 grid (and, split over the cores, orders the queries' results), and the Numba functions a
 kernel calls to visit the 27 cells around a point on :class:`GridArrays`: :func:`cell_of`,
@@ -15,7 +15,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from .random import _mix
+from .hashing import mix64 as _mix
 
 __all__ = [
     "CELL_MARGIN",
