@@ -173,7 +173,12 @@ def run_scene(
                     recording = load_recording(staged)
                 with job.writing(name) as path:
                     write_output(
-                        recording, path, model.output_fps, model.output_speed, model.output_trail
+                        recording,
+                        path,
+                        model.output_fps,
+                        model.output_speed,
+                        model.output_trail,
+                        model.output_color_by,
                     )
             except ModelError as error:
                 # The simulation is done: keep it, and say which output could not be made.
@@ -260,6 +265,7 @@ def _simulate_streaming(
         "t_end": seconds,
         "playback_speed": model.output_speed,
         "playback_trail": model.output_trail,
+        "playback_color_by": model.output_color_by,
         "compiled": False,
     } | model.recording_attrs()
     run = _Run()

@@ -41,6 +41,14 @@ TrailOption = Annotated[
         "default: the run's, else 0.",
     ),
 ]
+ColorByOption = Annotated[
+    str | None,
+    typer.Option(
+        "--color-by",
+        help="What colours the points (video, viewer): scene (the recorded colours) or speed; "
+        "default: the run's, else scene.",
+    ),
+]
 
 
 @app.command("run")
@@ -181,6 +189,7 @@ def view_command(
     fps: FpsOption = None,
     speed: SpeedOption = None,
     trail: TrailOption = None,
+    color_by: ColorByOption = None,
     run: RunOption = None,
     force: ForceOption = False,
 ) -> None:
@@ -193,8 +202,15 @@ def view_command(
     target = output or recording.with_name("viewer.html")
     check_new_file(target, force=force)
     source = load_recording(recording, run)
-    speed, trail = playback(source, speed, trail)
-    written = write_viewer(source, target, fps=fps, speed=speed, trail=trail)
+    chosen = playback(source, speed, trail, color_by)
+    written = write_viewer(
+        source,
+        target,
+        fps=fps,
+        speed=chosen.speed,
+        trail=chosen.trail,
+        color_by=chosen.color_by,
+    )
     typer.echo(f"wrote {written}; open it in a browser (file://{written.resolve()})")
 
 
@@ -208,6 +224,7 @@ def export_command(
     fps: FpsOption = None,
     speed: SpeedOption = None,
     trail: TrailOption = None,
+    color_by: ColorByOption = None,
     size: Annotated[
         str | None,
         typer.Option("--size", help="Video size WIDTHxHEIGHT in pixels (mp4, gif), e.g. 1280x720."),
@@ -239,17 +256,25 @@ def export_command(
     else:
         check_new_file(target, force=force)
     source = load_recording(recording, run)
-    speed, trail = playback(source, speed, trail)
+    chosen = playback(source, speed, trail, color_by)
     if video:
         from ..viz.video import render_video
 
         written = [
-            render_video(source, target, fps=fps or 30.0, size=pixels, speed=speed, trail=trail)
+            render_video(
+                source,
+                target,
+                fps=fps or 30.0,
+                size=pixels,
+                speed=chosen.speed,
+                trail=chosen.trail,
+                color_by=chosen.color_by,
+            )
         ]
     else:
         from ..io.export import export_recording
 
-        written = export_recording(source, target, to=to, fps=fps, speed=speed)
+        written = export_recording(source, target, to=to, fps=fps, speed=chosen.speed)
     if to == "obj":
         folder = written[0].parent
         typer.echo(f"wrote {len(written)} OBJ files into {folder}/ ({written[0].name} …)")

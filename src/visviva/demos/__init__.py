@@ -39,6 +39,8 @@ class Demo:
         speed: Simulated seconds per second of those outputs' playback.
         trail: Simulated seconds of each point's path drawn behind it in the video and the
             viewer (0: none).
+        color_by: What colours the points of the video and the viewer: ``"scene"`` (the
+            recorded colours) or ``"speed"``.
     """
 
     name: str
@@ -48,6 +50,7 @@ class Demo:
     picture: bool = False
     speed: float = 1.0
     trail: float = 0.0
+    color_by: str = "scene"
 
 
 _DEMOS: Registry[Demo] = Registry("demo")
@@ -141,7 +144,11 @@ def run_demo(
         if interrupted is None and stops.requested:
             interrupted = Interrupted(stops.requested, seconds)
         for recording in output.recordings.values():  # later exports play them the same way
-            recording.attrs |= {"playback_speed": demo.speed, "playback_trail": demo.trail}
+            recording.attrs |= {
+                "playback_speed": demo.speed,
+                "playback_trail": demo.trail,
+                "playback_color_by": demo.color_by,
+            }
         summary = _summary(demo, output, seconds, interrupted) | extra
         if extras and interrupted is None:
             run, primary = next(iter(output.recordings.items()))
@@ -149,7 +156,9 @@ def run_demo(
             for file_name in extras:
                 try:
                     with output.writing(file_name) as path:
-                        write_output(primary, path, fps, demo.speed, demo.trail)
+                        write_output(
+                            primary, path, fps, demo.speed, demo.trail, demo.color_by
+                        )
                 except KeyboardInterrupt:
                     interrupted = Interrupted(stops.requested or "SIGINT", seconds)
                     summary["interrupted"] = interrupted.signal

@@ -8,12 +8,13 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from pathlib import Path
+from typing import NamedTuple
 
 from .._validation import did_you_mean
 from ..errors import ModelError
 from ..simulation.recording import Recording
 
-__all__ = ["OUTPUT_FILES", "output_names", "playback", "write_output"]
+__all__ = ["OUTPUT_FILES", "Playback", "output_names", "playback", "write_output"]
 
 #: Output format → its file (or, for OBJ, folder) name in a run's output directory; `visviva
 #: export` uses the same names next to the recording.
@@ -41,20 +42,26 @@ def output_names(formats: Iterable[str]) -> list[str]:
 
 
 def write_output(
-    recording: Recording, path: Path, fps: float, speed: float = 1.0, trail: float = 0.0
+    recording: Recording,
+    path: Path,
+    fps: float,
+    speed: float = 1.0,
+    trail: float = 0.0,
+    color_by: str = "scene",
 ) -> None:
     """Write one output (video, viewer or export, chosen by the suffix of ``path``) at ``fps``
     frames per second, playing ``speed`` simulated seconds per second; the video and the viewer
-    draw ``trail`` simulated seconds of each point's path behind it."""
+    draw ``trail`` simulated seconds of each point's path behind it and colour the points by
+    ``color_by`` (``"scene"`` or ``"speed"``)."""
     suffix = path.suffix.lower()
     if suffix in (".mp4", ".gif"):
         from ..viz.video import render_video
 
-        render_video(recording, path, fps=fps, speed=speed, trail=trail)
+        render_video(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by)
     elif suffix == ".html":
         from ..viz.viewer import write_viewer
 
-        write_viewer(recording, path, fps=fps, speed=speed, trail=trail)
+        write_viewer(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by)
     else:
         from .export import export_recording
 
@@ -62,15 +69,32 @@ def write_output(
         export_recording(recording, path, to=to, fps=fps, speed=speed)
 
 
-def playback(recording: Recording, speed: float | None, trail: float | None) -> tuple[float, float]:
-    """The playback ``speed`` [simulated s per s] and ``trail`` [s] of an output made later from
-    ``recording``: the ones given, else those its run was made with (``visviva run`` and
-    ``visviva demo`` store them as the attributes ``playback_speed`` and ``playback_trail``),
-    else 1 and 0. So ``visviva export REC --to mp4`` plays a year of orbits at the week per
-    second ``visviva run -f mp4`` chose, not a year of video."""
+class Playback(NamedTuple):
+    """How an output plays a recording: simulated seconds per second, the trail behind each
+    point [s], and what colours the points (``"scene"`` or ``"speed"``)."""
+
+    speed: float
+    trail: float
+    color_by: str
+
+
+def playback(
+    recording: Recording,
+    speed: float | None,
+    trail: float | None,
+    color_by: str | None = None,
+) -> Playback:
+    """The playback ``speed`` [simulated s per s], ``trail`` [s] and ``color_by`` of an output
+    made later from ``recording``: the ones given, else those its run was made with
+    (``visviva run`` and ``visviva demo`` store them as the attributes ``playback_speed``,
+    ``playback_trail`` and ``playback_color_by``), else 1, 0 and ``"scene"``. So
+    ``visviva export REC --to mp4`` plays a year of orbits at the week per second
+    ``visviva run -f mp4`` chose, not a year of video."""
     attrs = recording.attrs
     if speed is None:
         speed = float(attrs.get("playback_speed", 1.0))
     if trail is None:
         trail = float(attrs.get("playback_trail", 0.0))
-    return speed, trail
+    if color_by is None:
+        color_by = str(attrs.get("playback_color_by", "scene"))
+    return Playback(speed, trail, color_by)

@@ -150,6 +150,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         output_fps=scene.output.fps,
         output_speed=scene.output.speed,
         output_trail=scene.output.trail,
+        output_color_by=scene.output.color_by,
         source=source,
     )
     problems = _check_start(model)

@@ -112,9 +112,11 @@ class SceneBuilder:
         fps: float | None = None,
         speed: float | None = None,
         trail: float | None = None,
+        color_by: str | None = None,
     ) -> None:
         """Set the extra output ``formats`` of ``visviva run``, their ``fps``, ``speed``
-        (simulated seconds per second of playback) and ``trail`` [s]."""
+        (simulated seconds per second of playback), ``trail`` [s] and ``color_by``
+        (``"scene"`` or ``"speed"``)."""
         self._replace(output=_validated(Output, "output", **_given(locals())))
 
     def add_particles(

@@ -153,6 +153,8 @@ class Model:
         output_fps: Frame rate of videos, viewer and exports [1/s].
         output_speed: Simulated seconds per second of their playback.
         output_trail: Simulated seconds of each point's path drawn behind it [s].
+        output_color_by: What colours the points of videos and the viewer: ``"scene"`` or
+            ``"speed"``.
         source: The scene file's text, if it came from a file (kept in recordings).
     """
 
@@ -178,6 +180,7 @@ class Model:
     output_fps: float = 30.0
     output_speed: float = 1.0
     output_trail: float = 0.0
+    output_color_by: str = "scene"
     source: str | None = field(default=None, repr=False)
 
     @property

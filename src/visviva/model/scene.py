@@ -149,6 +149,11 @@ class Output(Strict):
         description="simulated seconds of each point's path drawn behind it in the video and "
         "the viewer [s] (0: none; at most 1000 points)",
     )
+    color_by: Literal["scene", "speed"] = Field(
+        "scene",
+        description="what colours the points of videos and the viewer: scene (the entities' "
+        "colours) or speed (purple at rest to yellow at the fastest)",
+    )
 
 
 class Particles(Strict):

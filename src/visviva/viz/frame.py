@@ -380,8 +380,10 @@ class FramePainter:
         camera: Camera,
         times: np.ndarray,
         trail: float = 0.0,
+        caption: str = "",
     ) -> None:
         self.geometry = geometry
+        self.caption = caption
         self.width, self.height = size
         look = Appearance.of(geometry)
         self.look = look
@@ -431,9 +433,11 @@ class FramePainter:
 
     def label(self, time: float) -> str:
         """The text in the corner: the time in the unit that reads best for the recording's
-        span, and a warning when points are drawn at display radii."""
+        span, a warning when points are drawn at display radii, and the caption (a colour
+        scale)."""
         text = format_time(time, self.span)
-        return text if self.geometry.to_scale else f"{text}, sizes not to scale"
+        text = text if self.geometry.to_scale else f"{text}, sizes not to scale"
+        return f"{text}, {self.caption}" if self.caption else text
 
     def paint(self, index: int, time: float) -> np.ndarray:
         """Image of recorded frame ``index`` labelled with ``time`` [s]: uint8, ``(H, W, 3)``."""

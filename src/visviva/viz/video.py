@@ -49,6 +49,7 @@ from ..io.files import atomic_path
 from ..io.timeline import frames_at_rate
 from ..simulation.recording import Geometry, Recording
 from .frame import FramePainter, drawn_bounds
+from .speed_colors import check_color_mode, colored_by_speed
 
 __all__ = [
     "FORMATS",
@@ -204,6 +205,7 @@ def render_video(
     progress: bool | None = None,
     speed: float = 1.0,
     trail: float = 0.0,
+    color_by: str = "scene",
 ) -> Path:
     """Render a recording's geometry to an mp4 or GIF file.
 
@@ -224,6 +226,8 @@ def render_video(
             recording's span (s, min, h, days, years).
         trail: Draw each point's path over the last ``trail`` simulated seconds [s] behind
             it (0: none); for at most :data:`MAX_TRAIL_POINTS` points.
+        color_by: ``"scene"``: the recorded colours; ``"speed"``: each point's speed in each
+            frame (:mod:`visviva.viz.speed_colors`), the scale in the corner label.
 
     Returns:
         The path written.
@@ -262,6 +266,7 @@ def render_video(
         )
     width, height = _checked_size(size, even=suffix == ".mp4")
     trail = real_number("trail", trail, nonnegative=True, unit=" s")
+    color_by = check_color_mode(color_by)
     if camera is not None and not isinstance(camera, Camera):
         raise ModelError(f"`camera` must be a visviva Camera or None (got {describe(camera)})")
     if not isinstance(recording, Recording):
@@ -273,6 +278,10 @@ def render_video(
             f"`trail` draws a path behind each point, for at most {MAX_TRAIL_POINTS} points "
             f"(this recording has {geometry.points.shape[1]}); leave it at 0"
         )
+    caption = ""
+    if color_by == "speed":
+        geometry, scale = colored_by_speed(recording, geometry)
+        caption = scale.caption()
     if not target.parent.is_dir():
         raise ModelError(
             f"`path` {os.fspath(path)!r}: directory {os.fspath(target.parent)!r} does not "
@@ -282,7 +291,7 @@ def render_video(
 
     if camera is None:
         camera = Camera.framing(drawn_bounds(geometry), aspect=width / height)
-    painter = FramePainter(geometry, (width, height), camera, recording.time, trail)
+    painter = FramePainter(geometry, (width, height), camera, recording.time, trail, caption)
     times = recording.time[shown]
     from ..simulation.progress import Progress
 

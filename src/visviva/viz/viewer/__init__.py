@@ -30,6 +30,7 @@ from ...errors import ModelError
 from ...io.files import atomic_path
 from ...io.timeline import check_playback, frames_at_rate
 from ...simulation.recording import Geometry, Recording
+from ..speed_colors import check_color_mode, colored_by_speed
 from ..video import MAX_TRAIL_POINTS
 from ._payload import encode_payload, to_json
 
@@ -201,6 +202,7 @@ def write_viewer(
     title: str | None = None,
     speed: float = 1.0,
     trail: float = 0.0,
+    color_by: str = "scene",
 ) -> Path:
     """Write ``recording``'s animation as one self-contained HTML file.
 
@@ -222,6 +224,8 @@ def write_viewer(
             simulated time, in the unit that reads best (s, min, h, days, years).
         trail: Draw each point's path over the last ``trail`` simulated seconds [s] behind it
             (0: none); for at most :data:`~visviva.viz.video.MAX_TRAIL_POINTS` points.
+        color_by: ``"scene"``: the recorded colours; ``"speed"``: each point's speed in each
+            frame (:mod:`visviva.viz.speed_colors`), the scale in the legend.
 
     Returns:
         The path written.
@@ -250,6 +254,10 @@ def write_viewer(
             f"`trail` draws a path behind each point, for at most {MAX_TRAIL_POINTS} points "
             f"(this recording has {geometry.points.shape[1]}); leave it at 0"
         )
+    color_by = check_color_mode(color_by)
+    scale = None
+    if color_by == "speed":
+        geometry, scale = colored_by_speed(recording, geometry)
     shown = frames_at_rate(recording.time, rate, speed=speed)
     page_title = _default_title(recording) if title is None else title
     payload = encode_payload(
@@ -261,6 +269,8 @@ def write_viewer(
         attrs=recording.attrs,
         trail_frames=round(trail * rate / speed),
     )
+    if scale is not None:
+        payload["legend"].append(["colour", scale.caption()])
     parts = {
         "title": html.escape(page_title, quote=False),
         "three": _asset("three.min.js"),
