@@ -1,0 +1,513 @@
+"""Compiled kernels of the particle–particle contact stage (:mod:`.particle_contacts`).
+
+Three parts, each described where it is written:
+
+* **detection**: the pairs of spheres that touch at the step's end, or whose centres' paths
+  crossed within the step, found on the shared neighbour grid; and each sphere's contacts with
+  the static colliders;
+* **ordering**: the contacts sorted into slabs along a horizontal axis, bottom-up within each
+  slab, by a stable counting sort;
+* **the solve**: sweeps of sequential impulses over the contacts (velocities), then sweeps of
+  projections (positions), slab by slab: the even slabs, then the odd ones.
+
+A contact ``c`` joins sphere ``first[c]`` and sphere ``second[c]``, or a collider when
+``second[c] = −1``; its unit normal ``n`` points from the second towards the first (a
+collider's outward normal), and its gap is ``n · (x_first − x_second) + offset[c]`` (with
+``x_second = 0`` for a collider): ``offset = −(r_first + r_second)`` for two spheres, so the
+gap is the distance between the surfaces measured along the normal, fixed for the step.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, prange
+
+from ..geometry.neighbour_cells import cell_of, neighbour_runs
+from .colliders import collider_distance
+
+__all__ = [
+    "CHUNK",
+    "ContactArrays",
+    "assemble",
+    "collider_contacts",
+    "extents",
+    "pair_contacts",
+    "scan",
+    "solve",
+]
+
+#: Sorted points per parallel task of the detection.
+CHUNK = 256
+
+
+class ContactArrays(NamedTuple):
+    """The contacts of one step, in solve order (structure of arrays, ``C`` contacts).
+
+    Attributes:
+        first, second: ``(C,)`` int64 particle rows (``second = −1``: a collider).
+        nx, ny, nz: ``(C,)`` unit normal, from the second towards the first.
+        offset: ``(C,)`` [m]: gap = ``n · (x_first − x_second) + offset``.
+        friction: ``(C,)`` Coulomb coefficient μ.
+        target: ``(C,)`` [m/s]: the relative normal velocity the impulses aim at
+            (``−e v_n`` of a colliding contact, 0 of a resting one).
+        normal_impulse: ``(C,)`` [N·s] accumulated normal impulse (≥ 0).
+        tangent_impulse: ``(C, 3)`` [N·s] accumulated friction impulse.
+        collider: ``(C,)`` int64 collider index (−1 for two spheres).
+        start: ``(S · L + 1,)`` first contact of each (slab, layer) key.
+        slabs, layers: How many slabs and layers.
+    """
+
+    first: np.ndarray
+    second: np.ndarray
+    nx: np.ndarray
+    ny: np.ndarray
+    nz: np.ndarray
+    offset: np.ndarray
+    friction: np.ndarray
+    target: np.ndarray
+    normal_impulse: np.ndarray
+    tangent_impulse: np.ndarray
+    collider: np.ndarray
+    start: np.ndarray
+    slabs: int
+    layers: int
+
+
+# ---------------------------------------------------------------------------------------------
+# Detection
+# ---------------------------------------------------------------------------------------------
+
+
+@njit(cache=True, error_model="numpy")
+def _pair_test(i, j, px, py, pz, x0, radius, slack):  # pragma: no cover - compiled
+    """Whether spheres ``i`` and ``j``, their centres ``p = x_i − x_j`` apart at the step's end,
+    are in contact, and the unit normal (from ``j`` towards ``i``).
+
+    In contact: closer than ``r_i + r_j + slack`` at the end (the normal along ``p``; a fixed
+    one, +y, if the centres coincide), or — apart at the end — their relative path from the
+    step's start ``q = x0_i − x0_j`` to ``p`` (a straight chord) entered the distance
+    ``R = r_i + r_j``: then the normal is the direction at the first touch, ``|q + s(p − q)| =
+    R``, the smaller root of ``|d|² s² + 2 (q·d) s + |q|² − R² = 0`` with ``d = p − q``.
+    """
+    big = radius[i] + radius[j]
+    d2 = px * px + py * py + pz * pz
+    limit = big + slack
+    if d2 < limit * limit:
+        d = math.sqrt(d2)
+        if d > 0.0:
+            return True, px / d, py / d, pz / d
+        return True, 0.0, 1.0, 0.0
+    qx, qy, qz = x0[i, 0] - x0[j, 0], x0[i, 1] - x0[j, 1], x0[i, 2] - x0[j, 2]
+    dx, dy, dz = px - qx, py - qy, pz - qz
+    a = dx * dx + dy * dy + dz * dz
+    b = qx * dx + qy * dy + qz * dz  # half the linear coefficient
+    c = qx * qx + qy * qy + qz * qz - big * big
+    if c <= 0.0 or b >= 0.0:  # touching at the start (and apart at the end), or receding
+        return False, 0.0, 0.0, 0.0
+    disc = b * b - a * c
+    if disc < 0.0:
+        return False, 0.0, 0.0, 0.0
+    s = (-b - math.sqrt(disc)) / a
+    if s > 1.0:
+        return False, 0.0, 0.0, 0.0
+    mx, my, mz = qx + s * dx, qy + s * dy, qz + s * dz
+    m = math.sqrt(mx * mx + my * my + mz * mz)
+    if not m > 0.0:
+        return False, 0.0, 0.0, 0.0
+    return True, mx / m, my / m, mz / m
+
+
+@njit(cache=True, error_model="numpy")
+def _pairs_chunk(
+    g, x0, radius, reach2, slack, begin, end, offsets, write, first, second, nx, ny, nz
+):  # pragma: no cover - compiled
+    """Sorted positions ``begin .. end − 1``: count each one's contacts with later sorted
+    positions into ``offsets[s + 1]``, or (``write``) write them from ``offsets[s]`` on."""
+    runs = np.empty((27, 2), dtype=np.int64)
+    x, y, z, order = g.x, g.y, g.z, g.order
+    for s in range(begin, end):
+        xi, yi, zi = x[s], y[s], z[s]
+        cx, cy, cz = cell_of(xi, yi, zi, g.inv_cell)
+        m = neighbour_runs(g, cx, cy, cz, runs)
+        i = order[s]
+        c = offsets[s] if write else 0
+        for k in range(m):
+            for t in range(max(runs[k, 0], s + 1), runs[k, 1]):
+                px, py, pz = xi - x[t], yi - y[t], zi - z[t]
+                if px * px + py * py + pz * pz > reach2:
+                    continue
+                hit, ux, uy, uz = _pair_test(i, order[t], px, py, pz, x0, radius, slack)
+                if hit:
+                    if write:
+                        first[c], second[c] = i, order[t]
+                        nx[c], ny[c], nz[c] = ux, uy, uz
+                    c += 1
+        if not write:
+            offsets[s + 1] = c
+
+
+@njit(cache=True, error_model="numpy")
+def _colliders_chunk(
+    x,
+    radius,
+    order,
+    masks,
+    slack,
+    begin,
+    end,
+    offsets,
+    write,
+    first,
+    which,
+    nx,
+    ny,
+    nz,
+    offset,
+    colliders,
+):  # pragma: no cover - compiled
+    """Sorted positions ``begin .. end − 1``: count (or write) each sphere's contacts with the
+    colliders of its mask, within ``r + slack`` of its centre."""  # fmt: skip
+    kinds, rows, offs, nb, nl, tp, tn = colliders
+    for s in range(begin, end):
+        i = order[s]
+        c = offsets[s] if write else 0
+        mask = masks[i]
+        if mask != 0:
+            r = radius[i]
+            for k in range(kinds.shape[0]):
+                if not (mask >> np.uint64(k)) & np.uint64(1):
+                    continue
+                d, ux, uy, uz = collider_distance(
+                    k, x[i, 0], x[i, 1], x[i, 2], kinds, rows, offs, nb, nl, tp, tn
+                )
+                if d < r + slack:
+                    if write:
+                        first[c], which[c] = i, k
+                        nx[c], ny[c], nz[c] = ux, uy, uz
+                        # gap(x) = d + n·(x − x_now) − r, linear along the normal.
+                        offset[c] = d - r - (ux * x[i, 0] + uy * x[i, 1] + uz * x[i, 2])
+                    c += 1
+        if not write:
+            offsets[s + 1] = c
+
+
+@njit(cache=True, parallel=True)
+def _pairs_parallel(g, x0, radius, reach2, slack, offsets, write, first, second, nx, ny, nz):
+    n = g.order.shape[0]  # pragma: no cover - compiled
+    for task in prange((n + CHUNK - 1) // CHUNK):
+        begin, end = task * CHUNK, min(n, task * CHUNK + CHUNK)
+        _pairs_chunk(
+            g, x0, radius, reach2, slack, begin, end, offsets, write, first, second, nx, ny, nz
+        )
+
+
+@njit(cache=True)
+def _pairs_serial(g, x0, radius, reach2, slack, offsets, write, first, second, nx, ny, nz):
+    n = g.order.shape[0]  # pragma: no cover - compiled
+    _pairs_chunk(g, x0, radius, reach2, slack, 0, n, offsets, write, first, second, nx, ny, nz)
+
+
+@njit(cache=True)
+def _prefix(offsets):  # pragma: no cover - compiled
+    """Counts in ``offsets[1:]`` to offsets, in place; the total."""
+    offsets[0] = 0
+    for s in range(offsets.shape[0] - 1):
+        offsets[s + 1] += offsets[s]
+    return offsets[offsets.shape[0] - 1]
+
+
+def pair_contacts(g, x0, radius, reach: float, slack: float, parallel: bool):
+    """The sphere pairs in contact (see :func:`_pair_test`) among the grid's points, each once:
+    ``(first, second, nx, ny, nz)``, ordered by the first's sorted position."""
+    n = g.order.shape[0]
+    offsets = np.zeros(n + 1, dtype=np.int64)
+    run = _pairs_parallel if parallel else _pairs_serial
+    none = np.zeros(0, dtype=np.int64)
+    empty = np.zeros(0)
+    reach2 = reach * reach
+    run(g, x0, radius, reach2, slack, offsets, False, none, none, empty, empty, empty)
+    total = int(_prefix(offsets))
+    first, second = np.empty(total, np.int64), np.empty(total, np.int64)
+    nx, ny, nz = np.empty(total), np.empty(total), np.empty(total)
+    if total:
+        run(g, x0, radius, reach2, slack, offsets, True, first, second, nx, ny, nz)
+    return first, second, nx, ny, nz
+
+
+@njit(cache=True, parallel=True)
+def _colliders_all(x, radius, order, masks, slack, offsets, write, first, which, nx, ny, nz, off,
+                   colliders):  # fmt: skip
+    n = order.shape[0]  # pragma: no cover - compiled
+    for task in prange((n + CHUNK - 1) // CHUNK):
+        begin, end = task * CHUNK, min(n, task * CHUNK + CHUNK)
+        _colliders_chunk(
+            x, radius, order, masks, slack, begin, end, offsets, write, first, which, nx, ny, nz,
+            off, colliders,
+        )  # fmt: skip
+
+
+def collider_contacts(x, radius, order, masks, slack: float, colliders):
+    """Each sphere's contacts with the colliders: ``(first, which, nx, ny, nz, offset)`` in the
+    spheres' ``order``. Every sphere's own work, so the result is the same on any number of
+    threads."""
+    n = order.shape[0]
+    offsets = np.zeros(n + 1, dtype=np.int64)
+    none, empty = np.zeros(0, dtype=np.int64), np.zeros(0)
+    _colliders_all(
+        x, radius, order, masks, slack, offsets, False, none, none, empty, empty, empty, empty,
+        colliders,
+    )  # fmt: skip
+    total = int(_prefix(offsets))
+    first, which = np.empty(total, np.int64), np.empty(total, np.int64)
+    nx, ny, nz, offset = np.empty(total), np.empty(total), np.empty(total), np.empty(total)
+    if total:
+        _colliders_all(
+            x, radius, order, masks, slack, offsets, True, first, which, nx, ny, nz, offset,
+            colliders,
+        )  # fmt: skip
+    return first, which, nx, ny, nz, offset
+
+
+# ---------------------------------------------------------------------------------------------
+# Ordering: slabs along a horizontal axis (the parallel solve's unit), layers bottom-up in each
+# ---------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def extents(x, y, z, ux, uy, uz):  # pragma: no cover - compiled
+    """``(low, high)`` of each coordinate and of the height ``p · u`` over the points
+    ``(x, y, z)``, as a ``(4, 2)`` array (rows: x, y, z, height)."""
+    out = np.zeros((4, 2))
+    for s in range(x.shape[0]):
+        h = x[s] * ux + y[s] * uy + z[s] * uz
+        for row, a in ((0, x[s]), (1, y[s]), (2, z[s]), (3, h)):
+            if s == 0 or a < out[row, 0]:
+                out[row, 0] = a
+            if s == 0 or a > out[row, 1]:
+                out[row, 1] = a
+    return out
+
+
+@njit(cache=True)
+def scan(x0, x, radius, active):  # pragma: no cover - compiled
+    """Over the ``active`` spheres: the largest radius [m], the largest move ``|x − x0|`` of
+    the step [m], and whether every position is finite."""
+    largest = move = 0.0
+    for i in range(x.shape[0]):
+        if not active[i]:
+            continue
+        dx, dy, dz = x[i, 0] - x0[i, 0], x[i, 1] - x0[i, 1], x[i, 2] - x0[i, 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        if not (math.isfinite(d2) and math.isfinite(x[i, 0] + x[i, 1] + x[i, 2])):
+            return largest, move, False
+        largest = max(largest, radius[i])
+        move = max(move, math.sqrt(d2))
+    return largest, move, True
+
+
+@njit(cache=True, error_model="numpy")
+def _cell(x, i, axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers):  # pragma: no cover
+    """Slab and layer of particle ``i``."""
+    a = x[i, axis]
+    f = min(max((a - lo) * inv_width, 0.0), slabs - 1.0)
+    h = x[i, 0] * ux + x[i, 1] * uy + x[i, 2] * uz
+    e = min(max((h - hlo) * inv_lw, 0.0), layers - 1.0)
+    return np.int64(f), np.int64(e)
+
+
+# fmt: off
+@njit(cache=True, error_model="numpy")
+def _assemble(
+    x, v, radius, cf, ck, cnx, cny, cnz, coff, pf, ps, pnx, pny, pnz,
+    e_pair, mu_pair, rest_pair, e_col, mu_col, rest_col,
+    axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers,
+):  # pragma: no cover - compiled
+    # fmt: on
+    q, p = cf.shape[0], pf.shape[0]
+    total = q + p
+    keys = np.empty(total, dtype=np.int64)
+    for c in range(q):
+        a, b = _cell(x, cf[c], axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers)
+        keys[c] = a * layers + b
+    for c in range(p):
+        a, b = _cell(x, pf[c], axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers)
+        a2, b2 = _cell(x, ps[c], axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers)
+        keys[q + c] = min(a, a2) * layers + min(b, b2)
+    # A stable counting sort by key (Cormen et al. §8.2): colliders first, then pairs, each in
+    # detection order, within a key.
+    count = slabs * layers
+    start = np.zeros(count + 1, dtype=np.int64)
+    for c in range(total):
+        start[keys[c] + 1] += 1
+    for k in range(count):
+        start[k + 1] += start[k]
+    cursor = start[:count].copy()
+    first, second = np.empty(total, np.int64), np.empty(total, np.int64)
+    collider = np.empty(total, np.int64)
+    nx, ny, nz = np.empty(total), np.empty(total), np.empty(total)
+    offset, friction, target = np.empty(total), np.empty(total), np.empty(total)
+    for c in range(total):
+        at = cursor[keys[c]]
+        cursor[keys[c]] += 1
+        if c < q:
+            i, j, k = cf[c], -1, ck[c]
+            ax, ay, az, off = cnx[c], cny[c], cnz[c], coff[c]
+            e, mu, rest = e_col[k], mu_col[k], rest_col[k]
+            vn = ax * v[i, 0] + ay * v[i, 1] + az * v[i, 2]
+        else:
+            i, j, k = pf[c - q], ps[c - q], -1
+            ax, ay, az = pnx[c - q], pny[c - q], pnz[c - q]
+            off = -(radius[i] + radius[j])
+            e, mu, rest = e_pair, mu_pair, rest_pair
+            vn = ax * (v[i, 0] - v[j, 0]) + ay * (v[i, 1] - v[j, 1]) + az * (v[i, 2] - v[j, 2])
+        first[at], second[at], collider[at] = i, j, k
+        nx[at], ny[at], nz[at], offset[at], friction[at] = ax, ay, az, off, mu
+        # Mirtich's resting threshold: slow approaches get no bounce.
+        target[at] = -e * vn if vn < -rest else 0.0
+    return first, second, nx, ny, nz, offset, friction, target, collider, start
+
+
+def assemble(x, v, radius, colliders_found, pairs_found, pair_law, collider_law, frame):
+    """The :class:`ContactArrays` of one step, in solve order.
+
+    Args:
+        x, v: ``(N, 3)`` positions [m] and velocities [m/s] at the step's end.
+        radius: ``(N,)`` radii [m].
+        colliders_found: :func:`collider_contacts`' result.
+        pairs_found: :func:`pair_contacts`' result.
+        pair_law: ``(e, μ, resting speed)`` of sphere pairs.
+        collider_law: ``(e, μ, resting speed)`` arrays, one entry per collider.
+        frame: ``(axis, low, 1/width, slabs, u, height low, 1/layer height, layers)``.
+    """
+    axis, lo, inv_width, slabs, (ux, uy, uz), hlo, inv_lw, layers = frame
+    arrays = _assemble(
+        x, v, radius, *colliders_found, *pairs_found, *pair_law, *collider_law,
+        axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers,
+    )  # fmt: skip
+    first, second, nx, ny, nz, offset, friction, target, collider, start = arrays
+    total = first.shape[0]
+    return ContactArrays(
+        first, second, nx, ny, nz, offset, friction, target, np.zeros(total),
+        np.zeros((total, 3)), collider, start, slabs, layers,
+    )  # fmt: skip
+
+
+# ---------------------------------------------------------------------------------------------
+# The solve: sequential impulses, then projections
+# ---------------------------------------------------------------------------------------------
+
+
+@njit(cache=True, error_model="numpy")
+def _impulses(k, c, v, w):  # pragma: no cover - compiled
+    """One sweep of sequential impulses over contacts ``k.start[key]`` of the slab ``c``
+    (Catto 2005): the normal impulse accumulated and kept ≥ 0, then the friction impulse
+    accumulated and kept within μ times it; each change applied to the two spheres equal and
+    opposite (``Δv_i = w_i J``, ``Δv_j = −w_j J``)."""
+    begin, end = k.start[c * k.layers], k.start[(c + 1) * k.layers]
+    first, second, lt = k.first, k.second, k.tangent_impulse
+    for a in range(begin, end):
+        i, j = first[a], second[a]
+        wi = w[i]
+        wj = w[j] if j >= 0 else 0.0
+        total = wi + wj
+        if total == 0.0:
+            continue
+        meff = 1.0 / total
+        ux, uy, uz = k.nx[a], k.ny[a], k.nz[a]
+        rx, ry, rz = v[i, 0], v[i, 1], v[i, 2]
+        if j >= 0:
+            rx, ry, rz = rx - v[j, 0], ry - v[j, 1], rz - v[j, 2]
+        vn = ux * rx + uy * ry + uz * rz
+        old = k.normal_impulse[a]
+        new = max(old + meff * (k.target[a] - vn), 0.0)
+        k.normal_impulse[a] = new
+        dn = new - old
+        # The relative velocity after the normal change, then its tangential part.
+        rx, ry, rz = rx + total * dn * ux, ry + total * dn * uy, rz + total * dn * uz
+        vn = ux * rx + uy * ry + uz * rz
+        tx, ty, tz = rx - vn * ux, ry - vn * uy, rz - vn * uz
+        ox, oy, oz = lt[a, 0], lt[a, 1], lt[a, 2]
+        gx, gy, gz = ox - meff * tx, oy - meff * ty, oz - meff * tz
+        size = math.sqrt(gx * gx + gy * gy + gz * gz)
+        cap = k.friction[a] * new
+        if size > cap:
+            scale = cap / size
+            gx, gy, gz = gx * scale, gy * scale, gz * scale
+        lt[a, 0], lt[a, 1], lt[a, 2] = gx, gy, gz
+        jx, jy, jz = dn * ux + gx - ox, dn * uy + gy - oy, dn * uz + gz - oz
+        v[i, 0] += wi * jx
+        v[i, 1] += wi * jy
+        v[i, 2] += wi * jz
+        if j >= 0:
+            v[j, 0] -= wj * jx
+            v[j, 1] -= wj * jy
+            v[j, 2] -= wj * jz
+
+
+@njit(cache=True, error_model="numpy")
+def _projections(k, c, x, w):  # pragma: no cover - compiled
+    """One sweep of projections over the contacts of slab ``c``: an overlap (negative gap) is
+    removed by moving the two spheres apart along the normal, ``w_i / (w_i + w_j)`` of it the
+    first and the rest the second, so their centre of mass stays where it is; velocities are
+    untouched (no kinetic energy is added)."""
+    begin, end = k.start[c * k.layers], k.start[(c + 1) * k.layers]
+    first, second = k.first, k.second
+    for a in range(begin, end):
+        i, j = first[a], second[a]
+        wi = w[i]
+        wj = w[j] if j >= 0 else 0.0
+        total = wi + wj
+        if total == 0.0:
+            continue
+        ux, uy, uz = k.nx[a], k.ny[a], k.nz[a]
+        gap = ux * x[i, 0] + uy * x[i, 1] + uz * x[i, 2] + k.offset[a]
+        if j >= 0:
+            gap -= ux * x[j, 0] + uy * x[j, 1] + uz * x[j, 2]
+        if gap >= 0.0:
+            continue
+        push = -gap / total
+        x[i, 0] += wi * push * ux
+        x[i, 1] += wi * push * uy
+        x[i, 2] += wi * push * uz
+        if j >= 0:
+            x[j, 0] -= wj * push * ux
+            x[j, 1] -= wj * push * uy
+            x[j, 2] -= wj * push * uz
+
+
+# Slab c holds the contacts whose lower slab is c, so they touch spheres of slabs c and c + 1
+# only: slabs c and c + 2 share no sphere, and the even slabs (then the odd ones) can be swept
+# at once. The order of the updates is the same whether they are (two cores) or not.
+
+
+@njit(cache=True, parallel=True)
+def _solve_parallel(k, x, v, w, velocity_sweeps, position_sweeps):  # pragma: no cover
+    for _ in range(velocity_sweeps):
+        for colour in range(2):
+            for q in prange((k.slabs - colour + 1) // 2):
+                _impulses(k, colour + 2 * q, v, w)
+    for _ in range(position_sweeps):
+        for colour in range(2):
+            for q in prange((k.slabs - colour + 1) // 2):
+                _projections(k, colour + 2 * q, x, w)
+
+
+@njit(cache=True)
+def _solve_serial(k, x, v, w, velocity_sweeps, position_sweeps):  # pragma: no cover - compiled
+    for _ in range(velocity_sweeps):
+        for colour in range(2):
+            for q in range((k.slabs - colour + 1) // 2):
+                _impulses(k, colour + 2 * q, v, w)
+    for _ in range(position_sweeps):
+        for colour in range(2):
+            for q in range((k.slabs - colour + 1) // 2):
+                _projections(k, colour + 2 * q, x, w)
+
+
+def solve(k: ContactArrays, x, v, w, velocity_sweeps: int, position_sweeps: int, parallel: bool):
+    """Sweeps of impulses on ``v`` [m/s], then of projections on ``x`` [m] (in place);
+    ``w`` ``(N,)`` inverse masses [1/kg] (0: immovable). The same result either way."""
+    (_solve_parallel if parallel else _solve_serial)(k, x, v, w, velocity_sweeps, position_sweeps)
