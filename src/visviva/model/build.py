@@ -21,6 +21,7 @@ from .._validation import describe, did_you_mean
 from ..errors import ModelError, SceneError, SceneProblem
 from ..rigid.projection import BodyProjection
 from ..simulation.loop import MAX_STEPS
+from .boids_parts import boids_stages, check_flocks
 from .model import Integration, Model, SystemInstance, frozen_array
 from .parts import (
     Located,
@@ -44,6 +45,7 @@ from .scene import (
     System,
 )
 from .scene_bodies import BODIES, POINT_BODIES, Body, Hair, Rope, SpringGraph
+from .scene_boids import Boids
 from .scene_meshes import with_mesh_files
 from .scene_rigid import RigidBody
 from .systems import SYSTEMS
@@ -101,6 +103,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     try:
         systems = _systems(scene, names)
         stages: list[Any] = []
+        stages += boids_stages(scene, groups, arrays)
         handles = handle_stage(scene, groups, arrays)
         if handles is not None:
             stages.append(handles)
@@ -289,6 +292,8 @@ def _check(scene: Scene) -> list[SceneProblem]:
             )
         )
     problems += _check_targets(scene, names)
+    holders = [names[i] for i, e in enumerate(entities) if isinstance(e, PARTICLE_ENTITIES)]
+    problems += check_flocks(scene, holders)
     problems += _check_first_order(scene)
     return problems
 
@@ -323,7 +328,7 @@ def _check_targets(scene: Scene, names: list[str]) -> list[SceneProblem]:
     }
     problems = []
     for index, entity in enumerate(scene.entities):
-        if not isinstance(entity, (ForceField, Collider)) or entity.targets is None:
+        if not isinstance(entity, (ForceField, Collider, Boids)) or entity.targets is None:
             continue
         for k, target in enumerate(entity.targets):
             where = f"entities[{index}].targets[{k}]"

@@ -40,6 +40,7 @@ from .scene import (
     World,
 )
 from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, SpringGraph
+from .scene_boids import Boids
 from .scene_errors import scene_problems
 from .scene_handles import Handle
 from .scene_meshes import with_mesh_file
@@ -488,6 +489,36 @@ class SceneBuilder:
         ``friction`` μ, and ``response`` ``"impulse"`` or ``"penalty"`` (``stiffness``,
         ``damping``)."""
         return self._add(Collider, "collider", _given(locals()))
+
+    def add_boids(
+        self,
+        targets: Sequence[str],
+        *,
+        radius: float,
+        separation: float,
+        max_speed: float,
+        max_force: float,
+        fov: float | None = None,
+        min_speed: float | None = None,
+        separation_weight: float | None = None,
+        alignment_weight: float | None = None,
+        cohesion_weight: float | None = None,
+        goal: Vector | None = None,
+        goal_weight: float | None = None,
+        leader: str | None = None,
+        leader_weight: float | None = None,
+        look_ahead: float | None = None,
+        plane: str | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add a flock: Reynolds' boids steering the particles of the entities named in
+        ``targets`` (:mod:`visviva.particles.boids`). Boids see flockmates within ``radius``
+        [m] and the field of view ``fov`` [degrees]; separation from those closer than
+        ``separation`` [m], alignment and cohesion with weights [1/s]; desired speed
+        ``max_speed`` [m/s], steering bounded by ``max_force`` [m/s²]; an optional ``goal``
+        point and ``leader`` entity (weights default to 1/s); colliders avoided from
+        ``look_ahead`` [m]; ``plane="xz"`` for a 2-D flock."""
+        return self._add(Boids, "boids", _given(locals()))
 
     def build(self) -> Model:
         """Check the scene as a whole and return the frozen :class:`Model`."""

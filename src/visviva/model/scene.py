@@ -16,7 +16,8 @@ placed once), ``emitter`` (particles born and dying over time), the deformable b
 ``soft_lattice``, ``soft_mesh``: particles joined by springs), ``body`` (a rigid body,
 :mod:`.scene_rigid`), ``system`` (a named mechanical
 system: pendulums, Kepler orbits, star clusters...), ``force`` (a force field on particles, or
-gravitation among them) and ``collider`` (a static shape particles bounce off). The value types
+gravitation among them), ``collider`` (a static shape particles bounce off) and ``boids``
+(a flock: Reynolds' steering of the particles it names, :mod:`.scene_boids`). The value types
 the tables share are in :mod:`.scene_fields`.
 """
 
@@ -29,6 +30,7 @@ from pydantic_core import PydanticCustomError
 
 from .._validation import did_you_mean
 from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, SpringGraph
+from .scene_boids import Boids
 from .scene_fields import (
     MAX_PARTICLES,
     Color,
@@ -49,6 +51,7 @@ __all__ = [
     "FORCE_KINDS",
     "MAX_PARTICLES",
     "OUTPUT_FORMATS",
+    "Boids",
     "Burst",
     "Cloth",
     "ClothMesh",
@@ -535,7 +538,8 @@ Entity = Annotated[
     | Emitter
     | System
     | ForceField
-    | Collider,
+    | Collider
+    | Boids,
     Field(discriminator="type"),
 ]
 ENTITY_TYPES: dict[str, type[BaseModel]] = {
@@ -553,6 +557,7 @@ ENTITY_TYPES: dict[str, type[BaseModel]] = {
     "system": System,
     "force": ForceField,
     "collider": Collider,
+    "boids": Boids,
 }
 
 

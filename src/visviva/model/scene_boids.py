@@ -1,0 +1,74 @@
+"""The scene entity of a flock (``type = "boids"``), as plain data validated by pydantic.
+
+A flock is a behaviour, not a body: it names the particle entities whose particles are its
+boids (``targets``, e.g. a ``particle_cloud``) and steers them after every step with Reynolds'
+rules (:mod:`visviva.particles.boids` has the model, its units and its sources). Each field
+is checked here on its own and against its neighbours (``separation ≤ radius``,
+``min_speed ≤ max_speed``, a weight only with what it weighs); :mod:`.build` checks the names
+(targets and ``leader`` exist, the leader is not a target, no particle entity is in two
+flocks).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal, Self
+
+from pydantic import Field, model_validator
+from pydantic_core import PydanticCustomError
+
+from .scene_fields import Name, NonNegative, Positive, Strict, Vector
+
+__all__ = ["Boids"]
+
+Names = Annotated[list[Name], Field(min_length=1)]
+Degrees = Annotated[float, Field(strict=True, gt=0, le=360, allow_inf_nan=False)]
+
+
+class Boids(Strict):
+    """``type = "boids"``: Reynolds' flocking of the particles of ``targets``."""
+
+    type: Literal["boids"]
+    name: Name | None = None
+    targets: Names = Field(description="particle entities whose particles are the boids")
+    radius: Positive = Field(description="how far a boid sees its flockmates [m]")
+    separation: Positive = Field(description="flockmates closer than this push away [m]")
+    fov: Degrees = Field(360.0, description="field of view, full angle around the heading [deg]")
+    max_speed: Positive = Field(description="desired and largest speed [m/s]")
+    min_speed: NonNegative = Field(0.0, description="least speed of a moving boid [m/s]")
+    max_force: Positive = Field(description="bound of the steering acceleration [m/s^2]")
+    separation_weight: NonNegative = Field(1.5, description="weight of separation [1/s]")
+    alignment_weight: NonNegative = Field(1.0, description="weight of alignment [1/s]")
+    cohesion_weight: NonNegative = Field(1.0, description="weight of cohesion [1/s]")
+    goal: Vector | None = Field(None, description="a point the flock seeks [m]")
+    goal_weight: NonNegative | None = Field(None, description="weight of the goal [1/s] (1)")
+    leader: Name | None = Field(None, description="a particle entity the boids follow")
+    leader_weight: NonNegative | None = Field(None, description="weight of the leader [1/s] (1)")
+    look_ahead: Positive | None = Field(
+        None, description="distance from a collider at which boids turn away [m] (2 V^2/A)"
+    )
+    plane: Literal["xz"] | None = Field(None, description='"xz": a 2-D flock (default 3-D)')
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Self:
+        if self.separation > self.radius:
+            raise PydanticCustomError(
+                "separation_radius",
+                "`separation` ({separation} m) must not exceed `radius` ({radius} m): a boid "
+                "pushes away only flockmates it sees",
+                {"separation": self.separation, "radius": self.radius},
+            )
+        if self.min_speed > self.max_speed:
+            raise PydanticCustomError(
+                "min_speed",
+                "`min_speed` ({low} m/s) must not exceed `max_speed` ({high} m/s)",
+                {"low": self.min_speed, "high": self.max_speed},
+            )
+        for weight, what in (("goal_weight", "goal"), ("leader_weight", "leader")):
+            if getattr(self, weight) is not None and getattr(self, what) is None:
+                raise PydanticCustomError(
+                    "weight_without",
+                    "`{weight}` is given without `{what}`: give the {what} too, or leave the "
+                    "weight out",
+                    {"weight": weight, "what": what},
+                )
+        return self
