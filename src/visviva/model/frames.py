@@ -9,7 +9,8 @@ Per frame (:func:`frame_fields`), following the recording convention of
                                        every system is of gravitating bodies, whose coordinates
                                        are already their points
     y                     (n,)         a first-order system's state
-    alive                 (P,) bool    with emitters: which points hold a live particle
+    alive                 (P,) bool    with emitters, or stages that remove particles (a
+                                       crowd's exits): which points hold a live particle
     radius                (P,) [m]     with emitters: radii as they grow and shrink
     color                 (P, 3)       with colour ramps: sRGB colours in [0, 1]
     body_origin           (B, 3) [m]   each rigid body's own origin (its surface's coordinates
@@ -86,6 +87,11 @@ def _bodies(system: SystemInstance) -> bool:
     return SYSTEMS[system.system].bodies
 
 
+def _kills(model: Model) -> bool:
+    """True if a stage may remove particles (a crowd's exits): ``alive`` is then recorded."""
+    return any(getattr(stage, "kills_particles", False) for stage in model.stages)
+
+
 def _varying_color(model: Model) -> bool:
     return any(e.color_ramp.shape[0] > 1 for e in model.emitters)
 
@@ -111,9 +117,10 @@ def frame_fields(model: Model, state: State) -> dict[str, np.ndarray]:
         fields["velocities"] = np.concatenate(velocities) if len(velocities) > 1 else velocities[0]
     if "y" in state.names():
         fields["y"] = state["y"]
-    if model.emitters:
-        extra = sum(p.shape[0] for p in pictures)
+    extra = sum(p.shape[0] for p in pictures)
+    if model.emitters or _kills(model):
         fields["alive"] = np.concatenate([state["particle_alive"], np.ones(extra, dtype=bool)])
+    if model.emitters:
         fields["radius"] = np.concatenate(
             [state["particle_radius"], np.full(extra, _system_radius(model))]
         )

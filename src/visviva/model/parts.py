@@ -53,6 +53,8 @@ from .scene_bodies import (
     SoftLattice,
     SoftMesh,
 )
+from .scene_crowd import Crowd as CrowdEntity
+from .scene_crowd import wall_indices
 
 __all__ = [
     "Located",
@@ -484,7 +486,9 @@ def collision_stage(
             f"a scene may hold at most {MAX_COLLIDERS} impulse colliders",
         )
     shapes = [_shape(e, f"entities[{i}]") for i, e in chosen]
-    masks = _masks(chosen, groups, pinned)
+    masks = _masks(chosen, groups, pinned, scene)
+    if not masks.any():  # no particle meets them (pinned ones, a crowd's agents its walls)
+        return None
     response = ColliderResponse(
         restitution=[e.restitution for _, e in chosen],
         friction=[e.friction for _, e in chosen],
@@ -506,7 +510,9 @@ def penalty_forces(
     if not chosen or not arrays["mass"].shape[0]:
         return []
     shapes = [_shape(e, f"entities[{i}]") for i, e in chosen]
-    masks = _masks(chosen, groups, arrays["pinned"])
+    masks = _masks(chosen, groups, arrays["pinned"], scene)
+    if not masks.any():
+        return []
     return [
         PenaltyContact(
             ColliderSet(shapes),
@@ -521,14 +527,24 @@ def penalty_forces(
 
 
 def _masks(
-    chosen: Sequence[tuple[int, Collider]], groups: Sequence[ParticleGroup], pinned: np.ndarray
+    chosen: Sequence[tuple[int, Collider]],
+    groups: Sequence[ParticleGroup],
+    pinned: np.ndarray,
+    scene: Scene,
 ) -> np.ndarray:
     """Bit ``k`` of ``masks[i]`` set where particle ``i`` meets collider ``k`` (pinned
-    particles meet none)."""
+    particles meet none; a crowd's agents meet its walls through the crowd's forces only)."""
     count = pinned.shape[0]
     masks = np.zeros(count, dtype=np.uint64)
     for bit, (_, e) in enumerate(chosen):
         masks[_targets(e, groups, count).indices] |= np.uint64(1) << np.uint64(bit)
+    for crowd in (e for e in scene.entities if isinstance(e, CrowdEntity)):
+        walls = wall_indices(crowd, scene.entities)
+        agents = [g for g in groups if g.name in crowd.targets]
+        for bit, (index, _) in enumerate(chosen):
+            if index in walls:
+                for g in agents:
+                    masks[g.start : g.start + g.count] &= ~(np.uint64(1) << np.uint64(bit))
     masks[pinned] = 0
     return masks
 

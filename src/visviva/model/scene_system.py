@@ -116,6 +116,8 @@ def initial_state(model: Model) -> State:
         carried["particle_size"] = model.particle_radius.copy()
         carried["emitter_serial"] = np.zeros(emitters, dtype=np.int64)
         carried["emitter_dropped"] = np.zeros(emitters, dtype=np.int64)
+    for stage in model.stages:  # parts a stage keeps of its own (a crowd's exit times)
+        carried |= getattr(stage, "carried_start", dict)()
     return State(0.0, (q, v), layout(model), MappingProxyType(carried))
 
 
