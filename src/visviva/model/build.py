@@ -22,6 +22,7 @@ from ..errors import ModelError, SceneError, SceneProblem
 from ..rigid.projection import BodyProjection
 from ..simulation.loop import MAX_STEPS
 from .boids_parts import boids_stages, check_flocks
+from .crowd_parts import crowd_stage
 from .model import Integration, Model, SystemInstance, frozen_array
 from .parts import (
     Located,
@@ -46,6 +47,7 @@ from .scene import (
 )
 from .scene_bodies import BODIES, POINT_BODIES, Body, Hair, Rope, SpringGraph
 from .scene_boids import Boids
+from .scene_crowd import Crowd
 from .scene_meshes import with_mesh_files
 from .scene_rigid import RigidBody
 from .systems import SYSTEMS
@@ -104,6 +106,9 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         systems = _systems(scene, names)
         stages: list[Any] = []
         stages += boids_stages(scene, groups, arrays)
+        crowd = crowd_stage(scene, names, groups, arrays, h)
+        if crowd is not None:
+            stages.append(crowd)
         handles = handle_stage(scene, groups, arrays)
         if handles is not None:
             stages.append(handles)
@@ -328,7 +333,8 @@ def _check_targets(scene: Scene, names: list[str]) -> list[SceneProblem]:
     }
     problems = []
     for index, entity in enumerate(scene.entities):
-        if not isinstance(entity, (ForceField, Collider, Boids)) or entity.targets is None:
+        targeting = (ForceField, Collider, Boids, Crowd)
+        if not isinstance(entity, targeting) or entity.targets is None:
             continue
         for k, target in enumerate(entity.targets):
             where = f"entities[{index}].targets[{k}]"

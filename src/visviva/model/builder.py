@@ -41,6 +41,7 @@ from .scene import (
 )
 from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, SpringGraph
 from .scene_boids import Boids
+from .scene_crowd import Crowd
 from .scene_errors import scene_problems
 from .scene_handles import Handle
 from .scene_meshes import with_mesh_file
@@ -519,6 +520,31 @@ class SceneBuilder:
         point and ``leader`` entity (weights default to 1/s); colliders avoided from
         ``look_ahead`` [m]; ``plane="xz"`` for a 2-D flock."""
         return self._add(Boids, "boids", _given(locals()))
+
+    def add_crowd(
+        self,
+        targets: Sequence[str],
+        *,
+        goal: Vector | None = None,
+        exits: Sequence[Mapping[str, Vector]] | None = None,
+        walls: Sequence[str] | None = None,
+        preferred_speed: float | None = None,
+        relaxation_time: float | None = None,
+        max_speed: float | None = None,
+        repulsion: float | None = None,
+        repulsion_range: float | None = None,
+        body_stiffness: float | None = None,
+        friction: float | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Add a crowd: the particles of ``targets`` walk in the XZ plane to ``goal`` [m] or
+        the nearest of ``exits`` (``{"center": [x, y, z], "size": [sx, sy, sz]}`` boxes that
+        remove who enters), avoiding each other and the colliders named in ``walls`` (default:
+        all) with the social-force model (:mod:`visviva.particles.crowd`): ``preferred_speed``
+        v0 [m/s], ``relaxation_time`` tau [s], ``max_speed`` [m/s], ``repulsion`` A [N] of
+        range ``repulsion_range`` B [m], ``body_stiffness`` k [kg/s²], ``friction`` kappa
+        [kg/(m·s)]; defaults from Helbing, Farkas & Vicsek (2000)."""
+        return self._add(Crowd, "crowd", _given(locals()))
 
     def build(self) -> Model:
         """Check the scene as a whole and return the frozen :class:`Model`."""

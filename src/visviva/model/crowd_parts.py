@@ -122,7 +122,7 @@ def _agents(
             raise Located(
                 f"{where}.targets[{k}]",
                 f"a crowd's agents are the particles of a particles or particle_cloud entity; "
-                f"{target!r} is a {entity.type}",  # type: ignore[attr-defined]
+                f"{target!r} is of type {entity.type}",  # type: ignore[attr-defined]
             )
         if index in owner:
             raise Located(
@@ -205,7 +205,7 @@ def _check_places(
             wall = wall_names[own[int(np.argwhere(inside)[0][1])]]
             raise Located(
                 f"{where}.goal",
-                f"the goal {describe(list(spec.goal))} lies inside the wall {wall!r}: put the "
+                f"the goal {describe(spec.goal.tolist())} lies inside the wall {wall!r}: put the "
                 "goal outside the walls",
             )
     if own and spec.exits.shape[0]:
@@ -227,7 +227,7 @@ def _check_places(
             _refuse_agent(
                 spec.agents[a], groups, "overlaps the wall "
                 f"{wall_names[own[w]]!r}: its centre is {clearance[a, w] + radius[a]:.4g} m from "
-                f"it, less than its radius {radius[a]!r} m; place the agents at least a radius "
+                f"it, less than its radius {float(radius[a])!r} m; place the agents at least a radius "
                 "away from the walls (or leave that collider out of the crowd's `walls`)",
             )  # fmt: skip
     if spec.exits.shape[0]:
@@ -239,7 +239,7 @@ def _check_places(
         if stranded.any():
             a = int(np.argmax(stranded))
             _refuse_agent(
-                spec.agents[a], groups, f"stands at height y = {y[a]!r} m, outside the height "
+                spec.agents[a], groups, f"stands at height y = {float(y[a])!r} m, outside the height "
                 f"range of every exit of crowd {spec.name!r}: it could never leave; make the "
                 "exits' `size` span the agents' heights",
             )  # fmt: skip

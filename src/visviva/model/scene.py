@@ -17,7 +17,8 @@ placed once), ``emitter`` (particles born and dying over time), the deformable b
 :mod:`.scene_rigid`), ``system`` (a named mechanical
 system: pendulums, Kepler orbits, star clusters...), ``force`` (a force field on particles, or
 gravitation among them), ``collider`` (a static shape particles bounce off) and ``boids``
-(a flock: Reynolds' steering of the particles it names, :mod:`.scene_boids`). The value types
+(a flock: Reynolds' steering of the particles it names, :mod:`.scene_boids`); ``crowd`` makes
+particles pedestrians (the social-force model, :mod:`.scene_crowd`). The value types
 the tables share are in :mod:`.scene_fields`.
 """
 
@@ -31,6 +32,7 @@ from pydantic_core import PydanticCustomError
 from .._validation import did_you_mean
 from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, SpringGraph
 from .scene_boids import Boids
+from .scene_crowd import Crowd
 from .scene_fields import (
     MAX_PARTICLES,
     Color,
@@ -56,6 +58,7 @@ __all__ = [
     "Cloth",
     "ClothMesh",
     "Collider",
+    "Crowd",
     "Emitter",
     "Entity",
     "ForceField",
@@ -539,7 +542,8 @@ Entity = Annotated[
     | System
     | ForceField
     | Collider
-    | Boids,
+    | Boids
+    | Crowd,
     Field(discriminator="type"),
 ]
 ENTITY_TYPES: dict[str, type[BaseModel]] = {
@@ -558,6 +562,7 @@ ENTITY_TYPES: dict[str, type[BaseModel]] = {
     "force": ForceField,
     "collider": Collider,
     "boids": Boids,
+    "crowd": Crowd,
 }
 
 

@@ -188,12 +188,16 @@ def social_forces(
 @njit(cache=True)
 def exit_agents(agents, alive, x, v, crowd, exits, exit_start, exit_time, t):  # pragma: no cover
     """Remove the live agents whose centre lies in one of their crowd's exits (bounds
-    inclusive): ``alive`` False, parked at rest at the origin, ``exit_time`` ``t`` [s].
-    Returns how many left."""
+    inclusive): ``alive`` False, parked at rest at the origin, ``exit_time`` ``t`` [s]. Agents
+    that left before are parked again (the integrator's forces, gravity say, moved them).
+    Returns how many left in this step."""
     left = 0
     for a in range(agents.shape[0]):
         i = agents[a]
         if not alive[i]:
+            for q in range(3):
+                x[i, q] = 0.0
+                v[i, q] = 0.0
             continue
         c = crowd[a]
         for e in range(exit_start[c], exit_start[c + 1]):
