@@ -477,6 +477,22 @@ def test_bad_python_values_are_refused(kwargs, message):
     assert message in str(caught.value)
 
 
+def test_the_cli_refuses_a_bad_flock_with_status_2(tmp_path, monkeypatch, capsys):
+    """``visviva validate`` on a flock with fov = 400: exit status 2, one line naming the
+    entity and field, no traceback."""
+    from visviva.cli.main import main
+
+    path = tmp_path / "bad.toml"
+    path.write_text(SCENE.replace("max_force = 4.0\n", "max_force = 4.0\nfov = 400.0\n"))
+    monkeypatch.setattr("sys.argv", ["visviva", "validate", str(path)])
+    with pytest.raises(SystemExit) as exit_:
+        main()
+    captured = capsys.readouterr()
+    assert exit_.value.code == 2
+    assert "entities[2].fov" in captured.err + captured.out
+    assert "Traceback" not in captured.err
+
+
 def test_a_flock_beyond_the_grids_reach_is_refused_at_build():
     text = SCENE.replace('name = "birds"\n', 'name = "birds"\ncenter = [1e300, 0.0, 0.0]\n')
     with pytest.raises(SceneError, match=r"entities\[2\].*beyond the grid's reach"):
