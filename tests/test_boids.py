@@ -164,6 +164,8 @@ def test_dead_slots_are_never_flockmates():
     alive = np.array([True, False, False, False])
     stage = Boids(np.arange(4), radius=1.0, separation=0.5, max_speed=1.0, max_force=10.0)
     assert not stage.steering(x, v, alive).any()
+    with pytest.raises(ModelError, match=r"`alive` must be a boolean mask of shape \(4,\)"):
+        stage.steering(x, v, alive[:3])
     big, vel = flock(500, 3, side=5.0)
     dead = np.zeros(500, dtype=bool)
     dead[::7] = True

@@ -23,9 +23,10 @@ its steering is ``V u − v_i`` (nothing if it has no direction), times its weig
 a rule relaxes the velocity towards its desired one at the rate w. Separation's weight is
 ``w_s |S|``: it grows as flockmates close in, so a crowded boid is pushed out against the pull
 of cohesion, which a constant weight could not do (every rule's steering is at most 2V long,
-so the nearest flockmate settles no closer than about ``s / (1 + 2 Σw / w_s)``, Σw the other
-weights). The weighted sum is an acceleration [m/s²], truncated to the length ``max_force`` A
-(an acceleration bound).
+so a lone nearest flockmate settles near ``s / (1 + 2 Σw / w_s)``, Σw the other weights; a
+boid squeezed between flockmates feels the difference of their pushes and may settle nearer).
+The weighted sum is an acceleration [m/s²], truncated to the length ``max_force`` A (an
+acceleration bound).
 
 **Obstacles** come first (Reynolds 1987's prioritised allocation): a boid within the
 ``look_ahead`` distance L of a collider's surface (signed distance ``d < L`` from
@@ -278,7 +279,12 @@ class Boids:
             raise ModelError(
                 f"`targets` name row {int(self.targets.max())} of {x.shape[0]} particles"
             )
-        mask = np.ones(x.shape[0], dtype=bool) if alive is None else np.asarray(alive, bool)
+        mask = np.ones(x.shape[0], dtype=bool) if alive is None else np.asarray(alive)
+        if mask.dtype != np.bool_ or mask.shape != (x.shape[0],):
+            raise ModelError(
+                f"`alive` must be a boolean mask of shape ({x.shape[0]},), one flag per particle "
+                f"(got dtype {mask.dtype}, shape {mask.shape})"
+            )
         self._run(x, v, mask, x, x.copy(), v.copy(), real_number("h", h, positive=True))
         return self._acc[: self.targets.shape[0]].copy()
 
