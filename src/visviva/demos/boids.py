@@ -38,7 +38,7 @@ FOV = 270.0  # [degrees]
 MAX_SPEED = 6.0  # [m/s]
 MIN_SPEED = 2.0  # [m/s]
 MAX_FORCE = 12.0  # [m/s²]: look-ahead 2V²/A = 6 m
-WEIGHTS = {"separation_weight": 8.0, "alignment_weight": 2.0, "cohesion_weight": 1.0}
+SEPARATION_WEIGHT, ALIGNMENT_WEIGHT, COHESION_WEIGHT = 8.0, 2.0, 1.0  # [1/s]
 GOAL = (45.0, 12.0, 0.0)  # [m]
 GOAL_WEIGHT = 0.6  # [1/s]
 OBSTACLE = (0.0, 12.0, 0.0)  # centre [m]
@@ -79,8 +79,10 @@ def build_scene(birds: int = BIRDS, duration: float = DURATION) -> SceneBuilder:
         max_force=MAX_FORCE,
         goal=GOAL,
         goal_weight=GOAL_WEIGHT,
+        separation_weight=SEPARATION_WEIGHT,
+        alignment_weight=ALIGNMENT_WEIGHT,
+        cohesion_weight=COHESION_WEIGHT,
         name="flock",
-        **WEIGHTS,
     )
     return builder
 
@@ -130,7 +132,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     right.set_title("Seen from above")
     legend = right.legend(fontsize=8, loc="upper left")
     for handle in legend.legend_handles[:3]:  # the three frames' dots, enlarged
-        handle.set_sizes([12.0])  # type: ignore[union-attr]
+        handle.set_sizes([12.0])
     output.figures["boids"] = figure
 
     return {
