@@ -217,6 +217,9 @@ def test_cli_validate_schema_dry_run_and_plot(tmp_path):
         "system",
         "force",
         "collider",
+        "boids",
+        "crowd",
+        "particle_collisions",
     }
     assert schema["$defs"]["Particles"]["additionalProperties"] is False
     out = tmp_path / "dry"

@@ -35,8 +35,10 @@ __all__ = [
     "collider_contacts",
     "extents",
     "pair_contacts",
+    "remember",
     "scan",
     "solve",
+    "warm_start",
 ]
 
 #: Sorted points per parallel task of the detection.
@@ -86,16 +88,16 @@ def _pair_test(i, j, px, py, pz, x0, radius, slack):  # pragma: no cover - compi
     """Whether spheres ``i`` and ``j``, their centres ``p = x_i − x_j`` apart at the step's end,
     are in contact, and the unit normal (from ``j`` towards ``i``).
 
-    In contact: closer than ``r_i + r_j + slack`` at the end (the normal along ``p``; a fixed
-    one, +y, if the centres coincide), or — apart at the end — their relative path from the
-    step's start ``q = x0_i − x0_j`` to ``p`` (a straight chord) entered the distance
-    ``R = r_i + r_j``: then the normal is the direction at the first touch, ``|q + s(p − q)| =
-    R``, the smaller root of ``|d|² s² + 2 (q·d) s + |q|² − R² = 0`` with ``d = p − q``.
+    In contact: overlapping at the end (``|p| < R = r_i + r_j``; the normal along ``p``, or a
+    fixed one, +y, if the centres coincide); or apart at the end but their relative path from
+    the step's start ``q = x0_i − x0_j`` to ``p`` (a straight chord) entered the distance
+    ``R``: they passed through each other, and the normal is the direction at the first touch,
+    ``|q + s(p − q)| = R``, the smaller root of ``|d|² s² + 2 (q·d) s + |q|² − R² = 0`` with
+    ``d = p − q``; or apart by less than ``slack`` (a speculative contact, along ``p``).
     """
     big = radius[i] + radius[j]
     d2 = px * px + py * py + pz * pz
-    limit = big + slack
-    if d2 < limit * limit:
+    if d2 < big * big:
         d = math.sqrt(d2)
         if d > 0.0:
             return True, px / d, py / d, pz / d
@@ -105,19 +107,17 @@ def _pair_test(i, j, px, py, pz, x0, radius, slack):  # pragma: no cover - compi
     a = dx * dx + dy * dy + dz * dz
     b = qx * dx + qy * dy + qz * dz  # half the linear coefficient
     c = qx * qx + qy * qy + qz * qz - big * big
-    if c <= 0.0 or b >= 0.0:  # touching at the start (and apart at the end), or receding
-        return False, 0.0, 0.0, 0.0
-    disc = b * b - a * c
-    if disc < 0.0:
-        return False, 0.0, 0.0, 0.0
-    s = (-b - math.sqrt(disc)) / a
-    if s > 1.0:
-        return False, 0.0, 0.0, 0.0
-    mx, my, mz = qx + s * dx, qy + s * dy, qz + s * dz
-    m = math.sqrt(mx * mx + my * my + mz * mz)
-    if not m > 0.0:
-        return False, 0.0, 0.0, 0.0
-    return True, mx / m, my / m, mz / m
+    if c > 0.0 and b < 0.0 and b * b - a * c >= 0.0:  # apart at the start, approaching
+        s = (-b - math.sqrt(b * b - a * c)) / a
+        mx, my, mz = qx + s * dx, qy + s * dy, qz + s * dz
+        m = math.sqrt(mx * mx + my * my + mz * mz)
+        if s <= 1.0 and m > 0.0:
+            return True, mx / m, my / m, mz / m
+    limit = big + slack
+    if d2 < limit * limit:
+        d = math.sqrt(d2)
+        return True, px / d, py / d, pz / d
+    return False, 0.0, 0.0, 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -323,7 +323,7 @@ def _cell(x, i, axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers):  #
 def _assemble(
     x, v, radius, cf, ck, cnx, cny, cnz, coff, pf, ps, pnx, pny, pnz,
     e_pair, mu_pair, rest_pair, e_col, mu_col, rest_col,
-    axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers,
+    axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers, h,
 ):  # pragma: no cover - compiled
     # fmt: on
     q, p = cf.shape[0], pf.shape[0]
@@ -365,12 +365,20 @@ def _assemble(
             vn = ax * (v[i, 0] - v[j, 0]) + ay * (v[i, 1] - v[j, 1]) + az * (v[i, 2] - v[j, 2])
         first[at], second[at], collider[at] = i, j, k
         nx[at], ny[at], nz[at], offset[at], friction[at] = ax, ay, az, off, mu
-        # Mirtich's resting threshold: slow approaches get no bounce.
-        target[at] = -e * vn if vn < -rest else 0.0
+        gap = ax * x[i, 0] + ay * x[i, 1] + az * x[i, 2] + off
+        if j >= 0:
+            gap -= ax * x[j, 0] + ay * x[j, 1] + az * x[j, 2]
+        # Touching, or closing the gap within the next step: a collision now, with a bounce
+        # unless slower than the resting speed (Mirtich's threshold). Otherwise a speculative
+        # contact: the spheres may approach by the gap in a step, not more.
+        if gap <= 0.0 or gap + vn * h < 0.0:
+            target[at] = -e * vn if vn < -rest else 0.0
+        else:
+            target[at] = -gap / h
     return first, second, nx, ny, nz, offset, friction, target, collider, start
 
 
-def assemble(x, v, radius, colliders_found, pairs_found, pair_law, collider_law, frame):
+def assemble(x, v, radius, colliders_found, pairs_found, pair_law, collider_law, frame, h):
     """The :class:`ContactArrays` of one step, in solve order.
 
     Args:
@@ -381,11 +389,12 @@ def assemble(x, v, radius, colliders_found, pairs_found, pair_law, collider_law,
         pair_law: ``(e, μ, resting speed)`` of sphere pairs.
         collider_law: ``(e, μ, resting speed)`` arrays, one entry per collider.
         frame: ``(axis, low, 1/width, slabs, u, height low, 1/layer height, layers)``.
+        h: The step [s] (a speculative contact may close its gap in one).
     """
     axis, lo, inv_width, slabs, (ux, uy, uz), hlo, inv_lw, layers = frame
     arrays = _assemble(
         x, v, radius, *colliders_found, *pairs_found, *pair_law, *collider_law,
-        axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers,
+        axis, lo, inv_width, slabs, ux, uy, uz, hlo, inv_lw, layers, h,
     )  # fmt: skip
     first, second, nx, ny, nz, offset, friction, target, collider, start = arrays
     total = first.shape[0]
@@ -476,6 +485,90 @@ def _projections(k, c, x, w):  # pragma: no cover - compiled
             x[j, 0] -= wj * push * ux
             x[j, 1] -= wj * push * uy
             x[j, 2] -= wj * push * uz
+
+
+# Temporal coherence (Catto 2005): a contact that persists from one step to the next starts
+# from the impulses it ended the last step with, so a resting pile's impulses converge over
+# steps rather than within one. Contacts are remembered by their lower particle (a counting
+# sort, O(N + C)) and its partner: the other particle, or N + k for collider k; impulses are
+# kept as acting on the lower particle.
+
+
+@njit(cache=True)
+def _partner(i, j, k, count):  # pragma: no cover - compiled
+    """The lower particle of a contact, its partner's code, and the sign of the impulses on the
+    lower particle (+1 if it is the contact's first)."""
+    if j < 0:
+        return i, count + k, 1.0
+    if i < j:
+        return i, j, 1.0
+    return j, i, -1.0
+
+
+@njit(cache=True)
+def remember(k, count):  # pragma: no cover - compiled
+    """The impulses of the contacts ``k`` by lower particle: ``(start, partner, normal,
+    tangent)``, ``start`` of shape ``(count + 1,)``."""
+    total = k.first.shape[0]
+    start = np.zeros(count + 1, dtype=np.int64)
+    for a in range(total):
+        low, _, _ = _partner(k.first[a], k.second[a], k.collider[a], count)
+        start[low + 1] += 1
+    for i in range(count):
+        start[i + 1] += start[i]
+    cursor = start[:count].copy()
+    partner = np.empty(total, dtype=np.int64)
+    normal, tangent = np.empty(total), np.empty((total, 3))
+    for a in range(total):
+        low, code, sign = _partner(k.first[a], k.second[a], k.collider[a], count)
+        at = cursor[low]
+        cursor[low] += 1
+        partner[at], normal[at] = code, k.normal_impulse[a]
+        for d in range(3):
+            tangent[at, d] = sign * k.tangent_impulse[a, d]
+    return start, partner, normal, tangent
+
+
+@njit(cache=True, error_model="numpy")
+def warm_start(k, start, partner, normal, tangent, v, w):  # pragma: no cover - compiled
+    """Give each contact found in the last step's memory its impulses back (the friction
+    impulse projected on the new tangent plane and kept within μ times the normal one) and
+    apply them, equal and opposite; return how many contacts were warm-started."""
+    count = start.shape[0] - 1
+    warmed = 0
+    for a in range(k.first.shape[0]):
+        i, j = k.first[a], k.second[a]
+        low, code, sign = _partner(i, j, k.collider[a], count)
+        found = -1
+        for b in range(start[low], start[low + 1]):
+            if partner[b] == code:
+                found = b
+                break
+        if found < 0:
+            continue
+        ux, uy, uz = k.nx[a], k.ny[a], k.nz[a]
+        ln = normal[found]
+        gx, gy, gz = sign * tangent[found, 0], sign * tangent[found, 1], sign * tangent[found, 2]
+        along = gx * ux + gy * uy + gz * uz
+        gx, gy, gz = gx - along * ux, gy - along * uy, gz - along * uz
+        size = math.sqrt(gx * gx + gy * gy + gz * gz)
+        cap = k.friction[a] * ln
+        if size > cap:
+            gx, gy, gz = gx * (cap / size), gy * (cap / size), gz * (cap / size)
+        k.normal_impulse[a] = ln
+        k.tangent_impulse[a, 0], k.tangent_impulse[a, 1], k.tangent_impulse[a, 2] = gx, gy, gz
+        jx, jy, jz = ln * ux + gx, ln * uy + gy, ln * uz + gz
+        wi = w[i]
+        v[i, 0] += wi * jx
+        v[i, 1] += wi * jy
+        v[i, 2] += wi * jz
+        if j >= 0:
+            wj = w[j]
+            v[j, 0] -= wj * jx
+            v[j, 1] -= wj * jy
+            v[j, 2] -= wj * jz
+        warmed += 1
+    return warmed
 
 
 # Slab c holds the contacts whose lower slab is c, so they touch spheres of slabs c and c + 1

@@ -64,16 +64,24 @@ __all__ = ["MAX_ITERATIONS", "MOTION_CAP", "PairContacts", "ParticleContacts"]
 #: The largest move of a step [in diameters of the largest sphere] the detection widens its
 #: search for; faster pairs may pass through each other.
 MOTION_CAP = 2.0
-#: Gap [in sums of radii] within which two spheres (or a sphere and a collider) count as
-#: touching: after the projections, resting spheres touch to round-off.
-TOUCH = 1e-9
+#: Gap [in diameters of the largest sphere] within which two spheres (or a sphere and a
+#: collider) are speculative contacts besides twice the step's largest move: the projections
+#: of a pile move spheres by about their overlaps, and must not push them into neighbours the
+#: solve does not see.
+SPECULATIVE = 0.05
 #: Most sweeps of each kind per step.
 MAX_ITERATIONS = 10_000
 #: Most slabs (the parallel solve's unit) and layers (bottom-up order within a slab).
 MAX_SLABS = 64
 MAX_LAYERS = 1024
-#: Fewest contacts for which the solve uses every core (a parallel region costs 10–90 µs).
-PARALLEL_MIN_CONTACTS = 4096
+#: Fewest contacts for which the solve sweeps the slabs on every core. Measured on 2 cores
+#: shared with other jobs (November 2026; benchmarks/bench_particle_contacts.py, part (c)):
+#: 20 + 20 sweeps over 59,000 contacts took 41 ms on one core and 240–400 ms on two, over
+#: 307,000 contacts 237–402 against 652–702 ms (each sweep is two parallel regions, and a
+#: region waits for its slowest thread), so the solve stays on one core up to a million
+#: contacts; the detection uses both (the grid's PARALLEL_MIN_POINTS). Either path gives the
+#: same numbers.
+PARALLEL_MIN_CONTACTS = 1 << 20
 # The slabs' width exceeds the interaction radius by this factor, so that the two spheres of a
 # contact always lie in neighbouring slabs despite rounding.
 _SLAB_MARGIN = 1.0 + 2.0**-10
@@ -166,6 +174,9 @@ class ParticleContacts:
         self.up = -g / size if size > 0.0 else np.zeros(3)
         self.colliders = colliders
         self._grid: NeighbourGrid | None = None
+        #: Whether persisting contacts start from their last step's impulses (Catto 2005).
+        self.warm = True
+        self._memory: tuple[np.ndarray, ...] | None = None
         #: The contacts of the latest :meth:`resolve`, in solve order, with their impulses.
         self.last: kernels.ContactArrays | None = None
 
@@ -180,23 +191,31 @@ class ParticleContacts:
             result["particle_velocity"],
             after["particle_radius"],
             after["particle_alive"],
+            h,
         )
         return result
 
     def resolve(
-        self, x0: np.ndarray, x: np.ndarray, v: np.ndarray, radius: np.ndarray, alive: np.ndarray
+        self,
+        x0: np.ndarray,
+        x: np.ndarray,
+        v: np.ndarray,
+        radius: np.ndarray,
+        alive: np.ndarray,
+        h: float,
     ) -> int:
-        """Resolve the contacts of a step from ``x0`` to ``x`` [m] in place on ``x`` and ``v``
-        [m/s] (``(N, 3)`` each); ``radius`` ``(N,)`` [m], ``alive`` ``(N,)`` bool. Returns the
-        number of contacts. Non-finite positions are left to the divergence watch."""
+        """Resolve the contacts of a step of ``h`` [s] from ``x0`` to ``x`` [m] in place on
+        ``x`` and ``v`` [m/s] (``(N, 3)`` each); ``radius`` ``(N,)`` [m], ``alive`` ``(N,)``
+        bool. Returns the number of contacts (speculative ones included). Non-finite positions
+        are left to the divergence watch."""
         active = np.asarray(alive, dtype=np.bool_) & self.targets
         x0 = np.ascontiguousarray(x0, dtype=np.float64)
         radius = np.ascontiguousarray(radius, dtype=np.float64)
         largest, move, finite = kernels.scan(x0, x, radius, active)
         if not finite or largest == 0.0:
             return 0
-        slack = TOUCH * 2.0 * largest
-        reach = 2.0 * largest + slack + min(2.0 * move, MOTION_CAP * 2.0 * largest)
+        slack = SPECULATIVE * 2.0 * largest + min(2.0 * move, MOTION_CAP * 2.0 * largest)
+        reach = 2.0 * largest + slack
         g = self._grid_over(x, active, reach)
         parallel = g.order.shape[0] >= PARALLEL_MIN_POINTS
         pairs = kernels.pair_contacts(g, x0, radius, reach, slack, parallel)
@@ -204,14 +223,17 @@ class ParticleContacts:
         contacts = kernels.assemble(
             x, v, radius, found, pairs,
             (self.restitution, self.friction, self.resting_speed), law,
-            self._frame(g, reach),
+            self._frame(g, reach), h,
         )  # fmt: skip
         total = contacts.first.shape[0]
         if total:
+            if self._memory is not None:
+                kernels.warm_start(contacts, *self._memory, v, self.inverse_mass)
             parallel = total >= PARALLEL_MIN_CONTACTS and contacts.slabs > 1
             kernels.solve(
                 contacts, x, v, self.inverse_mass, self.iterations, self.iterations, parallel
             )
+        self._memory = kernels.remember(contacts, x.shape[0]) if self.warm else None
         self.last = contacts
         return int(total)
 

@@ -205,6 +205,7 @@ def _interrupted_run_name(output: JobOutput, error: Interrupted) -> str:
 
 def _load_builtins() -> None:
     from . import (  # noqa: F401 - registers the demos
+        ball_pit,
         boids,
         bottle_flip,
         bunny_throw,

@@ -22,6 +22,7 @@ from ..errors import ModelError, SceneError, SceneProblem
 from ..rigid.projection import BodyProjection
 from ..simulation.loop import MAX_STEPS
 from .boids_parts import boids_stages, check_flocks
+from .contact_parts import check_contacts, contact_stages
 from .crowd_parts import crowd_stage
 from .model import Integration, Model, SystemInstance, frozen_array
 from .parts import (
@@ -47,6 +48,7 @@ from .scene import (
 )
 from .scene_bodies import BODIES, POINT_BODIES, Body, Hair, Rope, SpringGraph
 from .scene_boids import Boids
+from .scene_contacts import ParticleCollisionSettings
 from .scene_crowd import Crowd
 from .scene_meshes import with_mesh_files
 from .scene_rigid import RigidBody
@@ -118,6 +120,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
             forces += spring_forces(scene, groups, count)
         bodies, body_forces = rigid_bodies(scene, names)
         collisions = collision_stage(scene, groups, arrays["pinned"], h)
+        stages += contact_stages(scene, groups, arrays, collisions, h)
         if collisions is not None:
             stages.append(collisions)
         if specs:
@@ -299,6 +302,7 @@ def _check(scene: Scene) -> list[SceneProblem]:
     problems += _check_targets(scene, names)
     holders = [names[i] for i, e in enumerate(entities) if isinstance(e, PARTICLE_ENTITIES)]
     problems += check_flocks(scene, holders)
+    problems += check_contacts(scene)
     problems += _check_first_order(scene)
     return problems
 
@@ -333,7 +337,7 @@ def _check_targets(scene: Scene, names: list[str]) -> list[SceneProblem]:
     }
     problems = []
     for index, entity in enumerate(scene.entities):
-        targeting = (ForceField, Collider, Boids, Crowd)
+        targeting = (ForceField, Collider, Boids, ParticleCollisionSettings, Crowd)
         if not isinstance(entity, targeting) or entity.targets is None:
             continue
         for k, target in enumerate(entity.targets):

@@ -41,6 +41,7 @@ from .scene import (
 )
 from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, SpringGraph
 from .scene_boids import Boids
+from .scene_contacts import ParticleCollisionSettings
 from .scene_crowd import Crowd
 from .scene_errors import scene_problems
 from .scene_handles import Handle
@@ -490,6 +491,22 @@ class SceneBuilder:
         ``friction`` μ, and ``response`` ``"impulse"`` or ``"penalty"`` (``stiffness``,
         ``damping``)."""
         return self._add(Collider, "collider", _given(locals()))
+
+    def add_particle_collisions(
+        self,
+        *,
+        targets: Sequence[str] | None = None,
+        restitution: float | None = None,
+        friction: float | None = None,
+        iterations: int | None = None,
+        resting_speed: float | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Make the particles of ``targets`` (default: every particle) collide with each other
+        as spheres of their radii, with restitution ``e`` in [0, 1] and Coulomb ``friction``
+        μ, in ``iterations`` sweeps per step; approaches slower than ``resting_speed`` [m/s]
+        rest (:mod:`visviva.collision.particle_contacts`)."""
+        return self._add(ParticleCollisionSettings, "particle_collisions", _given(locals()))
 
     def add_boids(
         self,

@@ -16,9 +16,11 @@ placed once), ``emitter`` (particles born and dying over time), the deformable b
 ``soft_lattice``, ``soft_mesh``: particles joined by springs), ``body`` (a rigid body,
 :mod:`.scene_rigid`), ``system`` (a named mechanical
 system: pendulums, Kepler orbits, star clusters...), ``force`` (a force field on particles, or
-gravitation among them), ``collider`` (a static shape particles bounce off) and ``boids``
-(a flock: Reynolds' steering of the particles it names, :mod:`.scene_boids`); ``crowd`` makes
-particles pedestrians (the social-force model, :mod:`.scene_crowd`). The value types
+gravitation among them), ``collider`` (a static shape particles bounce off), ``boids``
+(a flock: Reynolds' steering of the particles it names, :mod:`.scene_boids`) and
+``particle_collisions`` (particles colliding with each other as spheres,
+:mod:`.scene_contacts`); ``crowd`` makes particles pedestrians (the social-force model,
+:mod:`.scene_crowd`). The value types
 the tables share are in :mod:`.scene_fields`.
 """
 
@@ -32,6 +34,7 @@ from pydantic_core import PydanticCustomError
 from .._validation import did_you_mean
 from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, SpringGraph
 from .scene_boids import Boids
+from .scene_contacts import ParticleCollisionSettings
 from .scene_crowd import Crowd
 from .scene_fields import (
     MAX_PARTICLES,
@@ -66,6 +69,7 @@ __all__ = [
     "Integration",
     "Output",
     "ParticleCloud",
+    "ParticleCollisionSettings",
     "Particles",
     "Rope",
     "Scene",
@@ -542,6 +546,7 @@ Entity = Annotated[
     | System
     | ForceField
     | Collider
+    | ParticleCollisionSettings
     | Boids
     | Crowd,
     Field(discriminator="type"),
@@ -561,6 +566,7 @@ ENTITY_TYPES: dict[str, type[BaseModel]] = {
     "system": System,
     "force": ForceField,
     "collider": Collider,
+    "particle_collisions": ParticleCollisionSettings,
     "boids": Boids,
     "crowd": Crowd,
 }
