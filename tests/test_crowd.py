@@ -54,19 +54,27 @@ def test_a_lone_agent_relaxes_to_its_preferred_speed_as_the_closed_form():
     assert 1.9 < coarse / fine < 2.1
 
 
-def _pair(velocity_b=(-0.4, 0.0, 0.9)) -> tuple[Crowd, np.ndarray, np.ndarray]:
+#: Two agents overlapping by 0.07 m (deeper than a scene may start with: see the refusals).
+PRESSED = np.array([[0.0, 1.0, 0.0], [0.45, 1.0, 0.2]])
+SLIDING = np.array([[0.7, 0.0, -0.2], [-0.4, 0.0, 0.9]])
+
+
+def _pair_model(**crowd) -> vv.model.Model:
+    """Two agents (radii 0.3 and 0.26 m, 80 and 60 kg), built apart."""
     builder = vv.SceneBuilder(name="pair")
     builder.set_integration(dt=H, duration=1.0)
     builder.add_particles(
         name="people",
-        positions=[[0.0, 1.0, 0.0], [0.45, 1.0, 0.2]],
+        positions=[[0.0, 1.0, 0.0], [3.0, 1.0, 0.0]],
         radius=[0.3, 0.26],
         mass=[80.0, 60.0],
     )
-    builder.add_crowd(["people"], goal=(5.0, 1.0, 0.0))
-    model = builder.build()
-    v = np.array([[0.7, 0.0, -0.2], velocity_b])
-    return _crowd_stage(model), np.array(model.particle_position), v
+    builder.add_crowd(["people"], goal=(5.0, 1.0, 0.0), **crowd)
+    return builder.build()
+
+
+def _pair() -> tuple[Crowd, np.ndarray, np.ndarray]:
+    return _crowd_stage(_pair_model()), PRESSED.copy(), SLIDING.copy()
 
 
 def test_two_agents_pressed_together_push_each_other_equally_and_oppositely():
@@ -74,12 +82,13 @@ def test_two_agents_pressed_together_push_each_other_equally_and_oppositely():
     i, j to the last bit: the sums of the pair's forces and of its momentum change are zero."""
     stage, x, v = _pair()
     _, agents, _ = stage.forces(x, v)
-    assert np.abs(agents[0]).max() > 1e3  # overlapping by 0.1 m: body force and friction act
+    assert np.abs(agents[0]).max() > 1e3  # overlapping by 0.07 m: body force and friction act
     np.testing.assert_array_equal(agents[0], -agents[1])
     # One step of the stage: the pair's momentum changes by h × (sum of the drives) only.
-    model = _pair_model()
+    model = _pair_model(max_speed=100.0)
     stage = _crowd_stage(model)
-    state = vv.Simulation(model).raw_state
+    start = vv.Simulation(model).raw_state
+    state = start.from_parts(0.0, (PRESSED.ravel(), SLIDING.ravel()))
     after = stage.apply(state, state, H)
     drive, agents, _ = stage.forces(state["particle_position"], state["particle_velocity"])
     mass = model.particle_mass[:, None]
@@ -87,20 +96,6 @@ def test_two_agents_pressed_together_push_each_other_equally_and_oppositely():
     impulse = H * np.abs(agents).max()
     assert impulse > 10.0  # N·s: the interaction's impulse on each of them
     np.testing.assert_allclose(change, H * drive.sum(axis=0), rtol=0, atol=1e-14 * impulse)
-
-
-def _pair_model() -> vv.model.Model:
-    builder = vv.SceneBuilder(name="pair")
-    builder.set_integration(dt=H, duration=1.0)
-    builder.add_particles(
-        name="people",
-        positions=[[0.0, 1.0, 0.0], [0.45, 1.0, 0.2]],
-        velocities=[[0.7, 0.0, -0.2], [-0.4, 0.0, 0.9]],
-        radius=[0.3, 0.26],
-        mass=[80.0, 60.0],
-    )
-    builder.add_crowd(["people"], goal=(5.0, 1.0, 0.0), max_speed=100.0)
-    return builder.build()
 
 
 def _brute_force(stage: Crowd, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -142,12 +137,13 @@ def _brute_force(stage: Crowd, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray
 
 
 def _dense_scene() -> vv.model.Model:
-    """300 agents of two crowds packed in a 9 m × 9 m yard with walls, many touching."""
+    """300 agents of two crowds (built on a lattice 0.75 m apart) by two walls."""
     rng = np.random.default_rng(7)
     builder = vv.SceneBuilder(name="dense")
     builder.set_integration(dt=H, duration=1.0)
+    lattice = np.stack(np.meshgrid(np.arange(20), np.arange(15)), axis=-1).reshape(-1, 2)
     positions = np.column_stack(
-        [rng.uniform(0.6, 9.4, 300), np.full(300, 1.0), rng.uniform(-4.3, 4.4, 300)]
+        [0.6 + 0.75 * lattice[:, 0], np.full(300, 1.0), -4.3 + 0.75 * lattice[:, 1]]
     )
     radius = rng.uniform(0.25, 0.35, 300)
     for name, rows in (("calm", slice(0, 150)), ("hurried", slice(150, 300))):
@@ -168,8 +164,9 @@ def test_kernel_forces_equal_a_brute_force_numpy_sum_on_300_agents():
     model = _dense_scene()
     stage = _crowd_stage(model)
     rng = np.random.default_rng(8)
-    x = np.array(model.particle_position)
-    x[0, 0], x[1, 2], x[200, 0] = 0.2, -4.45, 0.25  # pressed into the walls
+    # Packed in a 9 m × 9 m yard, many touching, three pressed into the walls.
+    x = np.column_stack([rng.uniform(0.6, 9.4, 300), np.ones(300), rng.uniform(-4.3, 4.4, 300)])
+    x[0, 0], x[1, 2], x[200, 0] = 0.2, -4.45, 0.25
     v = rng.normal(0.0, 1.0, x.shape)
     found = stage.forces(x, v)
     expected = _brute_force(stage, x, v)
@@ -184,14 +181,14 @@ def test_kernel_forces_equal_a_brute_force_numpy_sum_on_300_agents():
 def test_dead_agents_are_nobodys_neighbours_and_feel_nothing():
     stage, x, v = _pair()
     alive = np.array([True, False])
-    drive, agents, walls = stage.forces(x, v, alive)
-    assert np.all(agents == 0.0)  # the dead one overlaps the live one by 0.11 m
+    drive, agents, _ = stage.forces(x, v, alive)
+    assert np.all(agents == 0.0)  # the dead one overlaps the live one by 0.07 m
     assert np.all(drive[1] == 0.0) and np.any(drive[0] != 0.0)
 
 
 def _room_model(door: float, agents: int = 40, side: float = 6.0, duration: float = 120.0):
     builder = vv.SceneBuilder(name="room")
-    builder.set_integration(dt=H, duration=duration)
+    builder.set_integration(dt=H / 2, duration=duration)  # jams at the door: overlaps of cm
     room(builder, agents=agents, side=side, door=door, seed=3)
     return builder.build()
 
@@ -220,7 +217,7 @@ def test_everyone_leaves_a_room_and_nobody_ends_in_a_wall():
     assert deepest[0] < 0.05  # overlaps with the walls (if any) of centimetres at most
     assert exited(times, [times.max()])[0] == 40
     centres, flow = exit_flow(times, 1.0)
-    assert flow.sum() * 1.0 == 40
+    assert flow.sum() * 1.0 == 40 and centres[-1] > times.max() - 1.0
 
 
 def test_the_flow_through_a_door_grows_with_its_width():
@@ -232,7 +229,7 @@ def test_the_flow_through_a_door_grows_with_its_width():
         assert np.isfinite(times).all()
         flows.append(mean_flow(times))
     assert flows[0] < flows[1] < flows[2], flows
-    assert 0.5 < flows[0] and flows[2] < 6.0  # agents/s: of the order of 1.3 per metre of door
+    assert flows[0] > 0.5 and flows[2] < 6.0  # agents/s: of the order of 1.3 per metre of door
 
 
 def test_an_agent_entering_an_exit_leaves_at_that_step():
@@ -298,7 +295,8 @@ EXIT = {"center": (5.0, 1.0, 0.0), "size": (1.0, 2.0, 1.0)}
         (lambda b: (_people(b, ((1.0, 1.0, 0.0), (2.8, 1.0, 1.0))), _wall(b),
                     b.add_crowd(["people"], exits=[EXIT])),
          r"entities\[0\]: agent 1 of 'people' overlaps the wall 'wall'"),
-        (lambda b: (_people(b, ((1.0, 1.0, 0.0), (2.0, 3.5, 0.0))), b.add_crowd(["people"], exits=[EXIT])),
+        (lambda b: (_people(b, ((1.0, 1.0, 0.0), (2.0, 3.5, 0.0))),
+                    b.add_crowd(["people"], exits=[EXIT])),
          r"agent 1 of 'people' stands at height y = 3.5 m, outside"),
         (lambda b: (_people(b), b.add_crowd(["people"], exits=[EXIT], walls=["wal"])),
          r"walls\[0\]: no collider is called 'wal'"),
@@ -319,12 +317,15 @@ EXIT = {"center": (5.0, 1.0, 0.0), "size": (1.0, 2.0, 1.0)}
          r"repulsion_range: the repulsion at full overlap"),
         (lambda b: (_people(b), b.add_crowd(["people"], exits=[EXIT], max_speed=1.0)),
          r"`max_speed` \(1.0 m/s\) must be at least `preferred_speed`"),
+        (lambda b: (_people(b, ((1.0, 1.0, 0.0), (1.55, 1.0, 0.0))),
+                    b.add_crowd(["people"], exits=[EXIT])),
+         r"agent 0 of 'people' overlaps agent 1 of 'people' by 0.05 m: their sliding friction"),
     ],
     ids=[
         "radius", "negative-repulsion", "negative-friction", "speed", "tau", "no-goal",
         "flat-exit", "goal-in-wall", "exit-in-wall", "agent-in-wall", "stranded-agent",
         "unknown-wall", "misspelt-wall", "unknown-target", "emitter-target", "two-crowds",
-        "step-vs-tau", "step-vs-k", "tiny-range", "max-speed",
+        "step-vs-tau", "step-vs-k", "tiny-range", "max-speed", "deep-overlap",
     ],
 )  # fmt: skip
 def test_bad_crowds_are_refused_naming_entity_and_field(steps, match):
@@ -408,8 +409,8 @@ def test_hostile_positions_give_a_clear_refusal_or_a_finite_run(points, duplicat
 
 def test_reach_of_the_repulsion_is_the_stated_cut():
     """The repulsion is cut where A exp(−s/B) = CUTOFF · A: s = B ln(1/CUTOFF) beyond contact."""
-    stage, x, v = _pair()
-    assert REACH == pytest.approx(math.log(1e3))
+    stage = _crowd_stage(_pair_model())
+    assert math.log(1e3) == pytest.approx(REACH)
     gap = stage.params[0, 6]
     x = np.array([[0.0, 1.0, 0.0], [0.56 + gap * (1 - 1e-9), 1.0, 0.0]])
     _, near, _ = stage.forces(x, np.zeros((2, 3)))

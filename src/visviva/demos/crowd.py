@@ -28,8 +28,8 @@ from ..simulation.simulation import Simulation
 from . import Demo, register_demo
 
 DURATION = 120.0  # [s]: longer than the evacuation (the run stops when everyone is out)
-DT = 0.01  # [s]: h/τ = 0.02; below 2/√(2k/m) = 0.037 s
-RECORD_EVERY = 20  # 5 frames per second
+DT = 0.005  # [s]: see the module docstring
+RECORD_EVERY = 40  # 5 frames per second
 AGENTS = 200
 ROOM = 14.0  # [m]: side of the square room (inside)
 DOOR = 1.2  # [m]: width of the door

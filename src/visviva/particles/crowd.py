@@ -50,13 +50,22 @@ for ``B`` = 0.08 m), so the grid's radius is ``2 r_max + 6.9 B``; the force jump
 **Time stepping.** The crowd is a post-step stage: the integrator moves the particles with the
 other forces of the scene; then this stage evaluates the social forces at the new positions and
 velocities and kicks the velocities by ``h F/m`` (forward Euler in the velocity, the positions
-following in the next step: operator splitting, first order in ``h``). It is stable and
-accurate for ``h`` well below the relaxation time ``τ`` (the drive alone relaxes the velocity by
-the factor ``1 − h/τ`` a step, which oscillates beyond ``h = τ``) and below ``2/√(2k/m)`` for two
-agents pressed together (symplectic Euler on the body force's oscillation; 0.037 s for the
-papers' ``k`` and 80 kg); the scene builder refuses steps beyond either. The friction adds a
-damping rate ``κ g/m`` that grows with the overlap ``g``: with the papers' values, overlaps of a
-few centimetres ask for ``h`` of 10 ms or less.
+following in the next step: operator splitting, first order in ``h``). Three limits on ``h``:
+
+* the relaxation time: the drive alone scales the velocity's distance from ``v⁰ e`` by
+  ``1 − h/τ`` a step, which oscillates beyond ``h = τ``; ``h`` should be well below ``τ``;
+* the body force: two agents pressed together oscillate at ``√(2k/m)``, which symplectic Euler
+  follows only for ``h < 2/√(2k/m)`` (37 ms for the papers' ``k`` and 80 kg);
+* the sliding friction, a damper of rate ``κ g (1/m_i + 1/m_j)`` on the relative sliding of a
+  pair overlapping by ``g``: explicit, it reverses the sliding once ``h κ g (1/m_i + 1/m_j)``
+  exceeds 1 (and grows beyond 2). With the papers' ``κ`` and 80 kg, ``g`` must stay below
+  ``m/(2 h κ)``: 3.3 cm at ``h`` = 5 ms, which covers the few centimetres of a jam at a door;
+  at 10 ms, jams approach the limit.
+
+The scene builder refuses steps beyond the first two and agents that start overlapping beyond
+the third; within a run, deeper overlaps (a panicking crowd, ``v⁰`` of several m/s) ask for a
+smaller ``h``. Without noise, an arch of agents across a narrow door can hold for good (as in
+granular flow): the flow then stops with agents left inside.
 """
 
 from __future__ import annotations
