@@ -4,6 +4,7 @@
 * :mod:`~visviva.particles.emission`: the stage that makes particles live and die;
 * :mod:`~visviva.geometry.neighbour_grid`: which points are near which, every step (a hashed
   uniform grid; :func:`neighbours` and :class:`NeighbourGrid`);
+* :mod:`~visviva.particles.boids`: flocking, Reynolds' boids as a post-step stage;
 * :mod:`~visviva.particles.random`: random numbers that depend on who a particle is, not on
   when or where it was computed.
 """
