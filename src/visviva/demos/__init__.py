@@ -213,6 +213,7 @@ def _load_builtins() -> None:
         cloth_drape,
         cloth_hang,
         constrained_pendulum,
+        crowd,
         dahlquist,
         double_pendulum,
         dzhanibekov,
