@@ -163,5 +163,6 @@ register_demo(
         run,
         picture=True,
         speed=2.0,
+        color_by="speed",
     )
 )
