@@ -69,8 +69,8 @@ def room(
     }
     jamb = half + t - 0.5 * door  # length of the front wall on either side of the door
     for name, sign in (("front_left", -1.0), ("front_right", 1.0)):
-        centre = sign * (0.5 * door + 0.5 * jamb)
-        boxes[name] = ((side + 0.5 * t, HEIGHT, centre), (t, 2.0, jamb))
+        z = sign * (0.5 * door + 0.5 * jamb)
+        boxes[name] = ((side + 0.5 * t, HEIGHT, z), (t, 2.0, jamb))
     for name, (centre, size) in boxes.items():
         builder.add_collider("box", center=centre, size=size, name=name)
     rng = np.random.default_rng(seed)

@@ -46,16 +46,17 @@ def crowd_stage(
     if not crowds:
         return None
     entities = scene.entities
+    colliders = {i: e for i, e in enumerate(entities) if isinstance(e, Collider)}
     walls = sorted(
         {w for _, crowd in crowds for w in wall_indices(crowd, entities)},
-        key=lambda i: (entities[i].shape != "plane", i),  # planes first (ColliderSet)
+        key=lambda i: (colliders[i].shape != "plane", i),  # planes first (ColliderSet)
     )
     if len(walls) > MAX_COLLIDERS:
         raise Located(
             f"entities[{walls[MAX_COLLIDERS]}]",
             f"crowds may have at most {MAX_COLLIDERS} walls in all",
         )
-    shapes = [_shape(entities[i], f"entities[{i}]") for i in walls]  # type: ignore[arg-type]
+    shapes = [_shape(colliders[i], f"entities[{i}]") for i in walls]
     collider_set = ColliderSet(shapes)
     wall_names = [names[i] for i in walls]
     owner: dict[int, str] = {}
