@@ -3,7 +3,8 @@
 Particles (points with a radius) collide with static colliders. This package gives their
 geometry and the two responses: the collision stage (impulses with restitution and friction,
 time of impact by bisection; :mod:`~visviva.collision.response`) and the penalty force
-(:mod:`~visviva.collision.penalty`).
+(:mod:`~visviva.collision.penalty`). Particles also collide with each other as spheres
+(:mod:`~visviva.collision.particle_contacts`).
 
 * :mod:`~visviva.collision.shapes`: :class:`Plane` (half-space or slab), :class:`Sphere`,
   :class:`Box`, :class:`TriangleMesh`, validated at construction, each with vectorized
@@ -29,6 +30,7 @@ from __future__ import annotations
 
 from .bvh import MeshBVH
 from .colliders import MAX_COLLIDERS, ColliderSet
+from .particle_contacts import PairContacts, ParticleContacts
 from .penalty import PenaltyContact
 from .response import ColliderResponse, ParticleCollisions
 from .shapes import Box, Plane, Sphere, TriangleMesh
@@ -41,7 +43,9 @@ __all__ = [
     "ColliderResponse",
     "ColliderSet",
     "MeshBVH",
+    "PairContacts",
     "ParticleCollisions",
+    "ParticleContacts",
     "PenaltyContact",
     "Plane",
     "Sphere",
