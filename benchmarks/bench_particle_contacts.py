@@ -17,8 +17,8 @@ One step of the contact stage, as a simulation takes it: detection (``|x_i − x
 the speculative margin of the step's motion), ``K`` = 10 sweeps of impulses (restitution 0.5,
 friction 0.3) and ``K`` sweeps of projections:
 
-* visviva: ``ParticleContacts.resolve`` (the neighbour grid, the compiled sweeps), warm start
-  off so that every repeat does the same work;
+* visviva: ``ParticleContacts.resolve`` (the neighbour grid, the compiled sweeps), without
+  the last step's impulses (no warm start), so that every repeat does the same work;
 * SciPy + NumPy: ``cKDTree(x).query_pairs(2r + margin, output_type="ndarray")``, then the same
   per-contact arithmetic (normals, targets, accumulated and clamped normal and friction
   impulses, projections) vectorized over all contacts at once, each sweep's changes summed per
@@ -98,12 +98,11 @@ def visviva_step(x: np.ndarray, v: np.ndarray):
         np.full(x.shape[0], 1.0 / MASS), restitution=RESTITUTION, friction=FRICTION,
         iterations=SWEEPS, gravity=(0.0, 0.0, 0.0),
     )  # fmt: skip
-    stage.warm = False
 
     def call() -> tuple[np.ndarray, np.ndarray, int]:
         xs, vs = x.copy(), v.copy()
-        count = stage.resolve(x - H * v, xs, vs, np.full(x.shape[0], RADIUS), ALIVE[x.shape[0]], H)
-        return xs, vs, count
+        stage.resolve(x - H * v, xs, vs, np.full(x.shape[0], RADIUS), ALIVE[x.shape[0]], H)
+        return xs, vs, int(stage.last.first.shape[0])
 
     return call
 

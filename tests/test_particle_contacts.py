@@ -327,3 +327,21 @@ def test_hostile_positions_and_radii_give_finite_results_and_keep_momentum(
     assert np.isfinite(x1).all() and np.isfinite(v1).all()
     p0, p1 = (mass[:, None] * v).sum(0), (mass[:, None] * v1).sum(0)
     assert np.abs(p1 - p0).max() <= 1e-12 * max((mass[:, None] * np.abs(v)).sum(), 1e-300)
+
+
+def test_the_warm_start_lives_in_the_state_checkpoints_and_all():
+    """Two simulations of one model do not share the remembered impulses, and a checkpoint
+    restores them: the runs agree to the last bit."""
+    model = scene_column(6).build()
+    first, second = vv.Simulation(model), vv.Simulation(model)
+    first.run(until=0.5)
+    blob = first.checkpoint()
+    second.run(until=0.3)  # in between, on the same stage object
+    first.run(until=0.8)
+    second.run(until=0.8)
+    restored = vv.Simulation.restore(model, blob)
+    restored.run(until=0.8)
+    for other in (second, restored):
+        for name in ("particle_position", "particle_velocity", "contact_normal_impulse"):
+            np.testing.assert_array_equal(other.state[name], first.state[name])
+    assert first.state["contact_normal_impulse"].shape[0] >= 6  # remembered contacts

@@ -59,7 +59,10 @@ if TYPE_CHECKING:
     from ..ode.state import State
     from .response import ParticleCollisions
 
-__all__ = ["MAX_ITERATIONS", "MOTION_CAP", "PairContacts", "ParticleContacts"]
+__all__ = ["MAX_ITERATIONS", "MEMORY", "MOTION_CAP", "PairContacts", "ParticleContacts"]
+
+#: The carried parts of the warm start (see :meth:`ParticleContacts.carried_start`).
+MEMORY = ("contact_start", "contact_partner", "contact_normal_impulse", "contact_tangent_impulse")
 
 #: The largest move of a step [in diameters of the largest sphere] the detection widens its
 #: search for; faster pairs may pass through each other.
@@ -174,26 +177,36 @@ class ParticleContacts:
         self.up = -g / size if size > 0.0 else np.zeros(3)
         self.colliders = colliders
         self._grid: NeighbourGrid | None = None
-        #: Whether persisting contacts start from their last step's impulses (Catto 2005).
-        self.warm = True
-        self._memory: tuple[np.ndarray, ...] | None = None
-        #: The contacts of the latest :meth:`resolve`, in solve order, with their impulses.
+        #: The contacts of the latest :meth:`resolve` (of any simulation of the model), in
+        #: solve order, with their impulses: for inspection.
         self.last: kernels.ContactArrays | None = None
+
+    def carried_start(self) -> dict[str, np.ndarray]:
+        """The carried parts this stage keeps, at the start: the impulses of the last step's
+        contacts by lower particle, for the warm start (``contact_start`` ``(N + 1,)``, then
+        per contact ``contact_partner``, ``contact_normal_impulse`` [N·s] and
+        ``contact_tangent_impulse`` [N·s], ``(C, 3)``). Kept in the state, so that a
+        checkpoint restores them and two simulations of one model do not share them."""
+        count = self.inverse_mass.shape[0]
+        return dict(zip(MEMORY, (np.zeros(count + 1, np.int64), np.zeros(0, np.int64),
+                                 np.zeros(0), np.zeros((0, 3))), strict=True))  # fmt: skip
 
     def apply(self, before: State, after: State, h: float) -> State:
         """The state with the targeted spheres' collisions resolved (velocities) and their
         overlaps removed (positions)."""
         parts = tuple(np.array(part) for part in after.parts)
         result = after.from_parts(after.t, parts)
-        self.resolve(
+        memory = tuple(after[name] for name in MEMORY) if MEMORY[0] in after.carried else None
+        memory = self.resolve(
             before["particle_position"],
             result["particle_position"],
             result["particle_velocity"],
             after["particle_radius"],
             after["particle_alive"],
             h,
+            memory,
         )
-        return result
+        return result.with_carried(**dict(zip(MEMORY, memory, strict=True)))
 
     def resolve(
         self,
@@ -203,17 +216,20 @@ class ParticleContacts:
         radius: np.ndarray,
         alive: np.ndarray,
         h: float,
-    ) -> int:
+        memory: tuple[np.ndarray, ...] | None = None,
+    ) -> tuple[np.ndarray, ...]:
         """Resolve the contacts of a step of ``h`` [s] from ``x0`` to ``x`` [m] in place on
         ``x`` and ``v`` [m/s] (``(N, 3)`` each); ``radius`` ``(N,)`` [m], ``alive`` ``(N,)``
-        bool. Returns the number of contacts (speculative ones included). Non-finite positions
-        are left to the divergence watch."""
+        bool; ``memory``: the last step's impulses (:meth:`carried_start`'s parts) for the
+        warm start, or ``None``. Returns this step's. Non-finite positions are left to the
+        divergence watch (and nothing is remembered)."""
         active = np.asarray(alive, dtype=np.bool_) & self.targets
         x0 = np.ascontiguousarray(x0, dtype=np.float64)
         radius = np.ascontiguousarray(radius, dtype=np.float64)
         largest, move, finite = kernels.scan(x0, x, radius, active)
         if not finite or largest == 0.0:
-            return 0
+            self.last = None
+            return tuple(self.carried_start().values())
         slack = SPECULATIVE * 2.0 * largest + min(2.0 * move, MOTION_CAP * 2.0 * largest)
         reach = 2.0 * largest + slack
         g = self._grid_over(x, active, reach)
@@ -227,15 +243,14 @@ class ParticleContacts:
         )  # fmt: skip
         total = contacts.first.shape[0]
         if total:
-            if self._memory is not None:
-                kernels.warm_start(contacts, *self._memory, v, self.inverse_mass)
+            if memory is not None and memory[0].shape[0] == x.shape[0] + 1:
+                kernels.warm_start(contacts, *memory, v, self.inverse_mass)
             parallel = total >= PARALLEL_MIN_CONTACTS and contacts.slabs > 1
             kernels.solve(
                 contacts, x, v, self.inverse_mass, self.iterations, self.iterations, parallel
             )
-        self._memory = kernels.remember(contacts, x.shape[0]) if self.warm else None
         self.last = contacts
-        return int(total)
+        return tuple(kernels.remember(contacts, x.shape[0]))
 
     def pair_contacts(self, state: State, gap: float = DEFAULT_GAP) -> PairContacts:
         """The sphere–sphere contacts of ``state``'s targeted live particles: pairs whose
