@@ -4,12 +4,15 @@ After each integrator step (and the handles), :class:`ParticleContacts` makes th
 live particles — spheres of their radii ``particle_radius`` — stop passing into each other:
 
 1. **Detection** on the shared :class:`~visviva.geometry.NeighbourGrid`, built over the
-   step's end positions with the interaction radius ``2 r_max + 2 |Δx|_max`` (twice the
-   largest radius plus twice the largest move of the step, the move capped at
-   :data:`MOTION_CAP` diameters): two spheres are in contact when their centres end closer
+   step's end positions with the interaction radius ``2 r_max + m``, the margin ``m`` twice
+   the largest move of the step (capped at :data:`MOTION_CAP` diameters) plus
+   :data:`SPECULATIVE` diameters: two spheres are in contact when their centres end closer
    than ``r_i + r_j`` (the normal along the line of centres), or when the straight chord of
    their relative motion over the step entered that distance — they passed through each
-   other — and then the normal is the direction at the first touch. Each sphere's contacts
+   other — and then the normal is the direction at the first touch, or when they end apart by
+   less than ``m``: a speculative contact, which may close its gap ``g`` in the next step
+   (its target is a normal velocity of at least ``−g/h``) but not more, unless it would close
+   it anyway: then it collides now. Each sphere's contacts
    with the static impulse colliders (:class:`~visviva.collision.ColliderSet`) are found too:
    a pile resting on a floor is solved as one system, the colliders as bodies of infinite mass.
 2. **Impulses** (velocities): sequential impulses, the projected Gauss–Seidel iteration of
@@ -21,7 +24,10 @@ live particles — spheres of their radii ``particle_radius`` — stop passing i
    (B. Mirtich and J. Canny, "Impulse-based simulation of rigid bodies", I3D 1995). Every
    impulse ``J`` changes the two velocities by ``J / m_i`` and ``−J / m_j``: linear momentum
    is conserved to round-off. For one contact this is the closed form of a 1-D collision,
-   ``v₁' = ((m₁ − e m₂) v₁ + (1 + e) m₂ v₂) / (m₁ + m₂)``.
+   ``v₁' = ((m₁ − e m₂) v₁ + (1 + e) m₂ v₂) / (m₁ + m₂)``. A contact that persists from the
+   last step starts from the impulses it ended it with (Catto's warm start, "temporal
+   coherence"), so a resting pile's impulses converge over the steps; they are carried in the
+   state (:meth:`ParticleContacts.carried_start`).
 3. **Projections** (positions): sweeps that remove what overlap is left, moving each pair
    apart along its normal in the ratio of the inverse masses (their centre of mass stays put),
    as position-based dynamics projects a constraint (M. Müller, B. Heidelberger, M. Hennix,
@@ -32,8 +38,9 @@ live particles — spheres of their radii ``particle_radius`` — stop passing i
 
 The contacts are swept bottom-up (along gravity) so that a pile's support is met before what
 rests on it, and in slabs along a horizontal axis: contacts of slabs two apart share no sphere,
-so the even slabs are swept at once on every core, then the odd ones. The order is the same on
-any number of threads, so the result is too.
+so the even slabs may be swept at once on every core, then the odd ones
+(:data:`PARALLEL_MIN_CONTACTS` says from how many contacts). The order is the same either way
+and on any number of threads, so the result is too.
 
 The spheres do not spin: friction slows the relative sliding of their centres. Pinned
 particles (held by handles) are of infinite mass. A pair whose relative move in one step is
@@ -52,6 +59,7 @@ import numpy as np
 from .._validation import describe, real_number, whole_number
 from ..errors import ModelError
 from ..geometry.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid
+from . import contact_detection as detection
 from . import contact_kernels as kernels
 from .contacts import CLASSES, COLLIDING, DEFAULT_GAP, RESTING, SEPARATING
 
@@ -59,7 +67,14 @@ if TYPE_CHECKING:
     from ..ode.state import State
     from .response import ParticleCollisions
 
-__all__ = ["MAX_ITERATIONS", "MEMORY", "MOTION_CAP", "PairContacts", "ParticleContacts"]
+__all__ = [
+    "MAX_ITERATIONS",
+    "MEMORY",
+    "MOTION_CAP",
+    "SPECULATIVE",
+    "PairContacts",
+    "ParticleContacts",
+]
 
 #: The carried parts of the warm start (see :meth:`ParticleContacts.carried_start`).
 MEMORY = ("contact_start", "contact_partner", "contact_normal_impulse", "contact_tangent_impulse")
@@ -226,7 +241,7 @@ class ParticleContacts:
         active = np.asarray(alive, dtype=np.bool_) & self.targets
         x0 = np.ascontiguousarray(x0, dtype=np.float64)
         radius = np.ascontiguousarray(radius, dtype=np.float64)
-        largest, move, finite = kernels.scan(x0, x, radius, active)
+        largest, move, finite = detection.scan(x0, x, radius, active)
         if not finite or largest == 0.0:
             self.last = None
             return tuple(self.carried_start().values())
@@ -234,7 +249,7 @@ class ParticleContacts:
         reach = 2.0 * largest + slack
         g = self._grid_over(x, active, reach)
         parallel = g.order.shape[0] >= PARALLEL_MIN_POINTS
-        pairs = kernels.pair_contacts(g, x0, radius, reach, slack, parallel)
+        pairs = detection.pair_contacts(g, x0, radius, reach, slack, parallel)
         found, law = self._collider_contacts(x, radius, g.order, slack)
         contacts = kernels.assemble(
             x, v, radius, found, pairs,
@@ -260,7 +275,7 @@ class ParticleContacts:
         v = np.asarray(state["particle_velocity"], dtype=np.float64)
         radius = np.ascontiguousarray(state["particle_radius"], dtype=np.float64)
         active = np.asarray(state["particle_alive"], dtype=np.bool_) & self.targets
-        largest, _, finite = kernels.scan(x, x, radius, active)
+        largest, _, finite = detection.scan(x, x, radius, active)
         if not finite:
             raise ModelError("the state's particle positions are not all finite")
         if largest == 0.0:
@@ -269,7 +284,7 @@ class ParticleContacts:
                                 np.zeros(0, np.int8))  # fmt: skip
         grid = NeighbourGrid(2.0 * largest + gap)
         grid.update(x, active)
-        a, b, nx, ny, nz = kernels.pair_contacts(
+        a, b, nx, ny, nz = detection.pair_contacts(
             grid.arrays, x, radius, grid.radius, gap, grid.count >= PARALLEL_MIN_POINTS
         )
         normal = np.stack([nx, ny, nz], axis=1)
@@ -303,7 +318,7 @@ class ParticleContacts:
         if stage is None:
             none, empty = np.zeros(0, np.int64), np.zeros(0)
             return (none, none, empty, empty, empty, empty), (empty, empty, empty)
-        found = kernels.collider_contacts(
+        found = detection.collider_contacts(
             x, radius, order, stage.masks, slack, stage.colliders.kernel_arrays[1:]
         )
         r = stage.response
@@ -312,7 +327,7 @@ class ParticleContacts:
     def _frame(self, g: Any, reach: float) -> tuple[Any, ...]:
         """Slabs along the horizontal axis of widest extent, layers along ``up``."""
         ux, uy, uz = (float(c) for c in self.up)
-        bounds = kernels.extents(g.x, g.y, g.z, ux, uy, uz)
+        bounds = detection.extents(g.x, g.y, g.z, ux, uy, uz)
         spans = bounds[:, 1] - bounds[:, 0]
         axis = int(np.argmax(spans[:3] * (1.0 - np.abs(self.up))))
         width = max(reach * _SLAB_MARGIN, spans[axis] / MAX_SLABS)
