@@ -50,7 +50,7 @@ more than :data:`MOTION_CAP` diameters may pass through each other unseen.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -259,7 +259,8 @@ class ParticleContacts:
         total = contacts.first.shape[0]
         if total:
             if memory is not None and memory[0].shape[0] == x.shape[0] + 1:
-                kernels.warm_start(contacts, *memory, v, self.inverse_mass)
+                start, partner, normal, tangent = memory
+                kernels.warm_start(contacts, start, partner, normal, tangent, v, self.inverse_mass)
             parallel = total >= PARALLEL_MIN_CONTACTS and contacts.slabs > 1
             kernels.solve(
                 contacts, x, v, self.inverse_mass, self.iterations, self.iterations, parallel
@@ -267,8 +268,12 @@ class ParticleContacts:
         self.last = contacts
         return tuple(kernels.remember(contacts, x.shape[0]))
 
-    def pair_contacts(self, state: State, gap: float = DEFAULT_GAP) -> PairContacts:
-        """The sphere–sphere contacts of ``state``'s targeted live particles: pairs whose
+    def pair_contacts(
+        self, state: State | Mapping[str, np.ndarray], gap: float = DEFAULT_GAP
+    ) -> PairContacts:
+        """The sphere–sphere contacts of ``state``'s targeted live particles (a state, a
+        simulation's ``sim.state``, or a mapping of ``particle_position``,
+        ``particle_velocity``, ``particle_radius`` and ``particle_alive``): pairs whose
         surfaces are within ``gap`` [m] (classified with the stage's resting speed)."""
         gap = real_number("gap", gap, nonnegative=True, unit=" m")
         x = np.ascontiguousarray(state["particle_position"], dtype=np.float64)
@@ -280,8 +285,8 @@ class ParticleContacts:
             raise ModelError("the state's particle positions are not all finite")
         if largest == 0.0:
             i = np.zeros(0, np.int64)
-            return PairContacts(i, i, np.zeros((0, 3)), np.zeros((0, 3)), *[np.zeros(0)] * 2,
-                                np.zeros(0, np.int8))  # fmt: skip
+            none = np.zeros((0, 3))
+            return PairContacts(i, i, none, none, np.zeros(0), np.zeros(0), np.zeros(0, np.int8))
         grid = NeighbourGrid(2.0 * largest + gap)
         grid.update(x, active)
         a, b, nx, ny, nz = detection.pair_contacts(

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from ..collision import ParticleContacts
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
@@ -96,26 +97,37 @@ def build_scene(
                 color=color,
                 name=f"balls{k}",
             )
-    law = {"restitution": RESTITUTION, "friction": FRICTION}
-    builder.add_collider("plane", point=(0, 0, 0), normal=(0, 1, 0), name="floor", **law)
+    e, mu = RESTITUTION, FRICTION
+    builder.add_collider(
+        "plane", point=(0, 0, 0), normal=(0, 1, 0), restitution=e, friction=mu, name="floor"
+    )
     for axis, side in ((0, 1.0), (0, -1.0), (2, 1.0), (2, -1.0)):
         point, normal = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
         point[axis], normal[axis] = -side * box / 2.0, side
-        builder.add_collider("plane", point=tuple(point), normal=tuple(normal), **law)
-    builder.add_particle_collisions(iterations=iterations, name="balls collide", **law)
+        builder.add_collider("plane", point=point, normal=normal, restitution=e, friction=mu)
+    builder.add_particle_collisions(
+        restitution=e, friction=mu, iterations=iterations, name="balls collide"
+    )
     return builder
+
+
+def contact_stage(simulation: Simulation) -> ParticleContacts:
+    """The simulation's particle–particle contact stage."""
+    return next(s for s in simulation.model.stages if isinstance(s, ParticleContacts))
 
 
 def pit_measures(simulation: Simulation) -> dict[str, float]:
     """The deepest ball–ball and ball–floor overlaps of the current state [in radii] and the
     floor's share of the pile's weight in the last step (1 at rest)."""
     state = simulation.state
-    stage = simulation.model.stages[0]
+    stage = contact_stage(simulation)
     radius = state["particle_radius"]
     contacts = stage.pair_contacts(state)
     pairs = float(contacts.depth.max() / radius.max()) if len(contacts) else 0.0
     floor = float(np.max(radius - state["particle_position"][:, 1]) / radius.max())
     last = stage.last
+    if last is None:
+        raise ValueError("the simulation has not taken a step yet")
     box = last.second < 0
     on_floor = box & (last.collider == 0)
     weight = float(np.sum(simulation.model.particle_mass)) * GRAVITY * simulation.dt
@@ -126,6 +138,7 @@ def pit_measures(simulation: Simulation) -> dict[str, float]:
         "floor_overlap_over_radius": max(floor, 0.0),
         "floor_normal_impulse_over_weight": float(last.normal_impulse[on_floor].sum() / weight),
         "box_vertical_impulse_over_weight": float(lift.sum() / weight),
+        "contacts": float(last.first.shape[0]),
     }
 
 
@@ -159,12 +172,28 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     energy.set_ylabel("kinetic energy [J]")
     energy.set_title(f"{mass.shape[0]} balls settling")
     energy.legend(fontsize=8)
+    # The cut through the middle of the box (the plane z = 0): each ball it crosses is a disc
+    # of radius √(r² − z²); two discs overlap only where their balls do.
+    from matplotlib.collections import EllipseCollection
+
     last = x[-1]
-    side.scatter(last[:, 0], last[:, 1], s=2.0, c=recording.static.get("color", None))
+    cut = np.abs(last[:, 2]) < RADIUS
+    widths = 2.0 * np.sqrt(RADIUS**2 - last[cut, 2] ** 2)
+    colors = np.asarray(recording.static["color"])[cut] if "color" in recording.static else None
+    side.add_collection(
+        EllipseCollection(
+            widths, widths, 0.0, units="xy", offsets=last[cut][:, :2],
+            offset_transform=side.transData, facecolors=colors, edgecolors="0.2",
+            linewidths=0.3,
+        )
+    )  # fmt: skip
+    side.plot([-BOX / 2, -BOX / 2, BOX / 2, BOX / 2], [0.9, 0.0, 0.0, 0.9], color="k")
+    side.set_xlim(-0.55 * BOX, 0.55 * BOX)
+    side.set_ylim(-0.02, max(0.9, float(last[:, 1].max()) + 2.0 * RADIUS))
     side.set_aspect("equal")
     side.set_xlabel("x [m]")
     side.set_ylabel("height y [m]")
-    side.set_title(f"Side view at t = {t[-1]:.2f} s")
+    side.set_title(f"Cut through the middle of the box, t = {t[-1]:.2f} s")
     output.figures["ball_pit"] = figure
 
     return {
@@ -189,7 +218,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
             "peak": float(kinetic.max()),
             "end": float(kinetic[-1]),
         },
-        "contacts_at_end": int(model.stages[0].last.first.shape[0]),
+        "contacts_at_end": int(end["contacts"]),
     }
 
 
