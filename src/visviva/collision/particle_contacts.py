@@ -92,14 +92,14 @@ MAX_ITERATIONS = 10_000
 #: Most slabs (the parallel solve's unit) and layers (bottom-up order within a slab).
 MAX_SLABS = 64
 MAX_LAYERS = 1024
-#: Fewest contacts for which the solve sweeps the slabs on every core. Measured on 2 cores
-#: shared with other jobs (November 2026; benchmarks/bench_particle_contacts.py, part (c)):
-#: 20 + 20 sweeps over 59,000 contacts took 41 ms on one core and 240–400 ms on two, over
-#: 307,000 contacts 237–402 against 652–702 ms (each sweep is two parallel regions, and a
-#: region waits for its slowest thread), so the solve stays on one core up to a million
-#: contacts; the detection uses both (the grid's PARALLEL_MIN_POINTS). Either path gives the
-#: same numbers.
-PARALLEL_MIN_CONTACTS = 1 << 20
+#: Fewest contacts for which the solve sweeps the slabs on every core (either path gives the
+#: same numbers). Measured on 2 idle cores of a Zen 5 EPYC (November 2026;
+#: benchmarks/bench_particle_contacts.py, part (c)), 20 + 20 sweeps: 1,311 contacts 0.72 ms on
+#: one core against 0.56 on two, 5,535 3.2 against 2.0, 46,697 32 against 19, 306,530 220
+#: against 116. Each sweep is two parallel regions and a region waits for its slowest thread:
+#: with other jobs on the cores, two threads measured 6–10 times slower than one (59,000
+#: contacts: 240–400 ms against 41).
+PARALLEL_MIN_CONTACTS = 1024
 # The slabs' width exceeds the interaction radius by this factor, so that the two spheres of a
 # contact always lie in neighbouring slabs despite rounding.
 _SLAB_MARGIN = 1.0 + 2.0**-10
