@@ -176,7 +176,7 @@ def bench_steps(args: argparse.Namespace, checks: Checks) -> None:
         ALIVE[x.shape[0]] = np.ones(x.shape[0], dtype=bool)
         ours = measure(visviva_step(x, v), args.repeats, f"visviva {name}")
         theirs = measure(numpy_step(x, v), args.repeats, f"scipy {name}")
-        for label, timing in ((f"visviva ({cores} threads detect)", ours),
+        for label, timing in ((f"visviva ({cores} threads)", ours),
                               ("cKDTree + NumPy (Jacobi)", theirs)):  # fmt: skip
             xs, vs, count = timing.result
             rows.append([
