@@ -28,7 +28,7 @@ from ..simulation.simulation import Simulation
 from . import Demo, register_demo
 
 DURATION = 150.0  # [s]: longer than the evacuation (about 126 s)
-DT = 0.005  # [s]: see the module docstring
+DT = 0.005  # [s]: well below tau = 0.5 s and 2/sqrt(2k/m) = 37 ms
 RECORD_EVERY = 40  # 5 frames per second
 AGENTS = 200
 ROOM = 14.0  # [m]: side of the square room (inside)

@@ -17,7 +17,6 @@ import numpy as np
 from .._validation import describe, did_you_mean
 from ..collision.colliders import MAX_COLLIDERS, ColliderSet
 from ..geometry.neighbour_cells import CELL_MARGIN, MAX_CELLS, MAX_COORDINATE
-from ..geometry.neighbour_grid import NeighbourGrid
 from ..particles.crowd import Crowd, CrowdGroup
 from ..particles.crowd_kernels import wall_distances
 from .model import ParticleGroup
@@ -88,7 +87,6 @@ def crowd_stage(
         specs.append(spec)
     stage = Crowd(specs, arrays["mass"], arrays["radius"], collider_set)
     _check_reach(stage, arrays["position"], groups)
-    _check_overlaps(stage, arrays["position"], groups, h)
     return stage
 
 
@@ -271,34 +269,4 @@ def _check_reach(
             int(stage.agents[int(np.argmax(far))]), groups,
             f"lies beyond {reach:.3g} m from the origin, out of the reach of the crowd's "
             "neighbour grid: move the crowd nearer the origin",
-        )  # fmt: skip
-
-
-def _check_overlaps(
-    stage: Crowd, position: np.ndarray, groups: Sequence[ParticleGroup], h: float
-) -> None:
-    """No two agents start overlapping so deeply that their sliding friction, explicit in the
-    step, reverses their relative sliding: ``h κ g (1/m_i + 1/m_j) ≤ 1`` for the overlap ``g``
-    (with the papers' values and 80 kg, ``g`` ≤ 3.3 cm at h = 5 ms)."""
-    agents = stage.agents
-    if agents.shape[0] < 2 or not (stage.params[:, 3] > 0.0).any():
-        return
-    points = position[agents].copy()
-    points[:, 1] = 0.0
-    grid = NeighbourGrid(2.0 * float(stage.radius.max()))
-    grid.update(points)
-    a, b = grid.pairs()
-    overlap = stage.radius[a] + stage.radius[b] - np.hypot(*(points[a] - points[b])[:, [0, 2]].T)
-    kappa = 0.5 * (stage.params[stage.crowd[a], 3] + stage.params[stage.crowd[b], 3])
-    reversal = h * kappa * overlap * (1.0 / stage.mass[a] + 1.0 / stage.mass[b])
-    if (reversal > 1.0).any():
-        k = int(np.argmax(reversal))
-        first, second = int(agents[a[k]]), int(agents[b[k]])
-        deepest = 1.0 / (h * kappa[k] * (1.0 / stage.mass[a[k]] + 1.0 / stage.mass[b[k]]))
-        other = next(g for g in groups if g.start <= second < g.start + g.count)
-        _refuse_agent(
-            first, groups, f"overlaps agent {second - other.start} of {other.name!r} by "
-            f"{float(overlap[k]):.3g} m: their sliding friction would reverse their sliding in "
-            f"one step (h kappa g (1/m_i + 1/m_j) = {float(reversal[k]):.3g} > 1); place the "
-            f"agents at most {deepest:.3g} m into each other, or use a smaller dt",
         )  # fmt: skip

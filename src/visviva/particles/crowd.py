@@ -56,16 +56,18 @@ following in the next step: operator splitting, first order in ``h``). Three lim
   ``1 − h/τ`` a step, which oscillates beyond ``h = τ``; ``h`` should be well below ``τ``;
 * the body force: two agents pressed together oscillate at ``√(2k/m)``, which symplectic Euler
   follows only for ``h < 2/√(2k/m)`` (37 ms for the papers' ``k`` and 80 kg);
-* the sliding friction, a damper of rate ``κ g (1/m_i + 1/m_j)`` on the relative sliding of a
-  pair overlapping by ``g``: explicit, it reverses the sliding once ``h κ g (1/m_i + 1/m_j)``
-  exceeds 1 (and grows beyond 2). With the papers' ``κ`` and 80 kg, ``g`` must stay below
-  ``m/(2 h κ)``: 3.3 cm at ``h`` = 5 ms, which covers the few centimetres of a jam at a door;
-  at 10 ms, jams approach the limit.
+* none from the sliding friction, a damper of rate ``λ = κ g (1/m_i + 1/m_j)`` on the
+  relative sliding of a pair overlapping by ``g`` (``κ g / m_i`` against a wall). Explicit, it
+  would reverse the sliding once ``h λ > 1``: with the papers' ``κ`` and 80 kg, at overlaps
+  beyond 3.3 cm at ``h`` = 5 ms, which agents placed at random or a panicking crowd reach (they
+  then circle each other at full speed). So the stage applies it integrated exactly over the
+  step for the pair alone: the sliding decays by ``e^(−h λ)``, i.e. the force is scaled by
+  ``φ(h λ) = (1 − e^(−h λ))/(h λ)``, which is 1 − O(h λ) for small steps (the model's force) and
+  never reverses a pair's sliding.
 
-The scene builder refuses steps beyond the first two and agents that start overlapping beyond
-the third; within a run, deeper overlaps (a panicking crowd, ``v⁰`` of several m/s) ask for a
-smaller ``h``. Without noise, an arch of agents across a narrow door can hold for good (as in
-granular flow): the flow then stops with agents left inside.
+The scene builder refuses steps beyond the first two. Without noise, an arch of agents across a
+narrow door can hold for good (as in granular flow): the flow then stops with agents left
+inside.
 """
 
 from __future__ import annotations
@@ -221,7 +223,7 @@ class Crowd:
         exit_agents(
             self.agents, alive, x, v, self.crowd, self.exits, self.exit_start, exit_time, after.t
         )
-        self._evaluate(x, v, alive, height)
+        self._evaluate(x, v, alive, height, h)
         walk(
             self.agents, alive, x, v, height, self.mass, self._drive, self._social, self._wall,
             self.max_speed, self.crowd, h,
@@ -229,9 +231,10 @@ class Crowd:
         return result.with_carried(particle_alive=alive, crowd_exit_time=exit_time)
 
     def _evaluate(
-        self, x: np.ndarray, v: np.ndarray, alive: np.ndarray, height: np.ndarray
+        self, x: np.ndarray, v: np.ndarray, alive: np.ndarray, height: np.ndarray, h: float
     ) -> None:
-        """The three forces on the live agents into the stage's buffers."""
+        """The three forces on the live agents into the stage's buffers (the sliding friction
+        as a step of ``h`` [s] applies it)."""
         agents = self.agents
         live = alive[agents]
         points = self._points
@@ -243,22 +246,23 @@ class Crowd:
         social_forces(
             self._grid.arrays, px, np.ascontiguousarray(height), pz, vx, vz, self.radius,
             self.mass, self.crowd, self.params, self.goal, self.has_goal, self.exits,
-            self.exit_start, self.wall_mask, self._walls, self._drive, self._social, self._wall,
-            int(live.sum()) >= PARALLEL_MIN_POINTS,
+            self.exit_start, self.wall_mask, self._walls, h, self._drive, self._social,
+            self._wall, int(live.sum()) >= PARALLEL_MIN_POINTS,
         )  # fmt: skip
 
     def forces(
-        self, x: np.ndarray, v: np.ndarray, alive: np.ndarray | None = None
+        self, x: np.ndarray, v: np.ndarray, alive: np.ndarray | None = None, h: float = 0.0
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The social forces [N] at positions ``x`` and velocities ``v`` (``(N, 3)`` each) on
         every live agent: ``(drive, agents, walls)``, each ``(N, 3)`` with zero y component
-        and zero rows for other particles and dead agents (``alive`` ``(N,)``, default all)."""
+        and zero rows for other particles and dead agents (``alive`` ``(N,)``, default all).
+        ``h`` [s]: the sliding friction as a step of ``h`` applies it (0: the model's force)."""
         x = np.asarray(x, dtype=np.float64)
         v = np.asarray(v, dtype=np.float64)
         alive = np.ones(self.count, dtype=bool) if alive is None else np.asarray(alive, bool)
         for buffer in (self._drive, self._social, self._wall):
             buffer[:] = 0.0
-        self._evaluate(x, v, alive, np.ascontiguousarray(x[self.agents, 1]))
+        self._evaluate(x, v, alive, np.ascontiguousarray(x[self.agents, 1]), h)
         live = alive[self.agents]
         results = []
         for buffer in (self._drive, self._social, self._wall):

@@ -49,10 +49,19 @@ def _goal_direction(a, x, z, crowd, goal, has_goal, exits, exit_start):  # pragm
     return ex / norm, ez / norm
 
 
+@njit(cache=True)
+def _sliding_share(rate, h):  # pragma: no cover - compiled
+    """``φ(z) = (1 − e^(−z))/z`` at ``z = h · rate``: the sliding friction of a step, a damper
+    of ``rate`` [1/s] on a pair's relative sliding, integrated exactly over the step (1 at
+    ``h = 0``, the model's force; below 1 beyond, so a step never reverses the sliding)."""
+    z = h * rate
+    return 1.0 if z < 1e-12 else -math.expm1(-z) / z
+
+
 @njit(cache=True, error_model="numpy")
 def _forces_chunk(
     g, px, py, pz, vx, vz, radius, mass, crowd, params, goal, has_goal, exits, exit_start,
-    wall_mask, walls, drive, social, wall, runs, begin, end,
+    wall_mask, walls, h, drive, social, wall, runs, begin, end,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Forces [N] on the agents at sorted positions ``begin .. end − 1`` (see
     :func:`social_forces`)."""
@@ -94,12 +103,9 @@ def _forces_chunk(
                     kb, kappab = params[crowd[b], 2], params[crowd[b], 3]
                     push += 0.5 * (k + kb) * overlap
                     tx, tz = -nz, nx
-                    slide = (
-                        0.5
-                        * (kappa + kappab)
-                        * overlap
-                        * ((vx[b] - vx[a]) * tx + (vz[b] - vz[a]) * tz)
-                    )
+                    damper = 0.5 * (kappa + kappab) * overlap  # [kg/s]
+                    share = _sliding_share(damper * (1.0 / mass[a] + 1.0 / mass[b]), h)
+                    slide = damper * share * ((vx[b] - vx[a]) * tx + (vz[b] - vz[a]) * tz)
                     fx += slide * tx
                     fz += slide * tz
                 fx += push * nx
@@ -122,7 +128,8 @@ def _forces_chunk(
             if overlap > 0.0:
                 push += k * overlap
                 tx, tz = -nz, nx
-                slide = -kappa * overlap * (vx[a] * tx + vz[a] * tz)
+                share = _sliding_share(kappa * overlap / mass[a], h)
+                slide = -kappa * overlap * share * (vx[a] * tx + vz[a] * tz)
                 wx += slide * tx
                 wz += slide * tz
             wx += push * nx
@@ -133,14 +140,14 @@ def _forces_chunk(
 @njit(cache=True, parallel=True)
 def _forces_parallel(
     g, px, py, pz, vx, vz, radius, mass, crowd, params, goal, has_goal, exits, exit_start,
-    wall_mask, walls, drive, social, wall,
+    wall_mask, walls, h, drive, social, wall,
 ):  # fmt: skip  # pragma: no cover - compiled
     n = g.order.shape[0]
     for task in prange((n + CHUNK - 1) // CHUNK):
         runs = np.empty((27, 2), dtype=np.int64)
         _forces_chunk(
             g, px, py, pz, vx, vz, radius, mass, crowd, params, goal, has_goal, exits,
-            exit_start, wall_mask, walls, drive, social, wall, runs, CHUNK * task,
+            exit_start, wall_mask, walls, h, drive, social, wall, runs, CHUNK * task,
             min(n, CHUNK * task + CHUNK),
         )  # fmt: skip
 
@@ -148,18 +155,18 @@ def _forces_parallel(
 @njit(cache=True)
 def _forces_serial(
     g, px, py, pz, vx, vz, radius, mass, crowd, params, goal, has_goal, exits, exit_start,
-    wall_mask, walls, drive, social, wall,
+    wall_mask, walls, h, drive, social, wall,
 ):  # fmt: skip  # pragma: no cover - compiled
     runs = np.empty((27, 2), dtype=np.int64)
     _forces_chunk(
         g, px, py, pz, vx, vz, radius, mass, crowd, params, goal, has_goal, exits, exit_start,
-        wall_mask, walls, drive, social, wall, runs, 0, g.order.shape[0],
+        wall_mask, walls, h, drive, social, wall, runs, 0, g.order.shape[0],
     )  # fmt: skip
 
 
 def social_forces(
     g, px, py, pz, vx, vz, radius, mass, crowd, params, goal, has_goal, exits, exit_start,
-    wall_mask, walls, drive, social, wall, parallel,
+    wall_mask, walls, h, drive, social, wall, parallel,
 ) -> None:  # fmt: skip
     """The three forces [N] on every live agent, written into ``drive``, ``social`` and
     ``wall`` ``(n, 2)`` (x and z; rows of dead agents are left as they are).
@@ -176,12 +183,14 @@ def social_forces(
             ``exit_start`` ``(C + 1,)``: each crowd's first exit.
         wall_mask: Per crowd, bit ``w`` set if collider ``w`` is one of its walls.
         walls: The colliders' kernel arrays (what :func:`collider_distance` takes).
+        h: The step [s] the sliding friction is integrated over (:func:`_sliding_share`; 0:
+            the model's force at an instant).
         parallel: Use every core (a parallel region costs tens of µs to start).
     """
     kernel = _forces_parallel if parallel else _forces_serial
     kernel(
         g, px, py, pz, vx, vz, radius, mass, crowd, params, goal, has_goal, exits, exit_start,
-        wall_mask, walls, drive, social, wall,
+        wall_mask, walls, h, drive, social, wall,
     )  # fmt: skip
 
 
