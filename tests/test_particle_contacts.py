@@ -126,8 +126,17 @@ def test_a_dropped_column_comes_to_rest_stacked():
     y = simulation.state["particle_position"][:, 1]
     np.testing.assert_allclose(y, r + 2 * r * np.arange(10), atol=0.01 * r)
     assert np.abs(simulation.state["particle_velocity"]).max() < 0.05  # [m/s]: g·dt is 0.02
-    contacts = simulation.model.stages[0].pair_contacts(simulation.state)
+    contacts = simulation.pair_contacts()
     assert len(contacts) == 9 and contacts.depth.max() < 0.01 * r
+    np.testing.assert_array_equal(contacts.second - contacts.first, 1)  # each on the one below
+    assert set(contacts.classes()) == {"resting"}
+
+
+def test_pair_contacts_of_a_scene_without_particle_collisions_say_how_to_add_them():
+    builder = vv.SceneBuilder(name="apart")
+    builder.add_particles([[0.0, 1.0, 0.0], [0.01, 1.0, 0.0]], radius=0.05)
+    with pytest.raises(ModelError, match='add an entity of type "particle_collisions"'):
+        vv.Simulation(builder.build()).pair_contacts()
 
 
 def test_momentum_of_a_closed_cloud_is_conserved_to_round_off():

@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..collision.contacts import DEFAULT_GAP, Contacts
+from ..collision.particle_contacts import PairContacts, ParticleContacts
+from ..errors import ModelError
 from ..ode.problems import Problem
 from .systems import SYSTEMS
 
@@ -244,6 +246,22 @@ class Model:
         :mod:`visviva.collision.contacts`)."""
         sources = [s for s in (*self.stages, *self.forces) if hasattr(s, "contacts")]
         return Contacts.join([source.contacts(state, gap) for source in sources])
+
+    def pair_contacts(self, state: State, gap: float = DEFAULT_GAP) -> PairContacts:
+        """The sphere–sphere contacts of ``state`` among the particles of the scene's
+        ``particle_collisions`` (pairs, points, normals, depths, relative normal velocities,
+        classes; see :mod:`visviva.collision.particle_contacts`).
+
+        Raises:
+            ModelError: If the scene has no ``particle_collisions`` entity.
+        """
+        stage = next((s for s in self.stages if isinstance(s, ParticleContacts)), None)
+        if stage is None:
+            raise ModelError(
+                'this scene\'s particles do not collide with each other: add an entity of type '
+                '"particle_collisions" (SceneBuilder.add_particle_collisions)'
+            )
+        return stage.pair_contacts(state, gap)
 
     def frame(self, state: State) -> dict[str, np.ndarray]:
         """What a recording keeps of ``state`` (one frame; see :mod:`.frames`)."""

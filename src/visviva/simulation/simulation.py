@@ -34,6 +34,7 @@ import numpy as np
 
 from .._validation import real_number, whole_number
 from ..collision.contacts import DEFAULT_GAP, Contacts
+from ..collision.particle_contacts import PairContacts
 from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get
 from ..ode.state import State
@@ -197,6 +198,18 @@ class Simulation:
         if gap < 0.0:
             raise ModelError(f"`gap` must be >= 0 (got {gap!r} m)")
         return self.model.contacts(self._current(), gap)
+
+    def pair_contacts(self, gap: float = DEFAULT_GAP) -> PairContacts:
+        """The sphere–sphere contacts now among the particles that collide with each other
+        (a scene's ``particle_collisions``): which pairs touch (surfaces within ``gap`` [m]),
+        where, how deep, and whether colliding, resting or separating
+        (:class:`~visviva.collision.particle_contacts.PairContacts`).
+
+        Raises:
+            ModelError: If the scene's particles do not collide with each other.
+        """
+        gap = real_number("gap", gap, nonnegative=True, unit=" m")
+        return self.model.pair_contacts(self._current(), gap)
 
     def bodies(self) -> BodyViews:
         """What the rigid bodies' state implies now: ``v``, ``R``, the world inverse inertia
