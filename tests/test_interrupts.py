@@ -133,12 +133,12 @@ def test_ctrl_c_while_writing_outputs_keeps_the_finished_ones(tmp_path, monkeypa
     real = outputs.write_output
     calls = []
 
-    def write_then_interrupt(recording, path, fps, speed=1.0, trail=0.0):
+    def write_then_interrupt(recording, path, fps, *playback):
         calls.append(path.name)
         if len(calls) == 2:
             path.write_bytes(b"partial")
             raise KeyboardInterrupt
-        real(recording, path, fps, speed, trail)
+        real(recording, path, fps, *playback)
 
     monkeypatch.setattr(outputs, "write_output", write_then_interrupt)
     out = tmp_path / "out"

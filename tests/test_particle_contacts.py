@@ -132,6 +132,28 @@ def test_a_dropped_column_comes_to_rest_stacked():
     assert set(contacts.classes()) == {"resting"}
 
 
+def test_spheres_beyond_the_grids_reach_are_refused_at_build_and_stop_a_run_cleanly():
+    """The grid bins cells of a diameter up to 2⁴⁰ of them from the origin: a sphere placed
+    beyond is a scene error; one that flies beyond stops the run with an explanation."""
+    builder = vv.SceneBuilder(name="far")
+    builder.set_world(gravity=(0.0, 0.0, 0.0))
+    builder.add_particles([[1e200, 1.0, 0.0], [0.0, 1.0, 0.0]], radius=0.05, name="balls")
+    builder.add_particle_collisions()
+    with pytest.raises(SceneError, match=r"entities\[1\].*beyond the grid's reach"):
+        builder.build()
+    builder = vv.SceneBuilder(name="fast")
+    builder.set_world(gravity=(0.0, 0.0, 0.0))
+    builder.set_integration(dt=0.01, duration=1.0)
+    builder.add_particles(
+        [[0.0, 1.0, 0.0], [1.0, 1.0, 0.0]], velocities=[[1e14, 0.0, 0.0], [0.0, 0.0, 0.0]],
+        radius=0.05, name="balls",
+    )  # fmt: skip
+    builder.add_particle_collisions()
+    simulation = vv.Simulation(builder.build())
+    with pytest.raises(vv.SimulationError, match="particle collisions: .*beyond the grid's reach"):
+        simulation.run(until=1.0)
+
+
 def test_pair_contacts_of_a_scene_without_particle_collisions_say_how_to_add_them():
     builder = vv.SceneBuilder(name="apart")
     builder.add_particles([[0.0, 1.0, 0.0], [0.01, 1.0, 0.0]], radius=0.05)

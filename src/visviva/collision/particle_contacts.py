@@ -57,7 +57,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from .._validation import describe, real_number, whole_number
-from ..errors import ModelError
+from ..errors import ModelError, SimulationError
 from ..geometry.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid
 from . import contact_detection as detection
 from . import contact_kernels as kernels
@@ -212,15 +212,18 @@ class ParticleContacts:
         parts = tuple(np.array(part) for part in after.parts)
         result = after.from_parts(after.t, parts)
         memory = tuple(after[name] for name in MEMORY) if MEMORY[0] in after.carried else None
-        memory = self.resolve(
-            before["particle_position"],
-            result["particle_position"],
-            result["particle_velocity"],
-            after["particle_radius"],
-            after["particle_alive"],
-            h,
-            memory,
-        )
+        try:
+            memory = self.resolve(
+                before["particle_position"],
+                result["particle_position"],
+                result["particle_velocity"],
+                after["particle_radius"],
+                after["particle_alive"],
+                h,
+                memory,
+            )
+        except ModelError as error:  # a sphere flew beyond the grid's reach of the origin
+            raise SimulationError(f"particle collisions: {error}", t=after.t, step=None) from None
         return result.with_carried(**dict(zip(MEMORY, memory, strict=True)))
 
     def resolve(

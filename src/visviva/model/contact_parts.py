@@ -12,6 +12,7 @@ import numpy as np
 
 from ..collision.particle_contacts import ParticleContacts
 from ..errors import ModelError, SceneProblem
+from ..geometry.neighbour_grid import NeighbourGrid
 from .model import ParticleGroup
 from .parts import Located, _targets
 from .scene import Scene
@@ -71,4 +72,19 @@ def contact_stages(
             )
         except ModelError as error:
             raise Located(f"entities[{index}]", str(error)) from None
+        _check_reach(arrays, mask, index)
     return stages
+
+
+def _check_reach(arrays: dict[str, np.ndarray], mask: np.ndarray, index: int) -> None:
+    """The colliding spheres start within the neighbour grid's reach of the origin (2⁴⁰ cells
+    of a diameter, up to 10¹⁵⁰ m): binned once now so that a scene placing them beyond is
+    refused before it runs (a sphere that flies beyond it stops the run with an explanation)."""
+    live = mask & arrays["alive"]
+    largest = float(arrays["radius"][live].max(initial=0.0))
+    if largest == 0.0:
+        return
+    try:
+        NeighbourGrid(2.0 * largest).update(arrays["position"], live)
+    except ModelError as error:
+        raise Located(f"entities[{index}]", f"particle collisions: {error}") from None
