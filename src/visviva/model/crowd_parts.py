@@ -210,7 +210,7 @@ def _check_places(
                 "goal outside the walls",
             )
     if own and spec.exits.shape[0]:
-        centres = 0.5 * (spec.exits[:, 0] + spec.exits[:, 1])
+        centres = 0.5 * spec.exits[:, 0] + 0.5 * spec.exits[:, 1]  # no overflow near 1.8e308
         inside = wall_distances(np.ascontiguousarray(centres), kernel)[:, own] < 0.0
         if inside.any():
             e, w = (int(v) for v in np.argwhere(inside)[0])

@@ -37,8 +37,8 @@ def _goal_direction(a, x, z, crowd, goal, has_goal, exits, exit_start):  # pragm
         best = math.inf
         gx = gz = 0.0
         for e in range(exit_start[c], exit_start[c + 1]):
-            cx = 0.5 * (exits[e, 0] + exits[e, 1])
-            cz = 0.5 * (exits[e, 4] + exits[e, 5])
+            cx = 0.5 * exits[e, 0] + 0.5 * exits[e, 1]
+            cz = 0.5 * exits[e, 4] + 0.5 * exits[e, 5]
             dist2 = (cx - x) * (cx - x) + (cz - z) * (cz - z)
             if dist2 < best:
                 best, gx, gz = dist2, cx, cz
