@@ -150,7 +150,7 @@ def test_spheres_beyond_the_grids_reach_are_refused_at_build_and_stop_a_run_clea
     )  # fmt: skip
     builder.add_particle_collisions()
     simulation = vv.Simulation(builder.build())
-    with pytest.raises(vv.SimulationError, match="particle collisions: .*beyond the grid's reach"):
+    with pytest.raises(vv.SimulationError, match=r"particle collisions: .*beyond the grid's reach"):
         simulation.run(until=1.0)
 
 

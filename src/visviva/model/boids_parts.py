@@ -108,6 +108,7 @@ def boids_stages(
                 leader_weight=_weight(entity.leader_weight, entity.leader),
                 colliders=colliders,
                 look_ahead=entity.look_ahead,
+                min_distance=entity.min_distance,
                 plane=entity.plane,
                 name=entity.name or f"boids{index}",
             )

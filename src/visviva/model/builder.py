@@ -526,6 +526,7 @@ class SceneBuilder:
         leader: str | None = None,
         leader_weight: float | None = None,
         look_ahead: float | None = None,
+        min_distance: float | None = None,
         plane: str | None = None,
         name: str | None = None,
     ) -> int:
@@ -535,7 +536,8 @@ class SceneBuilder:
         ``separation`` [m], alignment and cohesion with weights [1/s]; desired speed
         ``max_speed`` [m/s], steering bounded by ``max_force`` [m/s²]; an optional ``goal``
         point and ``leader`` entity (weights default to 1/s); colliders avoided from
-        ``look_ahead`` [m]; ``plane="xz"`` for a 2-D flock."""
+        ``look_ahead`` [m]; no two boids left closer than ``min_distance`` [m] if given;
+        ``plane="xz"`` for a 2-D flock."""
         return self._add(Boids, "boids", _given(locals()))
 
     def add_crowd(

@@ -46,6 +46,11 @@ class Boids(Strict):
     look_ahead: Positive | None = Field(
         None, description="distance from a collider at which boids turn away [m] (2 V^2/A)"
     )
+    min_distance: Positive | None = Field(
+        None,
+        description="no two boids are left closer than this after a step [m], at most "
+        "`separation` (default: separation only steers)",
+    )
     plane: Literal["xz"] | None = Field(None, description='"xz": a 2-D flock (default 3-D)')
 
     @model_validator(mode="after")
@@ -56,6 +61,13 @@ class Boids(Strict):
                 "`separation` ({separation} m) must not exceed `radius` ({radius} m): a boid "
                 "pushes away only flockmates it sees",
                 {"separation": self.separation, "radius": self.radius},
+            )
+        if self.min_distance is not None and self.min_distance > self.separation:
+            raise PydanticCustomError(
+                "min_distance",
+                "`min_distance` ({low} m) must not exceed `separation` ({high} m): separation "
+                "steers boids apart before they are held apart",
+                {"low": self.min_distance, "high": self.separation},
             )
         if self.min_speed > self.max_speed:
             raise PydanticCustomError(

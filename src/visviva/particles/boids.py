@@ -47,6 +47,18 @@ truncated to V, so every velocity the rules see is bounded. The next step's inte
 the boids with the new velocities. World gravity acts on boids like on any particle: set it to
 zero for birds (their lift is not modelled).
 
+**Spacing** (``min_distance`` d, optional, ``≤ s``): separation is a steering, so a flock held
+together by cohesion settles with its nearest flockmates inside s. Where boids must never come
+closer than d (birds that keep a body length, a swarm of drones), the stage then moves every
+pair of live boids closer than d apart along the line between them, each by half the
+intrusion — the projection of position-based dynamics (M. Müller, B. Heidelberger, M. Hennix &
+J. Ratcliff, "Position based dynamics", VRIPHYS 2006): Gauss–Seidel sweeps over the pairs
+within :data:`SPACING_REACH` d in a fixed order until no pair is closer than d by more than
+:data:`SPACING_TOLERANCE` d (at most :data:`SPACING_SWEEPS` sweeps), the pairs searched again
+if it took more than one sweep (at most :data:`SPACING_ROUNDS` searches). As in position-based
+dynamics each boid's velocity then gains its move over h (truncated to V): a boid that pressed
+into a flockmate stops pressing, instead of being pushed back every step by the projection.
+
 **2-D** (``plane = "xz"``): every desired direction and the steering lose their vertical (y)
 component, the velocity's y is set to zero and each boid is put back at the height it had
 before the step, so a flock stays in its horizontal planes exactly (distances are still 3-D).
@@ -83,6 +95,13 @@ __all__ = ["MAX_LEADERS", "Boids", "polarisation"]
 MAX_CROWDING = 1e8
 #: Sorted boids per parallel task.
 CHUNK = 256
+#: The spacing projection: pairs searched within this many d (so that moves of a quarter of d
+#: meet no pair unseen), at most this many Gauss–Seidel sweeps per search and searches per
+#: step, until no pair is closer than d by more than this fraction of d.
+SPACING_REACH = 1.5
+SPACING_SWEEPS = 64
+SPACING_ROUNDS = 4
+SPACING_TOLERANCE = 1e-9
 #: Most leader particles: every boid looks for the nearest one by brute force (O(N L)).
 MAX_LEADERS = 1024
 #: Largest speed, acceleration bound, weight and look-ahead accepted: sums of a neighbourhood's
@@ -136,6 +155,8 @@ class Boids:
         colliders: The colliders the boids avoid, or ``None``.
         look_ahead: L, the distance from a collider at which a boid turns away [m] (default
             2 V²/A).
+        min_distance: d, the distance [m] no two boids are left closer than after a step
+            (``0 < d ≤ s``), or ``None`` (separation steers only).
         plane: ``"xz"`` for a flock in horizontal planes, ``None`` for 3-D.
         name: The flock's name, for messages.
 
@@ -165,6 +186,7 @@ class Boids:
         leader_weight: float = 0.0,
         colliders: ColliderSet | None = None,
         look_ahead: float | None = None,
+        min_distance: float | None = None,
         plane: str | None = None,
         name: str = "boids",
     ) -> None:
@@ -225,6 +247,17 @@ class Boids:
             if look_ahead is None
             else _bounded("look_ahead", look_ahead, positive=True, unit=" m")
         )
+        self.min_distance = None
+        self._spacing = None
+        if min_distance is not None:
+            self.min_distance = _bounded("min_distance", min_distance, positive=True, unit=" m")
+            if self.min_distance > self.separation:
+                raise ModelError(
+                    f"`min_distance` ({self.min_distance!r} m) must not exceed `separation` "
+                    f"({self.separation!r} m): separation steers boids apart before they are "
+                    "held apart"
+                )
+            self._spacing = NeighbourGrid(SPACING_REACH * self.min_distance)
         if plane not in (None, "xz"):
             raise ModelError(f'`plane` must be "xz" (a 2-D flock) or None (3-D), not {plane!r}')
         self.plane = plane
@@ -258,9 +291,35 @@ class Boids:
             return result  # a blown-up state: the divergence watch reports it
         try:
             self._run(x, v, alive, before["particle_position"], x, v, h)
+            if self._spacing is not None:
+                self._space(x, v, alive, h)
         except ModelError as error:  # a boid beyond the grid's reach of the origin
             raise SimulationError(f"{self.name}: {error}", t=after.t, step=None) from None
         return result
+
+    def _space(self, x: np.ndarray, v: np.ndarray, alive: np.ndarray, h: float) -> None:
+        """Move the live boids at ``x`` (in place) so that no two are closer than
+        ``min_distance``, and add each move over ``h`` to its velocity ``v`` (see the module
+        docstring)."""
+        rows = self.targets
+        start = np.ascontiguousarray(x[rows])
+        points = start.copy()
+        live = np.ascontiguousarray(alive[rows])
+        for _ in range(SPACING_ROUNDS):
+            self._spacing.update(points, live)
+            first, second = self._spacing.pairs()
+            sweeps = _separate(points, first, second, self.min_distance, self.plane == "xz")
+            if sweeps <= 1:  # nothing moved, or one sweep did it: no pair is new
+                break
+        moved = points - start
+        if not moved.any():
+            return
+        x[rows] = points
+        u = v[rows] + moved / h
+        speed = np.sqrt(np.einsum("ij,ij->i", u, u))
+        fast = speed > self.max_speed
+        u[fast] *= (self.max_speed / speed[fast])[:, None]
+        v[rows] = u
 
     def steering(
         self, positions: Any, velocities: Any, alive: Any = None, h: float = 1e-3
@@ -395,6 +454,42 @@ def _truncate(x, y, z, limit):  # pragma: no cover - compiled
         f = limit / length
         return x * f, y * f, z * f
     return x, y, z
+
+
+@njit(cache=True, error_model="numpy")
+def _separate(points, first, second, distance, planar):  # pragma: no cover - compiled
+    """Gauss–Seidel projection of the pairs ``(first[k], second[k])`` of rows of ``points``
+    ``(T, 3)`` [m] to at least ``distance`` [m] apart, each moved by half the intrusion along
+    the line between them (horizontally in a 2-D flock); coincident boids part along x.
+    Sweeps until no pair is closer than ``distance`` by more than :data:`SPACING_TOLERANCE` of
+    it, at most :data:`SPACING_SWEEPS`; returns how many moved a pair (0: none was too close).
+    """
+    slack = SPACING_TOLERANCE * distance
+    for sweep in range(SPACING_SWEEPS):
+        intruded = False
+        for k in range(first.shape[0]):
+            i, j = first[k], second[k]
+            dx = points[i, 0] - points[j, 0]
+            dy = 0.0 if planar else points[i, 1] - points[j, 1]
+            dz = points[i, 2] - points[j, 2]
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)
+            if d >= distance - slack:
+                continue
+            intruded = True
+            if d > 0.0:
+                f = 0.5 * (distance - d) / d
+                dx, dy, dz = f * dx, f * dy, f * dz
+            else:
+                dx, dy, dz = 0.5 * distance, 0.0, 0.0
+            points[i, 0] += dx
+            points[i, 1] += dy
+            points[i, 2] += dz
+            points[j, 0] -= dx
+            points[j, 1] -= dy
+            points[j, 2] -= dz
+        if not intruded:
+            return sweep
+    return SPACING_SWEEPS
 
 
 @njit(cache=True)
