@@ -4,7 +4,8 @@
 * :mod:`~visviva.particles.emission`: the stage that makes particles live and die;
 * :mod:`~visviva.geometry.neighbour_grid`: which points are near which, every step (a hashed
   uniform grid; :func:`neighbours` and :class:`NeighbourGrid`);
-* :mod:`~visviva.particles.boids`: flocking, Reynolds' boids as a post-step stage;
+* :mod:`~visviva.particles.boids`: flocking, Reynolds' boids as a post-step stage
+  (:class:`Boids`, :func:`polarisation`);
 * :mod:`~visviva.particles.crowd`: crowds, the social-force model as a post-step stage, with
   walls and exits (:class:`Crowd`);
 * :mod:`~visviva.particles.random`: random numbers that depend on who a particle is, not on
@@ -12,8 +13,17 @@
 """
 
 from ..geometry.neighbour_grid import NeighbourGrid, neighbours
+from .boids import Boids, polarisation
 from .crowd import Crowd
 from .emission import Emission
 from .emitters import EmitterSpec
 
-__all__ = ["Crowd", "Emission", "EmitterSpec", "NeighbourGrid", "neighbours"]
+__all__ = [
+    "Boids",
+    "Crowd",
+    "Emission",
+    "EmitterSpec",
+    "NeighbourGrid",
+    "neighbours",
+    "polarisation",
+]
