@@ -483,13 +483,15 @@ class SceneBuilder:
         time_of_impact: bool | None = None,
         resting_speed: float | None = None,
         targets: Sequence[str] | None = None,
+        color: Sequence[float] | None = None,
         name: str | None = None,
     ) -> int:
         """Add a static collider: ``"plane"`` (``point``, ``normal``, optional ``thickness``),
         ``"sphere"`` (``center``, ``radius``), ``"box"`` (``center``, ``size``,
         ``orientation``) or ``"mesh"`` (``vertices``, ``triangles``), with ``restitution`` e,
         ``friction`` μ, and ``response`` ``"impulse"`` or ``"penalty"`` (``stiffness``,
-        ``damping``)."""
+        ``damping``). The outputs draw a sphere, box or mesh in its sRGB ``color`` (default
+        grey); planes are not drawn."""
         return self._add(Collider, "collider", _given(locals()))
 
     def add_particle_collisions(

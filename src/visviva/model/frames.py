@@ -25,7 +25,8 @@ what to draw between points (point indices, the systems' shifted past the partic
     edges   (E, 2) int64  the stretch springs of the bodies without a surface (ropes, hair,
                           spring graphs), then the systems' links
 
-and the rigid bodies' surfaces in their own axes (:func:`visviva.rigid.surfaces.body_surface`),
+the static colliders' surfaces (``scenery_*``, :mod:`visviva.model.scenery`), and the rigid
+bodies' surfaces in their own axes (:func:`visviva.rigid.surfaces.body_surface`),
 body after body, with their colours and centres of mass (see
 :mod:`visviva.simulation.body_geometry`; their names go in the attributes,
 :func:`recording_attrs`):
@@ -55,6 +56,7 @@ from ..geometry.quaternions import quaternion_rotate
 from ..particles.emitters import ramp_values
 from ..rigid.surfaces import body_surface
 from .parts import body_networks
+from .scenery import scenery_attrs, scenery_fields
 from .systems import SYSTEMS
 
 if TYPE_CHECKING:
@@ -186,7 +188,7 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
         static["faces"] = np.concatenate(faces)
     if model.bodies is not None:
         static |= _body_surfaces(model.bodies)
-    return static
+    return static | scenery_fields(model.scene)
 
 
 def _body_surfaces(bodies: RigidBodies) -> dict[str, np.ndarray]:
@@ -207,8 +209,10 @@ def _body_surfaces(bodies: RigidBodies) -> dict[str, np.ndarray]:
 
 
 def recording_attrs(model: Model) -> dict[str, list[str]]:
-    """Attributes a recording keeps of the scene besides its arrays: the bodies' names."""
-    return {} if model.bodies is None else {"body_names": list(model.bodies.names)}
+    """Attributes a recording keeps of the scene besides its arrays: the bodies' names, the
+    drawn colliders' names."""
+    bodies = {} if model.bodies is None else {"body_names": list(model.bodies.names)}
+    return bodies | scenery_attrs(model.scene)
 
 
 def _body_topology(model: Model) -> tuple[list[np.ndarray], list[np.ndarray]]:

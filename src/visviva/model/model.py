@@ -288,6 +288,7 @@ class Model:
             "body_origin": "m",
             "body_vertices": "m",
             "body_center": "m",
+            "scenery_vertices": "m",
             "velocities": "m/s",
             "radius": "m",
             "mass": "kg",

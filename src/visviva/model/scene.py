@@ -490,6 +490,9 @@ class Collider(Strict):
         None, description="normal speed below which a contact rests [m/s] (default: 2|g|dt)"
     )
     targets: Names | None = Field(None, description="entity names (default: every particle)")
+    color: Color | None = Field(
+        None, description="sRGB colour drawn in the outputs, each in [0, 1] (default: grey)"
+    )
 
     @model_validator(mode="after")
     def _fields_of_the_shape(self) -> Collider:

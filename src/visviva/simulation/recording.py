@@ -38,6 +38,13 @@ Rigid bodies keep their surfaces once and a transform per frame (the full list i
     static/body_vertices    float64 (V, 3) [m]: the bodies' surfaces in their own axes, with
                             body_triangles (T, 3), body_vertex_start and body_triangle_start
                             (B + 1,), body_color (B, 3), body_center (B, 3) [m]
+
+Static colliders (spheres, boxes, meshes; not planes) keep their surfaces once, in the world
+frame (:mod:`visviva.simulation.scenery`; a recording without them has none of these names):
+
+    static/scenery_vertices float64 (V, 3) [m], with scenery_triangles (T, 3),
+                            scenery_vertex_start and scenery_triangle_start (C + 1,),
+                            scenery_color (C, 3)
 """
 
 from __future__ import annotations
@@ -50,6 +57,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .body_geometry import BodyGeometry, read_bodies
+from .scenery import Scenery, read_scenery
 
 __all__ = ["Geometry", "Recording"]
 
@@ -79,6 +87,7 @@ class Geometry:
         alive: Which points exist in each frame, shape ``(frames, P)`` bool, or ``None`` (all
             of them, always). Outputs draw only the live points of each frame.
         bodies: The rigid bodies' surfaces and transforms, or ``None``.
+        scenery: The static colliders' surfaces, or ``None``.
     """
 
     points: np.ndarray
@@ -89,6 +98,7 @@ class Geometry:
     display_radius: np.ndarray | None = None
     alive: np.ndarray | None = None
     bodies: BodyGeometry | None = None
+    scenery: Scenery | None = None
 
     @property
     def to_scale(self) -> bool:
@@ -259,7 +269,10 @@ class Recording:
                 if value.size and (value.min() < 0 or value.max() >= count):
                     raise ModelError(f"`{name}` refers to points outside 0..{count - 1}")
             topology[name] = value
-        return Geometry(points, **per_point, **topology, alive=alive, bodies=bodies)
+        scenery = read_scenery(self.static, self.attrs)
+        return Geometry(
+            points, **per_point, **topology, alive=alive, bodies=bodies, scenery=scenery
+        )
 
     def __repr__(self) -> str:
         shapes = ", ".join(f"{k}{tuple(v.shape)}" for k, v in self.fields.items())

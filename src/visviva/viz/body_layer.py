@@ -7,6 +7,9 @@ once: a rigid surface keeps its normals), then draws its triangles as the faces 
 drawn (Gouraud shading, ambient plus diffuse, :mod:`visviva.viz.shading`), in the body's
 colour. Only the triangles that face the light cast a shadow: over a closed surface they
 cover its whole shadow once, at half the cost of splatting every triangle.
+
+The static colliders (:mod:`visviva.simulation.scenery`) are drawn the same way, as bodies
+that never move (:class:`SceneryLayer`): their vertices are placed once for the whole clip.
 """
 
 from __future__ import annotations
@@ -16,13 +19,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..simulation.body_geometry import BodyGeometry
+from ..simulation.scenery import Scenery
 from . import ground, raster
 from .shading import LIGHT, lit_sides
 
 if TYPE_CHECKING:
     from .frame import _Frame, _ShadowMap, _Stage
 
-__all__ = ["BodyLayer"]
+__all__ = ["BodyLayer", "SceneryLayer"]
 
 #: Light blocked by a body's triangle.
 BODY_SHADOW_WEIGHT = 1.0
@@ -85,3 +89,17 @@ class BodyLayer:
                 self.back[b],
                 stage.near,
             )
+
+
+class SceneryLayer(BodyLayer):
+    """Draws and shadows the static colliders: bodies at rest, placed once for every frame.
+
+    Args:
+        scenery: The recording's scenery.
+    """
+
+    def __init__(self, scenery: Scenery) -> None:
+        super().__init__(scenery.as_bodies())
+
+    def _place(self, index: int) -> tuple[np.ndarray, np.ndarray]:
+        return super()._place(0)

@@ -14,7 +14,8 @@ then takes the steps:
 
 A geometry kind is a *layer*: an object with ``cast_shadows`` and ``draw``. Rigid bodies are
 one (:class:`~visviva.viz.body_layer.BodyLayer`: each body's surface placed by its transform,
-shaded like the faces, in its colour); the framing and the ground include them.
+shaded like the faces, in its colour), the static colliders another
+(:class:`~visviva.viz.body_layer.SceneryLayer`); the framing and the ground include them.
 
 Points that are born and die (:mod:`visviva.viz.lifetimes`): each frame draws and shadows only
 its live points, at that frame's radius and colour; a trail goes back no further than the start
@@ -32,7 +33,7 @@ import numpy as np
 
 from ..simulation.recording import Geometry
 from . import ground, raster
-from .body_layer import BodyLayer
+from .body_layer import BodyLayer, SceneryLayer
 from .lifetimes import Appearance, life_starts
 from .shading import LIGHT, MATERIAL, lit_sides
 from .timescale import format_time
@@ -76,7 +77,8 @@ NEAR_FRACTION = 1e-3
 
 def drawn_bounds(geometry: Geometry) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper corners [m] of the box holding everything drawn in every frame: each
-    live point padded by its drawn radius in that frame, and every rigid body's surface. Dead
+    live point padded by its drawn radius in that frame, every rigid body's surface and the
+    static colliders' (planes are not drawn). Dead
     points count for nothing; with nothing drawn at all, both corners are the origin."""
     look = Appearance.of(geometry)
     boxes = []
@@ -84,6 +86,8 @@ def drawn_bounds(geometry: Geometry) -> tuple[np.ndarray, np.ndarray]:
         boxes.append(look.live_bounds(geometry.points))
     if geometry.bodies is not None and geometry.bodies.vertices.shape[0]:
         boxes.append(geometry.bodies.bounds())
+    if geometry.scenery is not None and geometry.scenery.vertices.shape[0]:
+        boxes.append(geometry.scenery.bounds())
     if not boxes:
         return np.zeros(3), np.zeros(3)
     return np.min([low for low, _ in boxes], axis=0), np.max([high for _, high in boxes], axis=0)
@@ -397,6 +401,8 @@ class FramePainter:
         self.layers: list[_Layer] = []
         if geometry.bodies is not None:
             self.layers.append(BodyLayer(geometry.bodies))
+        if geometry.scenery is not None:
+            self.layers.append(SceneryLayer(geometry.scenery))
         if geometry.faces is not None and len(geometry.faces):
             self.layers.append(_Faces(geometry.faces))
         if geometry.edges is not None and len(geometry.edges):

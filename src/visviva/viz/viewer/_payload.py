@@ -26,9 +26,9 @@ them.
 
 Each kind of geometry is one *layer* with its own encoder here and its own builder in
 ``viewer.js`` (``LAYERS``): ``points`` (moving spheres; absent when the recording has rigid
-bodies alone), ``edges`` (lines between points), ``faces`` (triangles between points) and
-``bodies``. With faces, the points layer's ``spheres`` lists the points drawn as spheres
-(``uint32``): those on no face (:meth:`Geometry.off_faces`).
+bodies alone), ``edges`` (lines between points), ``faces`` (triangles between points),
+``bodies`` and ``scenery``. With faces, the points layer's ``spheres`` lists the points drawn
+as spheres (``uint32``): those on no face (:meth:`Geometry.off_faces`).
 
 The ``bodies`` layer holds each rigid body's surface once, in its own axes (``vertices``
 float32 ``(V, 3)`` [m], ``triangles`` uint32 ``(T, 3)`` numbered among each body's own
@@ -37,6 +37,10 @@ vertices, ``vertex_start`` and ``triangle_start`` uint32 ``(B + 1,)``, 8-bit sRG
 [m], the body's own origin, and ``orientations`` float32 ``(frames, B, 4)``, unit quaternions
 (w, x, y, z). The page moves each body's mesh by its object transform: 28 bytes per body per
 frame, however fine its surface.
+
+The ``scenery`` layer holds the static colliders' surfaces (:mod:`visviva.simulation.scenery`)
+in the same form as the bodies' but in the world frame and without transforms: the page draws
+them once, as meshes that never move.
 """
 
 from __future__ import annotations
@@ -50,6 +54,7 @@ import numpy as np
 
 from ...simulation.body_geometry import BodyGeometry
 from ...simulation.recording import Geometry
+from ...simulation.scenery import Scenery
 from ..frame import drawn_bounds
 from ..lifetimes import Appearance, held_frames, held_points, life_starts
 from ..timescale import time_unit
@@ -206,6 +211,21 @@ def _bodies_layer(bodies: BodyGeometry, shown: np.ndarray) -> dict[str, Any]:
     }
 
 
+def _scenery_layer(scenery: Scenery) -> dict[str, Any]:
+    """The static colliders' surfaces, in the world frame (module docstring)."""
+    owner = np.repeat(np.arange(scenery.count), np.diff(scenery.triangle_start))
+    local = scenery.triangles - scenery.vertex_start[owner][:, None]
+    return {
+        "count": scenery.count,
+        "names": list(scenery.names),
+        "vertices": _base64(scenery.vertices, "<f4"),
+        "triangles": _base64(local, "<u4"),
+        "vertex_start": _base64(scenery.vertex_start, "<u4"),
+        "triangle_start": _base64(scenery.triangle_start, "<u4"),
+        "colors": _base64(np.round(255 * scenery.color), "u1"),
+    }
+
+
 def _index_layer(indices: np.ndarray) -> dict[str, Any]:
     return {"count": int(indices.shape[0]), "indices": _base64(indices, "<u4")}
 
@@ -230,6 +250,9 @@ def _legend(attrs: dict[str, Any], geometry: Geometry, fps: float) -> list[list[
     if geometry.bodies is not None:
         count = geometry.bodies.count
         parts.append(f"{count} rigid bod{'y' if count == 1 else 'ies'}")
+    if geometry.scenery is not None:
+        count = geometry.scenery.count
+        parts.append(f"{count} collider{'' if count == 1 else 's'}")
     rows.append(["shows", ", ".join(parts)])
     rows.append(["playback", f"{fps:.6g} frames/s"])
     if not geometry.to_scale:
@@ -273,6 +296,8 @@ def encode_payload(
         layers["faces"] = _index_layer(geometry.faces)
     if geometry.bodies is not None:
         layers["bodies"] = _bodies_layer(geometry.bodies, shown)
+    if geometry.scenery is not None:
+        layers["scenery"] = _scenery_layer(geometry.scenery)
     return {
         "format": PAYLOAD_FORMAT,
         "version": PAYLOAD_VERSION,

@@ -5,9 +5,9 @@
  * elapsed wall-clock time (k = floor(elapsed * fps * speed)), never by counting redraws, so it
  * runs in real time however fast the machine draws. Y is up, lengths in metres.
  *
- * Each kind of geometry is one entry of LAYERS (points, edges, faces, bodies): a builder that
- * adds its objects to the scene and returns an update() called after every frame change. A
- * recording of rigid bodies alone has no points layer.
+ * Each kind of geometry is one entry of LAYERS (points, edges, faces, bodies, scenery): a
+ * builder that adds its objects to the scene and returns an update() called after every frame
+ * change. A recording of rigid bodies alone has no points layer.
  *
  * Points that are born and die come with per-frame alive bits (and, with a trail, birth bits),
  * radii and colours when the recording has them: a frame draws only its live points, at that
@@ -364,10 +364,36 @@
         }
       };
     },
+    /* Static colliders: one mesh per collider, in the world frame, drawn as placed. */
+    scenery(layer) {
+      const vertices = decode(layer.vertices, Float32Array);
+      const triangles = decode(layer.triangles, Uint32Array);
+      const vertexStart = decode(layer.vertex_start, Uint32Array);
+      const triangleStart = decode(layer.triangle_start, Uint32Array);
+      const rgb = decode(layer.colors, Uint8Array);
+      if (vertexStart.length !== layer.count + 1 || triangleStart.length !== layer.count + 1) {
+        throw new Error("corrupt scenery data");
+      }
+      for (let c = 0; c < layer.count; c++) {
+        const geometry = new THREE.BufferGeometry();
+        geometry.setAttribute("position", new THREE.BufferAttribute(
+          vertices.slice(3 * vertexStart[c], 3 * vertexStart[c + 1]), 3));
+        geometry.setIndex(new THREE.BufferAttribute(
+          triangles.slice(3 * triangleStart[c], 3 * triangleStart[c + 1]), 1));
+        geometry.computeVertexNormals();
+        const material = new THREE.MeshLambertMaterial({ color: srgb(rgb, c) });
+        const mesh = new THREE.Mesh(geometry, material);
+        mesh.name = layer.names[c];
+        scene.add(mesh);
+        sceneryMeshes.push(mesh);
+      }
+      return function update() {};
+    },
   };
 
   let pointMesh = null; // the points layer's instanced mesh, read back by visviva.drawn()
   const bodyMeshes = []; // the bodies layer's meshes, read back by visviva.bodies()
+  const sceneryMeshes = []; // the scenery layer's meshes, read back by visviva.scenery()
   const updates = [];
   for (const [name, layer] of Object.entries(data.layers)) {
     if (!(name in LAYERS)) throw new Error("this viewer cannot draw layer " + name);
@@ -577,6 +603,11 @@
       name: mesh.name,
       position: mesh.position.toArray(),
       orientation: [mesh.quaternion.w, mesh.quaternion.x, mesh.quaternion.y, mesh.quaternion.z],
+    })),
+    /* The static colliders as drawn: each mesh's name and number of triangles. */
+    scenery: () => sceneryMeshes.map((mesh) => ({
+      name: mesh.name,
+      triangles: mesh.geometry.index.count / 3,
     })),
     ready: false,
     readyTime: null, // performance.now() [ms since navigation start] at the first draw
