@@ -42,7 +42,7 @@ def box_corners() -> np.ndarray:
 
 
 def scene(*, colliders: bool = True) -> vv.SceneBuilder:
-    builder = vv.SceneBuilder(name="scenery")
+    builder = vv.SceneBuilder(name="colliders")
     builder.set_integration(method="symplectic_euler", dt=0.005, duration=0.4, record_every=4)
     builder.set_output(fps=10.0)
     builder.add_particle_cloud(
@@ -244,3 +244,90 @@ def test_the_viewer_draws_each_collider_as_a_static_mesh(recording, tmp_path):
             assert page.errors == []
         finally:
             browser.close()
+
+
+# --- the exports -----------------------------------------------------------------------------
+
+
+def test_usd_holds_each_collider_as_a_static_mesh_in_its_colour(recording, tmp_path):
+    from pxr import Usd, UsdGeom
+
+    from visviva.io.export import export_recording
+
+    (path,) = export_recording(recording, tmp_path / "scenery.usda")
+    stage = Usd.Stage.Open(str(path))
+    scenery = recording.geometry().scenery
+    assert scenery is not None
+    assert [p.GetName() for p in stage.GetPrimAtPath("/World/scenery").GetChildren()] == [
+        "crate",
+        "collider_3",
+        "wedge",
+    ]
+    for c, name in enumerate(scenery.names):
+        mesh = UsdGeom.Mesh(stage.GetPrimAtPath(f"/World/scenery/{name}"))
+        vertices, triangles = scenery.surface(c)
+        points = np.array(mesh.GetPointsAttr().Get(), dtype=np.float64)
+        np.testing.assert_allclose(points, vertices, rtol=1e-7, atol=1e-7)  # float32
+        assert list(mesh.GetFaceVertexIndicesAttr().Get()) == triangles.ravel().tolist()
+        assert set(mesh.GetFaceVertexCountsAttr().Get()) == {3}
+        colour = mesh.GetDisplayColorPrimvar().Get()
+        np.testing.assert_allclose(np.array(colour[0]), scenery.color[c], rtol=1e-6)
+        # Static: no attribute of a collider has time samples.
+        assert not any(a.GetNumTimeSamples() for a in mesh.GetPrim().GetAttributes())
+    assert stage.GetPrimAtPath("/World/points").IsValid()  # the particles, as before
+
+
+def test_gltf_holds_each_collider_as_a_static_node_without_channels(recording, tmp_path):
+    import pygltflib
+
+    from test_rigid_outputs import accessor
+    from visviva.io.export import export_recording
+
+    (path,) = export_recording(recording, tmp_path / "scenery.glb")
+    document = pygltflib.GLTF2.load(str(path))
+    blob = document.binary_blob()
+    scenery = recording.geometry().scenery
+    assert scenery is not None
+    nodes = {node.name: i for i, node in enumerate(document.nodes)}
+    (root,) = [i for i in document.scenes[0].nodes if document.nodes[i].name == "scenery"]
+    assert document.nodes[root].children == [nodes[name] for name in scenery.names]
+    animated = {c.target.node for a in document.animations for c in a.channels}
+    for c, name in enumerate(scenery.names):
+        node = document.nodes[nodes[name]]
+        assert nodes[name] not in animated
+        assert node.translation is None and node.rotation is None
+        (primitive,) = document.meshes[node.mesh].primitives
+        vertices, triangles = scenery.surface(c)
+        position = accessor(document, blob, primitive.attributes.POSITION)
+        np.testing.assert_array_equal(position, vertices.astype(np.float32))
+        indices = accessor(document, blob, primitive.indices)[:, 0]
+        np.testing.assert_array_equal(indices, triangles.ravel())
+        material = document.materials[primitive.material]
+        # glTF colours are linear: sRGB 0.9 is ((0.9 + 0.055) / 1.055)^2.4 = 0.7874 (IEC 61966-2-1).
+        srgb = scenery.color[c]
+        linear = np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
+        np.testing.assert_allclose(
+            material.pbrMetallicRoughness.baseColorFactor[:3], linear, rtol=1e-6
+        )
+
+
+def test_obj_writes_the_colliders_once_beside_the_sequence(recording, tmp_path):
+    from test_export import read_obj
+    from visviva.io.export import export_recording
+    from visviva.io.timeline import frames_at_rate
+
+    paths = export_recording(recording, tmp_path / "obj", to="obj", fps=10.0)
+    assert paths[-1] == tmp_path / "obj" / "scenery.obj"
+    frames = paths[:-1]
+    assert len(frames) == frames_at_rate(recording.time, 10.0).size
+    # The frames hold the particles only, as without colliders.
+    vertices, _, _ = read_obj(frames[0])
+    assert vertices.shape[0] == recording["points"].shape[1]
+    scenery = recording.geometry().scenery
+    assert scenery is not None
+    text = paths[-1].read_text()
+    objects = [line.split()[1] for line in text.splitlines() if line.startswith("o ")]
+    assert objects == list(scenery.names)
+    vertices, _, faces = read_obj(paths[-1])
+    np.testing.assert_array_equal(vertices, scenery.vertices)  # repr: exact float64
+    np.testing.assert_array_equal(np.array(faces) - 1, scenery.triangles)

@@ -13,6 +13,10 @@ The body nodes are children of one root node named ``bodies``. Each mesh has ``P
 (float32, with ``min`` and ``max``), unit ``NORMAL`` (the surface's area-weighted vertex
 normals) and ``TRIANGLES`` indices, counter-clockwise seen from outside, and its own material
 of the body's colour (``baseColorFactor``, linear as glTF wants, not metallic).
+
+The static colliders (:mod:`visviva.simulation.scenery`) are written the same way but never
+move: under a root node named ``scenery``, one node per collider (no transform, no channel)
+showing a mesh of its surface in the world frame, in its colour.
 """
 
 from __future__ import annotations
@@ -22,10 +26,11 @@ from typing import Any
 import numpy as np
 
 from ...simulation.body_geometry import BodyGeometry
+from ...simulation.scenery import Scenery
 from ._frames import ExportFrames
 from ._gltf_buffer import GltfBuffer, linear_rgb
 
-__all__ = ["add_rigid_bodies"]
+__all__ = ["add_rigid_bodies", "add_scenery"]
 
 #: The normal given to a vertex on no triangle (glTF asks for unit normals on every vertex).
 _SPARE_NORMAL = (0.0, 1.0, 0.0)
@@ -49,6 +54,40 @@ def _surface_mesh(bodies: BodyGeometry, b: int, data: GltfBuffer, material: int)
         material=material,
     )
     return gl.Mesh(name=bodies.names[b], primitives=[primitive])
+
+
+def _material(name: str, color: np.ndarray) -> Any:
+    """A material of sRGB ``color`` (``(3,)`` in [0, 1]), not metallic."""
+    import pygltflib as gl
+
+    return gl.Material(
+        name=name,
+        pbrMetallicRoughness=gl.PbrMetallicRoughness(
+            baseColorFactor=[*linear_rgb(color).tolist(), 1.0],
+            metallicFactor=0.0,
+            roughnessFactor=0.5,
+        ),
+    )
+
+
+def add_scenery(
+    scenery: Scenery, data: GltfBuffer, nodes: list[Any], meshes: list[Any], materials: list[Any]
+) -> int:
+    """Append the static colliders' nodes, meshes and materials (see the module docstring).
+
+    Returns:
+        The index of the scenery's root node.
+    """
+    import pygltflib as gl
+
+    surfaces = scenery.as_bodies()
+    root = len(nodes)
+    nodes.append(gl.Node(name="scenery", children=list(range(root + 1, root + 1 + scenery.count))))
+    for c in range(scenery.count):
+        materials.append(_material(scenery.names[c], scenery.color[c]))
+        meshes.append(_surface_mesh(surfaces, c, data, len(materials) - 1))
+        nodes.append(gl.Node(name=scenery.names[c], mesh=len(meshes) - 1))
+    return root
 
 
 def add_rigid_bodies(
@@ -83,16 +122,7 @@ def add_rigid_bodies(
     root = len(nodes)
     nodes.append(gl.Node(name="bodies", children=list(range(root + 1, root + 1 + bodies.count))))
     for b in range(bodies.count):
-        materials.append(
-            gl.Material(
-                name=bodies.names[b],
-                pbrMetallicRoughness=gl.PbrMetallicRoughness(
-                    baseColorFactor=[*linear_rgb(bodies.color[b]).tolist(), 1.0],
-                    metallicFactor=0.0,
-                    roughnessFactor=0.5,
-                ),
-            )
-        )
+        materials.append(_material(bodies.names[b], bodies.color[b]))
         meshes.append(_surface_mesh(bodies, b, data, len(materials) - 1))
         node = len(nodes)
         nodes.append(

@@ -37,7 +37,9 @@ and no extent; its ``_RADIUS`` and ``COLOR_0`` are those of its first life.
 
 Rigid bodies (:mod:`._gltf_rigid`) are added beside either layout, or alone: one node per
 body showing its surface, with ``translation`` and ``rotation`` channels and no per-frame
-vertex data. The document has one animation, ``simulation``, holding every channel.
+vertex data. The document has one animation, ``simulation``, holding every channel. The static
+colliders (spheres, boxes, meshes; not planes) are a root node ``scenery`` of static meshes,
+one node per collider, in the world frame, without channels.
 
 All: glTF time starts at 0 (the recording's first frame); every ``POSITION`` accessor and the
 animation input have ``min`` and ``max`` (§ 3.6.2.5, § 3.11); buffer views start on 4-byte
@@ -64,7 +66,7 @@ from ...errors import ModelError
 from ._files import all_or_nothing
 from ._frames import ExportFrames
 from ._gltf_buffer import GltfBuffer, linear_rgb
-from ._gltf_rigid import add_rigid_bodies
+from ._gltf_rigid import add_rigid_bodies, add_scenery
 
 __all__ = ["MAX_BODY_NODES", "MAX_GLTF_BYTES", "MAX_MORPH_FRAMES", "gltf_size", "write_gltf"]
 
@@ -421,6 +423,8 @@ def write_gltf(frames: ExportFrames, path: Path, *, binary: bool) -> list[Path]:
         roots.append(
             add_rigid_bodies(frames, frames.bodies, data, nodes, meshes, materials, animation)
         )
+    if frames.geometry.scenery is not None:
+        roots.append(add_scenery(frames.geometry.scenery, data, nodes, meshes, materials))
     document = gl.GLTF2(
         asset=gl.Asset(
             generator=f"visviva {__version__}",

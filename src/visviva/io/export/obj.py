@@ -26,6 +26,13 @@ Blender's OBJ importer splits objects into separate meshes by default but keeps 
 so the first file of a sequence still matches a PC2 cache of the same points and vertices,
 in the same order (:mod:`.pc2`).
 
+Static colliders (spheres, boxes, meshes: :mod:`visviva.simulation.scenery`) do not move, so
+they are written once, in a file of their own beside the sequence (``out/cloth_scenery.obj``
+or ``out/obj/scenery.obj``), one ``o NAME`` object per collider with its vertices (world frame)
+and triangles, and returned after the frames' files. Repeating them in every frame would
+only make the files larger and break the vertex match with a PC2 cache. Planes have no
+finite surface and are left out.
+
 Points that are born and die (particles of emitters): each file holds only the points alive in
 its frame, in point order, with a comment saying how many of the recording's slots they are;
 edges and triangles are kept where all their points are alive, renumbered to match. Vertex
@@ -41,10 +48,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ...simulation.scenery import Scenery
 from ._files import all_or_nothing
 from ._frames import ExportFrames
 
-__all__ = ["obj_sequence_paths", "write_obj_sequence"]
+__all__ = ["obj_scenery_path", "obj_sequence_paths", "write_obj_sequence"]
 
 #: Digits of the frame number in file names (more are used when the count needs them).
 _MIN_DIGITS = 4
@@ -65,6 +73,30 @@ def obj_sequence_paths(path: Path, count: int) -> list[Path]:
     else:
         folder, stem = path, "frame"
     return [folder / f"{stem}_{k:0{digits}d}.obj" for k in range(count)]
+
+
+def obj_scenery_path(path: Path) -> Path:
+    """The file an OBJ export to ``path`` writes the static colliders to (module docstring).
+
+    Example:
+        >>> obj_scenery_path(Path("out/cloth.obj")).as_posix()
+        'out/cloth_scenery.obj'
+    """
+    if path.suffix.lower() == ".obj":
+        return path.parent / f"{path.stem}_scenery.obj"
+    return path / "scenery.obj"
+
+
+def _scenery_text(scenery: Scenery) -> str:
+    """The static colliders as OBJ text: an ``o`` object per collider (1-based indices)."""
+    lines = ["# visviva OBJ export: the static colliders\n", "# units: metres, Y up\n"]
+    for c, name in enumerate(scenery.names):
+        vertices, triangles = scenery.surface(c)
+        lines.append(f"o {_object_name(name)}\n")
+        lines.extend(f"v {x!r} {y!r} {z!r}\n" for x, y, z in vertices.tolist())
+        start = int(scenery.vertex_start[c]) + 1
+        lines.extend(f"f {a} {b} {d}\n" for a, b, d in (triangles + start).tolist())
+    return "".join(lines)
 
 
 def _topology_text(frames: ExportFrames, live: np.ndarray | None = None) -> str:
@@ -110,9 +142,11 @@ def write_obj_sequence(frames: ExportFrames, path: Path) -> list[Path]:
             parent must exist).
 
     Returns:
-        The files written, in frame order.
+        The files written, in frame order, then the static colliders' file (if any).
     """
     targets = obj_sequence_paths(path, frames.count)
+    if frames.geometry.scenery is not None:
+        targets.append(obj_scenery_path(path))
     created = path.suffix.lower() != ".obj" and not path.exists()
     if created:
         path.mkdir()
@@ -122,7 +156,9 @@ def write_obj_sequence(frames: ExportFrames, path: Path) -> list[Path]:
     name = _object_name(frames.name)
     try:
         with all_or_nothing(targets) as temporaries:
-            for k, temporary in enumerate(temporaries):
+            if frames.geometry.scenery is not None:
+                temporaries[-1].write_text(_scenery_text(frames.geometry.scenery), "utf-8")
+            for k, temporary in enumerate(temporaries[: frames.count]):
                 shown = int(frames.shown[k])
                 header = (
                     f"# visviva OBJ export: frame {k} of {frames.count} at {frames.fps:.9g} "

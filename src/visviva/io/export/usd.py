@@ -43,6 +43,11 @@ Written with Pixar's ``usd-core`` (``pxr``), following the UsdGeom schemas (open
   transform alone: Blender imports each body as one object named ``NAME`` whose Transform
   Cache constraint reads the ops from the file.
 
+* ``/World/scenery/NAME`` (``UsdGeom.Mesh`` under a ``Scope``), one per drawn static collider
+  (sphere, box, mesh; planes have no finite surface and are left out): the surface in the
+  world frame with vertex ``normals``, ``extent``, ``orientation = rightHanded``,
+  ``subdivisionScheme = none`` and a constant ``primvars:displayColor``, without time samples.
+
 Point-based ``points`` are float32 (``point3f[]``), so positions keep float32 precision; the
 bodies' transforms are float64 (double and ``quatd``), exactly as recorded.
 """
@@ -57,6 +62,7 @@ import numpy as np
 
 from ..._version import __version__
 from ...simulation.body_geometry import BodyGeometry
+from ...simulation.scenery import Scenery
 from ._files import all_or_nothing
 from ._frames import ExportFrames
 
@@ -247,6 +253,30 @@ def _add_bodies(stage: Any, frames: ExportFrames, bodies: BodyGeometry) -> Calla
     return write
 
 
+def _add_scenery(stage: Any, scenery: Scenery) -> None:
+    """One static mesh per drawn collider, in the world frame (no time samples)."""
+    from pxr import Gf, UsdGeom, Vt
+
+    UsdGeom.Scope.Define(stage, "/World/scenery")
+    for c, name in enumerate(_prim_names(scenery.names)):
+        mesh = UsdGeom.Mesh.Define(stage, f"/World/scenery/{name}")
+        vertices, triangles = scenery.surface(c)
+        first, last = scenery.vertex_start[c], scenery.vertex_start[c + 1]
+        counts = np.full(triangles.shape[0], 3, dtype=np.int32)
+        mesh.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(vertices.astype(np.float32)))
+        mesh.CreateExtentAttr(Vt.Vec3fArray.FromNumpy(_extent(vertices, 0.0)))
+        mesh.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(counts))
+        mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(triangles.ravel().astype(np.int32)))
+        mesh.CreateNormalsAttr(
+            Vt.Vec3fArray.FromNumpy(scenery.normals[first:last].astype(np.float32))
+        )
+        mesh.SetNormalsInterpolation(UsdGeom.Tokens.vertex)
+        mesh.CreateOrientationAttr(UsdGeom.Tokens.rightHanded)
+        mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+        colour = mesh.CreateDisplayColorPrimvar(UsdGeom.Tokens.constant)
+        colour.Set(Vt.Vec3fArray([Gf.Vec3f(*scenery.color[c].tolist())]))
+
+
 def write_usd(frames: ExportFrames, path: Path, *, encoding: str) -> list[Path]:
     """Write the resampled recording as a USD stage (see the module docstring), atomically.
 
@@ -287,6 +317,8 @@ def write_usd(frames: ExportFrames, path: Path, *, encoding: str) -> list[Path]:
         writers.append(_add_mesh(stage, frames, frames.faces))
     if frames.bodies is not None:
         writers.append(_add_bodies(stage, frames, frames.bodies))
+    if frames.geometry.scenery is not None:
+        _add_scenery(stage, frames.geometry.scenery)
     for k in range(frames.count):
         for write in writers:
             write(k)
