@@ -1,6 +1,7 @@
 """Demo ``crowd``: a room of 200 people evacuating through one door (the social-force model).
 
-A square room of walls (thin boxes, the scene's colliders) with a door in its right wall; the
+A square room of walls (thin boxes 1.2 m high, the scene's colliders, which the video and the
+viewer draw: the camera sees the agents over them) with a door in its right wall; the
 agents start at rest, scattered over the room without touching, and walk to an exit box just
 outside the door with the social-force model of Helbing & Molnár (1995) and the parameters of
 Helbing, Farkas & Vicsek (2000) (:mod:`visviva.particles.crowd`): preferred speed 1.34 m/s,
@@ -34,7 +35,10 @@ AGENTS = 200
 ROOM = 14.0  # [m]: side of the square room (inside)
 DOOR = 1.2  # [m]: width of the door
 WALL = 0.2  # [m]: wall thickness
-HEIGHT = 1.0  # [m]: agents' height (their centres'); walls span y = 0 to 2 m
+HEIGHT = 1.0  # [m]: agents' height (their centres')
+#: [m]: walls span y = 0 to 1.2 m: above the agents' centres, so the model (discs in the XZ
+#: plane at y = 1 m) sees the same walls, and low enough that the camera sees over them.
+WALL_HEIGHT = 1.2
 RADIUS = (0.25, 0.35)  # [m]
 MASS = 80.0  # [kg]
 #: The door-width study: a smaller room, the same people.
@@ -62,15 +66,16 @@ def room(
     without overlap, and their crowd walking to an exit box outside the door. Returns the
     agents' positions ``(agents, 3)`` [m]."""
     half, t = 0.5 * side, WALL
+    y, tall = 0.5 * WALL_HEIGHT, WALL_HEIGHT
     boxes = {
-        "back": ((-0.5 * t, HEIGHT, 0.0), (t, 2.0, side + 2 * t)),
-        "left": ((0.5 * side, HEIGHT, -half - 0.5 * t), (side + 2 * t, 2.0, t)),
-        "right": ((0.5 * side, HEIGHT, half + 0.5 * t), (side + 2 * t, 2.0, t)),
+        "back": ((-0.5 * t, y, 0.0), (t, tall, side + 2 * t)),
+        "left": ((0.5 * side, y, -half - 0.5 * t), (side + 2 * t, tall, t)),
+        "right": ((0.5 * side, y, half + 0.5 * t), (side + 2 * t, tall, t)),
     }
     jamb = half + t - 0.5 * door  # length of the front wall on either side of the door
     for name, sign in (("front_left", -1.0), ("front_right", 1.0)):
         z = sign * (0.5 * door + 0.5 * jamb)
-        boxes[name] = ((side + 0.5 * t, HEIGHT, z), (t, 2.0, jamb))
+        boxes[name] = ((side + 0.5 * t, y, z), (t, tall, jamb))
     for name, (centre, size) in boxes.items():
         builder.add_collider("box", center=centre, size=size, name=name)
     rng = np.random.default_rng(seed)
