@@ -60,10 +60,17 @@ def _drawn(scene: Scene) -> list[tuple[int, Collider, tuple[np.ndarray, np.ndarr
     """The drawable colliders: (entity index, entity, surface), in the scene's order."""
     drawn = []
     for i, entity in enumerate(scene.entities):
-        if isinstance(entity, Collider) and entity.shape != "plane":
+        if not isinstance(entity, Collider) or entity.shape == "plane":
+            continue
+        if entity.shape == "mesh":  # checked when the model was built; no tree needed here
+            surface = (
+                np.asarray(entity.vertices, dtype=np.float64),
+                np.asarray(entity.triangles, dtype=np.int64),
+            )
+        else:
             surface = collider_surface(_shape(entity, f"entities[{i}]"))
-            if surface is not None:
-                drawn.append((i, entity, surface))
+        if surface is not None:
+            drawn.append((i, entity, surface))
     return drawn
 
 
