@@ -331,3 +331,25 @@ def test_obj_writes_the_colliders_once_beside_the_sequence(recording, tmp_path):
     vertices, _, faces = read_obj(paths[-1])
     np.testing.assert_array_equal(vertices, scenery.vertices)  # repr: exact float64
     np.testing.assert_array_equal(np.array(faces) - 1, scenery.triangles)
+
+
+def test_the_colliders_cast_shadows_on_the_ground(recording, tmp_path):
+    """The same frame with and without the scenery, from the same camera: ground pixels (no
+    collider's colour) darker with it are its shadows."""
+    import imageio.v3 as iio
+
+    from visviva.viz.video import Camera
+
+    camera = Camera.framing(drawn_bounds(recording.geometry()), aspect=480 / 270)
+    bare_static = {k: v for k, v in recording.static.items() if not k.startswith("scenery")}
+    bare = vv.Recording(recording.time, recording.fields, static=bare_static)
+    images = []
+    for name, shown in (("with", recording), ("bare", bare)):
+        path = render_video(shown, tmp_path / f"{name}.mp4", size=(480, 270), camera=camera)
+        images.append(iio.imread(path, index=0).astype(float))
+    drawn = np.zeros(images[0].shape[:2], dtype=bool)
+    for colour in (RED, GREEN, YELLOW):
+        drawn |= coloured(images[0].astype(np.uint8), colour)
+    darker = images[1].mean(axis=2) - images[0].mean(axis=2) > 20.0  # of 255
+    greyish = np.ptp(images[0], axis=2) < 25.0
+    assert (darker & greyish & ~drawn).sum() > 300
