@@ -48,6 +48,7 @@ if TYPE_CHECKING:
     from .scenes import load_model, run_scene
     from .simulation import Simulation, Solution, simulate, solve
     from .simulation.recording import Recording
+    from .sweeps import load_sweep, sweep
 
 __all__ = [
     "Model",
@@ -68,6 +69,7 @@ __all__ = [
     "integrators",
     "io",
     "load_model",
+    "load_sweep",
     "mechanics",
     "model",
     "ode",
@@ -77,6 +79,7 @@ __all__ = [
     "simulate",
     "simulation",
     "solve",
+    "sweep",
     "viz",
 ]
 
@@ -104,6 +107,8 @@ _FUNCTIONS = {
     "Solution": "simulation",
     "simulate": "simulation",
     "solve": "simulation",
+    "load_sweep": "sweeps",
+    "sweep": "sweeps",
 }
 
 

@@ -22,6 +22,7 @@ __all__ = [
     "SceneProblem",
     "SimulationDiverged",
     "SimulationError",
+    "SweepError",
     "VisvivaError",
 ]
 
@@ -84,6 +85,26 @@ class SceneError(ModelError):
         self.source = source
         count = len(problems)
         heading = f"{count} problem{'s' if count != 1 else ''} in the scene"
+        lines = [p.describe(source) for p in problems]
+        super().__init__("\n".join([heading + ":", *("  " + line for line in lines)]))
+
+
+class SweepError(ModelError):
+    """A sweep that cannot run: its description, or runs whose scenes fail validation.
+
+    Every problem is listed, and nothing has run or been written when it is raised.
+
+    Attributes:
+        problems: Each problem with its path (``parameters[1].path``, or ``run 3 (dt=0.5):
+            integration.dt`` for a run's scene), message, value and line.
+        source: The sweep file's name, when it came from a file.
+    """
+
+    def __init__(self, problems: list[SceneProblem], source: str | None = None) -> None:
+        self.problems = problems
+        self.source = source
+        count = len(problems)
+        heading = f"{count} problem{'s' if count != 1 else ''} in the sweep"
         lines = [p.describe(source) for p in problems]
         super().__init__("\n".join([heading + ":", *("  " + line for line in lines)]))
 

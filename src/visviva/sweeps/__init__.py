@@ -1,0 +1,30 @@
+"""Sweeps: many runs of one scene with parameters varied, on any executor.
+
+A sweep file names a base scene, the parameters to vary and how (grid, zip or random design,
+:mod:`.description`, :mod:`.design`); :func:`sweep` runs every run through
+:func:`~visviva.scenes.run_scene` on a process pool, in this process, or on any
+:class:`concurrent.futures.Executor`, resumes where an interrupted sweep stopped, and writes a
+results table (:mod:`.results`). A front layer like :mod:`visviva.scenes`: the physics packages
+never import it.
+"""
+
+from .description import Outputs, Parameter, Sweep, SweepInfo, load_sweep, parse_sweep
+from .design import SweepRun, expand, run_values
+from .runner import RunTask, SweepInterrupted, SweepResult, run_task, sweep
+
+__all__ = [
+    "Outputs",
+    "Parameter",
+    "RunTask",
+    "Sweep",
+    "SweepInfo",
+    "SweepInterrupted",
+    "SweepResult",
+    "SweepRun",
+    "expand",
+    "load_sweep",
+    "parse_sweep",
+    "run_task",
+    "run_values",
+    "sweep",
+]
