@@ -103,9 +103,11 @@ class SweepError(ModelError):
     def __init__(self, problems: list[SceneProblem], source: str | None = None) -> None:
         self.problems = problems
         self.source = source
-        count = len(problems)
-        heading = f"{count} problem{'s' if count != 1 else ''} in the sweep"
         lines = [p.describe(source) for p in problems]
+        if len(lines) == 1:  # one problem: one line
+            super().__init__(lines[0])
+            return
+        heading = f"{len(lines)} problems in the sweep"
         super().__init__("\n".join([heading + ":", *("  " + line for line in lines)]))
 
 

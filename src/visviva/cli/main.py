@@ -354,6 +354,7 @@ def demo_command(
 
 # After the commands above, so that `visviva --help` lists them first.
 from . import scenes as _scene_commands  # noqa: E402, F401 - registers run, validate, plot, ...
+from . import sweeps as _sweep_commands  # noqa: E402, F401 - registers sweep
 
 
 def main() -> None:

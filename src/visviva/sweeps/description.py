@@ -88,8 +88,8 @@ class Parameter(Strict):
 
     @field_validator("values")
     @classmethod
-    def _plain_values(cls, values: list[Any]) -> list[Any]:
-        for value in values:
+    def _plain_values(cls, values: list[Any] | None) -> list[Any] | None:
+        for value in values or ():
             _check_value(value)
         return values
 

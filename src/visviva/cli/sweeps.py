@@ -1,0 +1,74 @@
+"""``visviva sweep``: many runs of one scene with parameters varied (:mod:`visviva.sweeps`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from .common import app
+
+
+@app.command("sweep")
+def sweep_command(
+    description: Annotated[Path, typer.Argument(help="Sweep file (.toml or .json).")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="Output directory.")] = Path(
+        "out"
+    ),
+    workers: Annotated[
+        int | None, typer.Option("--workers", help="Processes of the pool (default: all cores).")
+    ] = None,
+    serial: Annotated[
+        bool, typer.Option("--serial", help="Run one after the other in this process.")
+    ] = False,
+    no_resume: Annotated[
+        bool, typer.Option("--no-resume", help="Run again the runs already finished in DIR.")
+    ] = False,
+    dry_run: Annotated[
+        bool,
+        typer.Option("--dry-run", help="Validate, expand and print the runs; write nothing."),
+    ] = False,
+) -> None:
+    """Run a sweep: every run into DIR/runs/, the table into DIR/results.csv and results.json."""
+    from ..errors import ModelError
+    from ..sweeps import expand, load_sweep, sweep
+
+    if serial and workers is not None:
+        raise ModelError("--serial runs in this process; drop --workers (or --serial)")
+    chosen = load_sweep(description)
+    if dry_run:
+        runs = expand(chosen)
+        info = chosen.info
+        typer.echo(
+            f"{description}: sweep {info.name!r}, {info.design} design, {len(runs)} runs, "
+            f"all scenes valid; would write into {output}/runs/"
+        )
+        paths = list(chosen.paths)
+        typer.echo("\t".join(["index", *paths]))
+        for run in runs:
+            typer.echo("\t".join([str(run.index), *(_shown(run.values[p]) for p in paths)]))
+        return
+    result = sweep(
+        chosen,
+        output,
+        executor="serial" if serial else None,
+        workers=workers,
+        resume=not no_resume,
+    )
+    _print_result(result)
+
+
+def _shown(value: Any) -> str:
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def _print_result(result: Any) -> None:
+    """The lines that end a sweep: counts, failed runs, where the table is."""
+    total = len(result.rows)
+    reused = f" ({result.skipped} already finished, not run again)" if result.skipped else ""
+    typer.echo(f"{total} runs{reused}; {total - result.failed} succeeded, {result.failed} failed")
+    for row in result.rows:
+        if not row["success"]:
+            typer.echo(f"run {row['run']}: {str(row['error']).splitlines()[0]}")
+    typer.echo(f"wrote {result.files[0]} and {result.files[1].name}")
