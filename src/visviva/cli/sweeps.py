@@ -13,9 +13,7 @@ from .common import app
 @app.command("sweep")
 def sweep_command(
     description: Annotated[Path, typer.Argument(help="Sweep file (.toml or .json).")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="Output directory.")] = Path(
-        "out"
-    ),
+    output: Annotated[Path, typer.Option("--output", "-o", help="Output directory.")] = Path("out"),
     workers: Annotated[
         int | None, typer.Option("--workers", help="Processes of the pool (default: all cores).")
     ] = None,

@@ -24,6 +24,7 @@ from collections.abc import Callable
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed, wait
 from dataclasses import dataclass
 from pathlib import Path
+from types import FrameType
 from typing import Any, Literal
 
 from .._validation import whole_number
@@ -42,6 +43,9 @@ __all__ = ["RunTask", "SweepInterrupted", "SweepResult", "run_task", "sweep"]
 RUN_FILE = "run.json"
 #: Modules the pool's fork server imports once, so that each worker starts with them loaded.
 WORKER_PRELOAD = ("visviva.sweeps.runner", "visviva.scenes", "visviva.simulation")
+# In a worker of the sweep's own pool: True, and the stop signal once one arrived.
+_in_pool_worker = False
+_stopped_worker: str | None = None
 #: Summary entries already in the row as ``success`` and ``error``.
 _OUTCOME = ("success", "message")
 
@@ -112,6 +116,9 @@ def run_task(task: RunTask) -> dict[str, Any]:
     from ..model.scene import Scene
     from ..scenes import run_scene
 
+    global _stopped_worker
+    if _stopped_worker is not None:  # the queued runs of a pool told to stop do not start
+        return {"index": task.index, "interrupted": _stopped_worker}
     directory = Path(task.directory)
     marker = directory / RUN_FILE
     marker.unlink(missing_ok=True)  # the run.json of an older run must not vouch for this one
@@ -123,6 +130,8 @@ def run_task(task: RunTask) -> dict[str, Any]:
         summary = report.summary
     except Interrupted as stop:
         shutil.rmtree(directory, ignore_errors=True)
+        if _in_pool_worker:
+            _stopped_worker = stop.signal
         return {"index": task.index, "interrupted": stop.signal}
     except VisvivaError as failure:  # diverged, failed to converge, an output not written
         error = str(failure)
@@ -348,10 +357,19 @@ def _worker_context() -> multiprocessing.context.BaseContext:
 
 def _start_worker(threads: int) -> None:
     """Prepare a pool worker: a share of the cores for Numba's parallel kernels (the pool
-    already runs one run per core: more threads only contend, 10x slower on 2 cores), and
-    SIGINT ignored between runs; during a run, run_scene's own handler stops it cleanly (a
-    Ctrl-C at the terminal reaches every process of the group)."""
+    already runs one run per core: more threads only contend, 10x slower on 2 cores), and a
+    SIGINT between runs remembered so that no queued run starts after it; during a run,
+    run_scene's own handler stops it cleanly (a Ctrl-C at the terminal reaches every process
+    of the group)."""
     import numba
 
+    global _in_pool_worker
     numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _in_pool_worker = True
+    signal.signal(signal.SIGINT, _remember_stop)
+
+
+def _remember_stop(number: int, frame: FrameType | None) -> None:
+    """A pool worker's SIGINT between runs: the runs queued to it will not start."""
+    global _stopped_worker
+    _stopped_worker = signal.Signals(number).name
