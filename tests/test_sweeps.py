@@ -388,15 +388,20 @@ def test_bad_runner_arguments_are_refused_before_anything_runs(tmp_path):
     assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
 
 
-def test_the_example_sweep_loads_and_expands():
-    runs = expand(load_sweep(EXAMPLE))
-    assert len(runs) == 12
-    assert {r.values["integration.method"] for r in runs} == {
-        "explicit_euler",
-        "symplectic_euler",
-        "velocity_verlet",
-        "rk4",
-    }
+def test_the_example_sweep_shows_explicit_euler_gaining_energy_with_dt(tmp_path):
+    result = vv.sweep(load_sweep(EXAMPLE), tmp_path, executor="serial")
+    assert (result.ran, result.failed) == (12, 0)
+    drift = {(r["integration.method"], r["integration.dt"]): r["energy_drift"] for r in result.rows}
+    dts = sorted({dt for _, dt in drift})
+    assert dts[0] == 0.001 and dts[-1] == 0.04
+    euler = [drift[("explicit_euler", dt)] for dt in dts]
+    # Explicit Euler's energy grows at every step, more with a larger dt (first order: ~ dt).
+    assert 0 < euler[0] < euler[1] < euler[2]
+    assert euler[1] / euler[0] == pytest.approx(dts[1] / dts[0], rel=0.2)
+    for dt in dts:  # the second- and fourth-order methods stay far closer to the energy
+        assert abs(drift[("velocity_verlet", dt)]) < euler[0] / 10
+        assert abs(drift[("rk4", dt)]) < abs(drift[("velocity_verlet", dt)])
+    assert abs(drift[("rk4", 0.001)]) < 1e-12
 
 
 # ---------------------------------------------------------------- the command
