@@ -496,8 +496,41 @@ _document = st.fixed_dictionaries(
 )
 
 
+_numbers = st.integers(min_value=-3, max_value=4) | st.floats(-1e3, 1e3)
+_near_valid = st.fixed_dictionaries(
+    {
+        "sweep": st.fixed_dictionaries(
+            {"name": st.just("hostile")},
+            optional={
+                "design": st.sampled_from(["grid", "zip", "random"]),
+                "samples": st.integers(min_value=-1, max_value=4) | st.none(),
+                "seed": st.integers(min_value=-1, max_value=2**64),
+            },
+        ),
+        "scene": st.just(VALID_SCENE),
+        "parameters": st.lists(
+            st.builds(
+                lambda path, source: {"path": path} | source,
+                _paths,
+                st.one_of(
+                    st.fixed_dictionaries(
+                        {"values": st.lists(_scalar | st.lists(_scalar, max_size=4), max_size=3)}
+                    ),
+                    st.fixed_dictionaries({"range": st.lists(_numbers, min_size=2, max_size=3)}),
+                    st.fixed_dictionaries(
+                        {"log_range": st.lists(_numbers, min_size=2, max_size=3)}
+                    ),
+                ),
+            ),
+            min_size=1,
+            max_size=2,
+        ),
+    }
+)
+
+
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(document=_document, text=st.text(max_size=200))
+@given(document=_document | _near_valid, text=st.text(max_size=200))
 def test_hostile_sweep_files_are_refused_without_a_traceback(document, text):
     try:
         encoded = json.dumps(document)

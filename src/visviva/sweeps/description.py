@@ -256,7 +256,10 @@ def parse_sweep(text: str, format: str = "toml", source: str | None = None) -> S
     try:
         description = SweepFile.model_validate(raw)
     except ValidationError as exc:
-        problems = scene_problems(exc, raw, lambda p: locate(text, p), SweepFile)
+        problems = [
+            SceneProblem(p.path, p.message.removeprefix("Value error, "), p.got, p.line)
+            for p in scene_problems(exc, raw, lambda p: locate(text, p), SweepFile)
+        ]
         raise SweepError(problems, source) from None
     folder = Path(os.path.abspath(source)).parent if source else Path.cwd()
     base = _base_scene(description, raw, text, locate, folder, source)
