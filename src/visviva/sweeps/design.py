@@ -159,7 +159,8 @@ def expand(sweep: Sweep, *, check: bool = True) -> list[SweepRun]:
 
     all_values = run_values(sweep)
     width = len(str(max(len(all_values) - 1, 0)))
-    runs, problems = [], []
+    runs: list[SweepRun] = []
+    problems: list[SceneProblem] = []
     failed = 0
     for index, values in enumerate(all_values):
         data = sweep.base

@@ -137,7 +137,7 @@ def replaced(data: Any, keys: tuple[str | int, ...], value: Any) -> Any:
     key, rest = keys[0], keys[1:]
     if isinstance(data, dict):
         copy = dict(data)
-        copy[key] = replaced(data.get(key), rest, value)  # type: ignore[index]
+        copy[key] = replaced(data.get(key), rest, value)
         return copy
     items = list(data)
     items[key] = replaced(items[key], rest, value)  # type: ignore[index]

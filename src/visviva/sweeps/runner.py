@@ -364,7 +364,7 @@ def _start_worker(threads: int) -> None:
     import numba
 
     global _in_pool_worker
-    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))  # type: ignore[attr-defined]
     _in_pool_worker = True
     signal.signal(signal.SIGINT, _remember_stop)
 
