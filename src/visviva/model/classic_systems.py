@@ -11,6 +11,7 @@ systems.
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -21,13 +22,23 @@ from .system_type import Parameter, SystemType
 
 __all__ = ["CLASSIC_SYSTEMS"]
 
-_BUILT: dict[tuple[Any, ...], Any] = {}
+#: Systems built, by name and the values of their equations, most recently used last.
+_BUILT: OrderedDict[tuple[Any, ...], Any] = OrderedDict()
+#: Systems kept: deriving and compiling one costs seconds; a sweep over masses must not keep
+#: every one of them alive.
+MAX_BUILT = 32
 
 
 def _cached(name: str, values: Mapping[str, float], g: float, make: Callable[[], Any]) -> Any:
+    """The system of ``name`` for ``values`` (its equations' parameters only: initial
+    conditions do not change the equations, so every start shares one compiled system)."""
     key = (name, tuple(sorted(values.items())), g)
-    if key not in _BUILT:
+    if key in _BUILT:
+        _BUILT.move_to_end(key)
+    else:
         _BUILT[key] = make()
+        if len(_BUILT) > MAX_BUILT:
+            _BUILT.popitem(last=False)
     return _BUILT[key]
 
 
@@ -45,7 +56,8 @@ def _lagrangian(
 
     def system(values: Mapping[str, float], gravity: np.ndarray) -> Any:
         g = float(np.linalg.norm(gravity))
-        return _cached(name, values, g, lambda: make(values, g))
+        equations = {k: v for k, v in values.items() if not parameters[k].initial}
+        return _cached(name, equations, g, lambda: make(equations, g))
 
     def build(values: Mapping[str, float], gravity: np.ndarray) -> Problem:
         q0, v0 = start(values)
@@ -144,11 +156,11 @@ def _draw_constrained(
 
 
 def _angle(description: str, default: float = 0.0) -> Parameter:
-    return Parameter(default, "rad", description)
+    return Parameter(default, "rad", description, initial=True)
 
 
 def _rate(description: str) -> Parameter:
-    return Parameter(0.0, "rad/s", description)
+    return Parameter(0.0, "rad/s", description, initial=True)
 
 
 _MASS = Parameter(1.0, "kg", "mass", positive=True)
@@ -161,8 +173,8 @@ CLASSIC_SYSTEMS: tuple[SystemType, ...] = (
         "a 1 kg mass on a spring: q'' = -omega^2 q",
         {
             "omega": Parameter(2.0 * np.pi, "rad/s", "angular frequency", positive=True),
-            "q0": Parameter(1.0, "m", "initial displacement"),
-            "v0": Parameter(0.0, "m/s", "initial velocity"),
+            "q0": Parameter(1.0, "m", "initial displacement", initial=True),
+            "v0": Parameter(0.0, "m/s", "initial velocity", initial=True),
         },
         _oscillator,
         _draw_oscillator,
@@ -207,9 +219,9 @@ CLASSIC_SYSTEMS: tuple[SystemType, ...] = (
             "mass": _MASS,
             "stiffness": Parameter(40.0, "N/m", "spring constant", positive=True),
             "rest_length": Parameter(1.0, "m", "spring rest length", positive=True),
-            "r0": Parameter(1.2, "m", "initial length", positive=True),
+            "r0": Parameter(1.2, "m", "initial length", positive=True, initial=True),
             "theta0": _angle("initial angle from the downward vertical", 0.8),
-            "rdot0": Parameter(0.0, "m/s", "initial stretching rate"),
+            "rdot0": Parameter(0.0, "m/s", "initial stretching rate", initial=True),
             "omega0": _rate("initial angular velocity"),
         },
         _spring_pendulum,
@@ -224,8 +236,8 @@ CLASSIC_SYSTEMS: tuple[SystemType, ...] = (
             "mass": _MASS,
             "stiffness": Parameter(4.0, "N/m", "spring constant", positive=True),
             "damping": Parameter(0.4, "N s/m", "damping coefficient", minimum=0.0),
-            "x0": Parameter(1.0, "m", "initial displacement"),
-            "v0": Parameter(0.0, "m/s", "initial velocity"),
+            "x0": Parameter(1.0, "m", "initial displacement", initial=True),
+            "v0": Parameter(0.0, "m/s", "initial velocity", initial=True),
         },
         _damped_oscillator,
         lambda p: ([p["x0"]], [p["v0"]]),
@@ -238,12 +250,12 @@ CLASSIC_SYSTEMS: tuple[SystemType, ...] = (
         "seed 001's thrown rock: a point mass under gravity, U = m g y",
         {
             "mass": _MASS,
-            "x0": Parameter(0.0, "m", "initial x"),
-            "y0": Parameter(0.0, "m", "initial height"),
-            "z0": Parameter(0.0, "m", "initial z"),
-            "vx": Parameter(4.0, "m/s", "initial velocity, x"),
-            "vy": Parameter(8.0, "m/s", "initial velocity, y (up)"),
-            "vz": Parameter(0.0, "m/s", "initial velocity, z"),
+            "x0": Parameter(0.0, "m", "initial x", initial=True),
+            "y0": Parameter(0.0, "m", "initial height", initial=True),
+            "z0": Parameter(0.0, "m", "initial z", initial=True),
+            "vx": Parameter(4.0, "m/s", "initial velocity, x", initial=True),
+            "vy": Parameter(8.0, "m/s", "initial velocity, y (up)", initial=True),
+            "vz": Parameter(0.0, "m/s", "initial velocity, z", initial=True),
         },
         _rock,
         lambda p: ([p["x0"], p["y0"], p["z0"]], [p["vx"], p["vy"], p["vz"]]),

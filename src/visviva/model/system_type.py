@@ -24,6 +24,9 @@ class Parameter:
         integer: The value must be a whole number (a count).
         minimum: Smallest value accepted (e.g. 0 for a length that may vanish).
         maximum: Largest value accepted (counts are capped before anything is allocated).
+        initial: The value is an initial condition (an angle, a speed at the start), not part
+            of the equations of motion: systems that differ only in such values share their
+            derived, compiled equations and can advance side by side in one batched state.
     """
 
     default: float
@@ -33,6 +36,7 @@ class Parameter:
     integer: bool = False
     minimum: float | None = None
     maximum: float | None = None
+    initial: bool = False
 
 
 #: Draws frames of a system: ``(values, gravity, parts)`` with ``parts`` = ``(q, v)`` or ``(y,)``
