@@ -135,6 +135,7 @@ class SimulationDiverged(SimulationError):
         value: Its value when the watch fired (``nan``, ``inf`` or a huge number).
         suggested_dt: The stability advisor's largest stable step for the method, from the
             Jacobian at the last finite state, or ``None`` if it could not be estimated.
+        system: The offender's system (row) in a batch, or ``None`` for a single system.
     """
 
     def __init__(
@@ -146,11 +147,13 @@ class SimulationDiverged(SimulationError):
         component: str,
         value: float,
         suggested_dt: float | None,
+        system: int | None = None,
     ) -> None:
         super().__init__(message, t=t, step=step)
         self.component = component
         self.value = value
         self.suggested_dt = suggested_dt
+        self.system = system
 
 
 class NewtonConvergenceError(SimulationError):

@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -23,7 +23,7 @@ import numpy as np
 
 from ._validation import real_number
 from ._version import __version__
-from .errors import ModelError, SceneError, SceneProblem, SimulationError
+from .errors import ModelError, SceneError, SceneProblem, SimulationError, VisvivaError
 from .io.job import JobReport, python_warnings
 from .io.recording import load_recording
 from .io.scene_files import dump_scene
@@ -31,9 +31,10 @@ from .model import Model
 from .model.build import build_model
 
 if TYPE_CHECKING:
+    from .ode.state import State
     from .simulation.interrupt import Interrupted, StopOnSignal
 
-__all__ = ["DryRun", "dry_run", "load_model", "run_scene"]
+__all__ = ["DryRun", "RunFigures", "dry_run", "load_model", "run_scene", "write_run"]
 
 
 def load_model(path: str | os.PathLike[str]) -> Model:
@@ -142,12 +143,50 @@ def run_scene(
             recording (marked incomplete), the summary and the outputs finished before the
             signal were written (``error.report``).
     """
+    seconds = _duration(model, duration)
+
+    def simulate(path: Path | None, stops: StopOnSignal) -> tuple[RunFigures, VisvivaError | None]:
+        assert path is not None  # a run always keeps its recording
+        return _simulate_streaming(model, path, seconds, progress, stops)
+
+    return write_run(
+        model,
+        directory,
+        simulate,
+        seconds=seconds,
+        formats=formats,
+        force=force,
+        energy_tolerance=energy_tolerance,
+    )
+
+
+def write_run(
+    model: Model,
+    directory: str | os.PathLike[str],
+    produce: Callable[[Path | None, StopOnSignal], tuple[RunFigures, VisvivaError | None]],
+    *,
+    seconds: float,
+    formats: Iterable[str] = (),
+    force: bool = False,
+    energy_tolerance: float | None = None,
+    record: bool = True,
+) -> JobReport:
+    """Write a run's outputs into ``directory``, all or nothing: :func:`run_scene` for a run
+    that ``produce`` computes (or replays) into its recording.
+
+    ``produce(path, stops)`` streams the recording into ``path`` (``None`` without ``record``)
+    and returns the run's figures and the failure or interrupt that ended it, if any. The
+    summary, the extra outputs and the error handling are those of :func:`run_scene`.
+    """
     from .io.job import JobOutput
     from .io.outputs import write_output
     from .simulation.interrupt import Interrupted, StopOnSignal
 
-    seconds = _duration(model, duration)
     planned = _planned(model, formats, seconds)
+    if not record:
+        if len(planned) > 2:
+            raise ModelError("outputs other than summary.json are made from the recording")
+        planned.remove("recording.h5")
     tolerance = (
         model.integration.energy_tolerance
         if energy_tolerance is None
@@ -162,14 +201,15 @@ def run_scene(
         warnings.simplefilter("always")
         job.check_target(planned)
         started = time.perf_counter()
-        staged = job.stage("recording.h5")
-        run, failure = _simulate_streaming(model, staged, seconds, progress, stops)
+        staged = job.stage("recording.h5") if record else None
+        run, failure = produce(staged, stops)
         summary = _summary(model, run, failure, seconds, tolerance)
         unwritten: list[str] = []
         recording = None
         for name in extra if failure is None else ():
             try:
                 if recording is None:
+                    assert staged is not None  # outputs besides the summary need a recording
                     recording = load_recording(staged)
                 with job.writing(name) as path:
                     write_output(
@@ -189,7 +229,7 @@ def run_scene(
                 summary["interrupted"] = failure.signal
                 summary["message"] = f"{failure.signal} while writing {name}; not written"
                 break
-        summary["wall_time_s"] = time.perf_counter() - started
+        summary["wall_time_s"] = run.wall_time_s + time.perf_counter() - started
         summary["warnings"] += python_warnings(caught)
         report = job.write(summary)
     if unwritten and failure is None:
@@ -201,11 +241,12 @@ def run_scene(
 
 
 @dataclass
-class _Run:
-    """What a streamed run leaves besides its file: outcome, work and energy figures.
+class RunFigures:
+    """What a run leaves besides its recording: outcome, work and energy figures.
 
     The energy is followed frame by frame (first, last, largest change), so nothing in
-    memory grows with the number of frames.
+    memory grows with the number of frames. ``wall_time_s`` is time spent before the job's
+    own clock started (a share of a batch the run was computed in), 0 for a run of its own.
     """
 
     t_reached: float = float("nan")
@@ -216,6 +257,7 @@ class _Run:
     energy_last: float | None = None
     energy_change: float = 0.0
     emitters: dict[str, dict[str, int]] = field(default_factory=dict)
+    wall_time_s: float = 0.0
 
     def see(self, t: float, energy: Any) -> None:
         self.t_reached = t
@@ -235,25 +277,25 @@ class _Run:
         scale = abs(self.energy_start)
         return (self.energy_last - self.energy_start) / scale, self.energy_change / scale
 
+    def recorder(self, model: Model, writer: Any) -> Callable[[State, Any], None]:
+        """``record(state, energy)``: what a recording keeps of ``state`` (the model's frame
+        and the energy) appended to ``writer`` (``writer.append(t, fields)``), and seen here."""
 
-def _simulate_streaming(
-    model: Model,
-    path: Path,
-    seconds: float,
-    progress: bool | None,
-    stops: StopOnSignal,
-) -> tuple[_Run, SimulationError | Interrupted | None]:
-    """Run the scene, streaming each recorded frame into the recording at ``path``.
+        def record(state: State, energy: Any) -> None:
+            fields = model.frame(state)
+            if energy is not None:
+                fields["energy"] = np.asarray(energy, dtype=np.float64)
+            writer.append(state.t, fields)
+            self.see(state.t, energy)
+            self.points = fields["points"].shape[0] if "points" in fields else 0
 
-    Returns what the run leaves (:class:`_Run`) and the failure or interrupt that ended it
-    early, if any.
-    """
-    from .io.writer import RecordingWriter
-    from .simulation import Simulation
-    from .simulation.interrupt import Interrupted
+        return record
 
+
+def recording_attrs(model: Model, seconds: float) -> dict[str, Any]:
+    """The attributes a scene run's recording starts with."""
     settings = model.integration
-    attrs = {
+    return {
         "scene": model.source or dump_scene(model.scene),
         "scene_name": model.name,
         "visviva_version": __version__,
@@ -268,26 +310,53 @@ def _simulate_streaming(
         "playback_color_by": model.output_color_by,
         "compiled": False,
     } | model.recording_attrs()
-    run = _Run()
+
+
+def final_attrs(run: RunFigures, failure: VisvivaError | None, wall_time_s: float) -> dict[str, Any]:
+    """The attributes a scene run's recording ends with: work, time and outcome."""
+    from .simulation.interrupt import Interrupted
+
+    final: dict[str, Any] = run.counters | {
+        "wall_time_s": wall_time_s,
+        "complete": failure is None,
+        "success": failure is None,
+        "message": "completed" if failure is None else str(failure),
+    }
+    if isinstance(failure, Interrupted):
+        final["interrupted"] = failure.signal
+    return final
+
+
+def _simulate_streaming(
+    model: Model,
+    path: Path,
+    seconds: float,
+    progress: bool | None,
+    stops: StopOnSignal,
+) -> tuple[RunFigures, SimulationError | Interrupted | None]:
+    """Run the scene, streaming each recorded frame into the recording at ``path``.
+
+    Returns what the run leaves (:class:`RunFigures`) and the failure or interrupt that ended
+    it early, if any.
+    """
+    from .io.writer import RecordingWriter
+    from .simulation import Simulation
+    from .simulation.interrupt import Interrupted
+
+    run = RunFigures()
     failure: SimulationError | Interrupted | None = None
     simulation = Simulation(model)
-    with RecordingWriter(path, units=model.units(), attrs=attrs, static=model.static()) as writer:
-
-        def record(state: Any, energy: Any) -> None:
-            fields = model.frame(state)
-            if energy is not None:
-                fields["energy"] = np.asarray(energy, dtype=np.float64)
-            writer.append(state.t, fields)
-            run.see(state.t, energy)
-            run.points = fields["points"].shape[0] if "points" in fields else 0
-
+    with RecordingWriter(
+        path, units=model.units(), attrs=recording_attrs(model, seconds), static=model.static()
+    ) as writer:
+        record = run.recorder(model, writer)
         started = time.perf_counter()
         record(simulation.raw_state, simulation.system.energy(simulation.raw_state))
         try:
             with stops.polled():
                 simulation.run(
                     seconds,
-                    record_every=settings.record_every,
+                    record_every=model.integration.record_every,
                     on_frame=record,
                     progress=progress,
                 )
@@ -307,21 +376,13 @@ def _simulate_streaming(
             }
             for spec in model.emitters
         }
-        final: dict[str, Any] = run.counters | {
-            "wall_time_s": time.perf_counter() - started,
-            "complete": failure is None,
-            "success": failure is None,
-            "message": "completed" if failure is None else str(failure),
-        }
-        if isinstance(failure, Interrupted):
-            final["interrupted"] = failure.signal
-        writer.finish(final)
+        writer.finish(final_attrs(run, failure, time.perf_counter() - started))
     return run, failure
 
 
 def _summary(
     model: Model,
-    run: _Run,
+    run: RunFigures,
     failure: Exception | None,
     seconds: float,
     tolerance: float,
@@ -381,7 +442,7 @@ def _energy_warning(model: Model, drift: float, tolerance: float) -> str:
     )
 
 
-def _counts(model: Model, run: _Run) -> dict[str, int]:
+def _counts(model: Model, run: RunFigures) -> dict[str, int]:
     """What the scene holds: particle slots, systems' degrees of freedom, drawn points."""
     counts = {}
     if model.particle_count:

@@ -23,6 +23,10 @@ def sweep_command(
     no_resume: Annotated[
         bool, typer.Option("--no-resume", help="Run again the runs already finished in DIR.")
     ] = False,
+    no_batch: Annotated[
+        bool,
+        typer.Option("--no-batch", help="Run every run alone, never in a batch (same results)."),
+    ] = False,
     dry_run: Annotated[
         bool,
         typer.Option("--dry-run", help="Validate, expand and print the runs; write nothing."),
@@ -53,6 +57,7 @@ def sweep_command(
         executor="serial" if serial else None,
         workers=workers,
         resume=not no_resume,
+        batch=not no_batch,
     )
     _print_result(result)
 

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..ode.batching import PARALLEL_MIN_SYSTEMS
 from .base import CompiledStep
 
 if TYPE_CHECKING:
@@ -217,11 +218,6 @@ def runge_kutta_step(tableau: ButcherTableau, problem: Problem) -> CompiledStep 
         return CompiledStep(step, s + 1)
 
     return _memoized(("runge_kutta", tableau.a.tobytes(), tableau.b.tobytes(), *key), build)
-
-
-#: Batches at least this large run on all cores; smaller ones on one (a parallel loop costs
-#: more to compile and to start than it saves on a handful of systems).
-PARALLEL_MIN_SYSTEMS = 64
 
 
 def make_runner(step: CompiledStep, systems: int) -> Callable[..., None]:

@@ -105,9 +105,12 @@ class ButcherTableau:
 class Stages:
     """The stage derivatives ``k_1 … k_s`` of one Runge–Kutta step.
 
-    Each state part keeps its stages as the rows of one ``(s, size)`` array, so a weighted sum
-    ``Σ_j w_j k_j`` is a single matrix–vector product instead of a Python loop of array updates
-    (which dominated the cost of small systems).
+    Each state part keeps its stages as the rows of one ``(s, size)`` array. A weighted sum
+    ``Σ_j w_j k_j`` is summed entry by entry in stage order, skipping zero weights, never as a
+    BLAS matrix–vector product: BLAS kernels order their sums by the array's length and
+    alignment, so one system would step differently alone and in a batch (a chaotic pendulum
+    then parts from itself within seconds). Entry-wise, every entry of every system is computed
+    the same way whatever surrounds it.
     """
 
     def __init__(self, parts: tuple[np.ndarray, ...], count: int) -> None:
@@ -134,9 +137,15 @@ class Stages:
 
     def weighted(self, h: float, weights: np.ndarray) -> tuple[np.ndarray, ...]:
         """``h Σ_j weights[j] k_j`` over the first ``len(weights)`` stages, part by part."""
-        scaled = h * weights
         n = self._filled(weights)
-        return tuple([(scaled @ rows[:n]).reshape(shape) for rows, shape in self._layout])
+        sums = []
+        for rows, shape in self._layout:
+            total = np.zeros(rows.shape[1], dtype=rows.dtype)
+            for j in range(n):
+                if weights[j] != 0.0:
+                    total += (h * weights[j]) * rows[j]
+            sums.append(total.reshape(shape))
+        return tuple(sums)
 
     def combine(
         self, base: tuple[np.ndarray, ...], h: float, weights: np.ndarray

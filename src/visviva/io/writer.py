@@ -11,6 +11,7 @@ options, so a crashed file needs no repair tool (NOTES.md).
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Mapping
 from datetime import UTC, datetime
@@ -97,26 +98,34 @@ class RecordingWriter:
         The frame counts once every array is written: an append cut short (by a signal) is
         dropped by :meth:`finish`.
         """
-        index = self.frames
-        for name, value in fields.items():
-            value = np.asarray(value)
+        self.extend([t], {name: np.asarray(value)[None] for name, value in fields.items()})
+
+    def extend(self, times: Any, fields: Mapping[str, np.ndarray]) -> None:
+        """Add ``k`` frames at once: their times [s], ``(k,)``, and one array per field with
+        the frames on its first axis, ``(k, ...)`` (the shapes of :meth:`append`'s)."""
+        times = np.asarray(times, dtype=np.float64)
+        start, count = self.frames, times.shape[0]
+        for name, values in fields.items():
+            values = np.asarray(values)
+            shape = values.shape[1:]
             if name not in self._fields:
                 dataset = self._fields.create_dataset(
                     name,
-                    (0, *value.shape),
-                    dtype=value.dtype,
-                    maxshape=(None, *value.shape),
-                    chunks=(1, *value.shape) if value.size else None,
+                    (0, *shape),
+                    dtype=values.dtype,
+                    maxshape=(None, *shape),
+                    chunks=(1, *shape) if math.prod(shape) else None,
                 )
                 dataset.attrs["units"] = self.units.get(name, "")
             dataset = self._fields[name]
-            dataset.resize((index + 1, *value.shape))
-            dataset[index] = value
-        self._time.resize((index + 1,))
-        self._time[index] = t
-        self.frames += 1
-        self.last_time = float(t)
-        if self.frames % self.flush_every == 0:
+            dataset.resize((start + count, *shape))
+            dataset[start:] = values
+        self._time.resize((start + count,))
+        self._time[start:] = times
+        self.frames += count
+        if count:
+            self.last_time = float(times[-1])
+        if self.frames // self.flush_every > start // self.flush_every:
             self._file.flush()
 
     def finish(

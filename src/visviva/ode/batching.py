@@ -20,6 +20,10 @@ from .functions import UserFunction
 __all__ = ["batched"]
 
 
+#: Batches at least this large run on all cores; smaller ones on one (a parallel loop costs
+#: more to start than a handful of systems take, and on a busy machine 10x more).
+PARALLEL_MIN_SYSTEMS = 64
+
 #: Built wrappers by (user function, its form, result kind): every problem made from the same
 #: Numba function reuses one compiled loop instead of compiling its own (~0.5 s each).
 _WRAPPERS: dict[tuple[Any, ...], Callable[..., Any]] = {}
@@ -45,6 +49,23 @@ def batched(function: UserFunction, result: str) -> Callable[..., Any]:
     return _WRAPPERS[key]
 
 
+class _Split:
+    """A loop over the systems of a batch (``loop(t, states..., outputs...)`` with ``prange``),
+    compiled on first use in two forms: parallel for batches of at least
+    :data:`PARALLEL_MIN_SYSTEMS` systems, serial for smaller ones. Both compute every system
+    the same way, so the choice never changes a result."""
+
+    def __init__(self, loop: Callable[..., None]) -> None:
+        import numba
+
+        self._parallel = numba.njit(parallel=True)(loop)
+        self._serial = numba.njit(loop)
+
+    def __call__(self, t: float, first: np.ndarray, *rest: Any) -> None:
+        big = first.shape[0] >= PARALLEL_MIN_SYSTEMS
+        (self._parallel if big else self._serial)(t, first, *rest)
+
+
 def _build(function: UserFunction, result: str) -> Callable[..., Any]:
     import numba
 
@@ -56,7 +77,7 @@ def _build(function: UserFunction, result: str) -> Callable[..., Any]:
         if writes_out:
             if two:
 
-                @numba.njit(parallel=True)
+                @_Split
                 def loop_out2(t, a, b, out):  # pragma: no cover - compiled
                     for i in numba.prange(a.shape[0]):
                         func(t, a[i], b[i], out[i])
@@ -64,7 +85,7 @@ def _build(function: UserFunction, result: str) -> Callable[..., Any]:
                 kernel: Any = loop_out2
             else:
 
-                @numba.njit(parallel=True)
+                @_Split
                 def loop_out1(t, a, out):  # pragma: no cover - compiled
                     for i in numba.prange(a.shape[0]):
                         func(t, a[i], out[i])
@@ -72,7 +93,7 @@ def _build(function: UserFunction, result: str) -> Callable[..., Any]:
                 kernel = loop_out1
         elif two:
 
-            @numba.njit(parallel=True)
+            @_Split
             def loop_ret2(t, a, b, out):  # pragma: no cover - compiled
                 for i in numba.prange(a.shape[0]):
                     result = func(t, a[i], b[i])
@@ -82,7 +103,7 @@ def _build(function: UserFunction, result: str) -> Callable[..., Any]:
             kernel = loop_ret2
         else:
 
-            @numba.njit(parallel=True)
+            @_Split
             def loop_ret1(t, a, out):  # pragma: no cover - compiled
                 for i in numba.prange(a.shape[0]):
                     result = func(t, a[i])
@@ -100,7 +121,7 @@ def _build(function: UserFunction, result: str) -> Callable[..., Any]:
 
     if result == "matrix":
 
-        @numba.njit(parallel=True)
+        @_Split
         def loop_matrix(t, a, out):  # pragma: no cover - compiled
             for i in numba.prange(a.shape[0]):
                 matrix = func(t, a[i])
@@ -117,7 +138,7 @@ def _build(function: UserFunction, result: str) -> Callable[..., Any]:
 
     if result == "pair":
 
-        @numba.njit(parallel=True)
+        @_Split
         def loop_pair(t, a, b, out_q, out_v):  # pragma: no cover - compiled
             for i in numba.prange(a.shape[0]):
                 jq, jv = func(t, a[i], b[i])
@@ -137,7 +158,7 @@ def _build(function: UserFunction, result: str) -> Callable[..., Any]:
     if result == "scalar":
         if two:
 
-            @numba.njit(parallel=True)
+            @_Split
             def loop_scalar2(t, a, b, out):  # pragma: no cover - compiled
                 for i in numba.prange(a.shape[0]):
                     out[i] = func(t, a[i], b[i])
@@ -145,7 +166,7 @@ def _build(function: UserFunction, result: str) -> Callable[..., Any]:
             scalar_kernel: Any = loop_scalar2
         else:
 
-            @numba.njit(parallel=True)
+            @_Split
             def loop_scalar1(t, a, out):  # pragma: no cover - compiled
                 for i in numba.prange(a.shape[0]):
                     out[i] = func(t, a[i])

@@ -56,10 +56,13 @@ class DivergenceWatch:
         self.system = system
         self.method = method
         self.dt = dt
-        if limit is None:
-            scale = max(float(np.max(np.abs(part))) for part in initial.parts)
-            limit = DEFAULT_DIVERGENCE_LIMIT * max(1.0, scale)
-        self.limit = float(limit)
+        self.limit = float(self.default_limit(initial) if limit is None else limit)
+
+    @staticmethod
+    def default_limit(initial: State) -> float:
+        """``DEFAULT_DIVERGENCE_LIMIT × max(1, max|initial state|)``."""
+        scale = max(float(np.max(np.abs(part))) for part in initial.parts)
+        return DEFAULT_DIVERGENCE_LIMIT * max(1.0, scale)
 
     def healthy(self, state: State) -> bool:
         """True if every component is finite and within the limit."""
@@ -84,6 +87,7 @@ class DivergenceWatch:
             component=component,
             value=value,
             suggested_dt=suggestion,
+            system=system_index,
         )
 
     def _first_offender(self, state: State) -> tuple[str, float, int | None]:

@@ -3,16 +3,19 @@
 A sweep file names a base scene, the parameters to vary and how (grid, zip or random design,
 :mod:`.description`, :mod:`.design`); :func:`sweep` runs every run through
 :func:`~visviva.scenes.run_scene` on a process pool, in this process, or on any
-:class:`concurrent.futures.Executor`, resumes where an interrupted sweep stopped, and writes a
+:class:`concurrent.futures.Executor` — runs that share their equations advance together in
+batches (:mod:`.tasks`) — resumes where an interrupted sweep stopped, and writes a
 results table (:mod:`.results`). A front layer like :mod:`visviva.scenes`: the physics packages
 never import it.
 """
 
 from .description import Outputs, Parameter, Sweep, SweepInfo, load_sweep, parse_sweep
 from .design import SweepRun, expand, run_values
-from .runner import RunTask, SweepInterrupted, SweepResult, run_task, sweep
+from .runner import SweepInterrupted, SweepResult, sweep
+from .tasks import BatchTask, RunTask, run_batch, run_task
 
 __all__ = [
+    "BatchTask",
     "Outputs",
     "Parameter",
     "RunTask",
@@ -24,6 +27,7 @@ __all__ = [
     "expand",
     "load_sweep",
     "parse_sweep",
+    "run_batch",
     "run_task",
     "run_values",
     "sweep",

@@ -22,7 +22,8 @@ import itertools
 import json
 import math
 import re
-from dataclasses import dataclass
+from collections.abc import Hashable
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -33,6 +34,7 @@ from ..errors import ModelError, SceneError, SceneProblem, SweepError
 from ..model.build import build_model
 from ..model.scene import Scene
 from ..model.scene_errors import scene_problems
+from ..simulation.ensemble import ensemble_key
 from .description import MAX_RUNS, Parameter, Sweep
 from .paths import replaced
 
@@ -52,6 +54,9 @@ class SweepRun:
         name: Directory name of the run: zero-padded index and the values, ``0003-dt=0.01``.
         scene: The run's scene as plain data (validated; picklable, sent to workers).
         digest: SHA-256 of the scene's data: a finished run is reused only for the same digest.
+        batch_key: What runs must share to advance together in one batched state
+            (:func:`~visviva.simulation.ensemble.ensemble_key` of its model, meaningful in this
+            process only), or ``None`` if the run cannot join a batch or was not checked.
     """
 
     index: int
@@ -59,6 +64,7 @@ class SweepRun:
     name: str
     scene: dict[str, Any]
     digest: str
+    batch_key: Hashable | None = field(default=None, compare=False, repr=False)
 
 
 def run_values(sweep: Sweep) -> list[dict[str, Any]]:
@@ -168,11 +174,13 @@ def expand(sweep: Sweep, *, check: bool = True) -> list[SweepRun]:
             data = replaced(data, keys, value)
         name = f"{index:0{width}d}-{_slug(values)}"
         found: list[SceneProblem] = []
+        key: Hashable | None = None
         if check:
             try:
                 scene = Scene.model_validate(data)
                 model = build_model(scene)
                 found = output_problems(model, sweep.outputs.formats, model.integration.duration)
+                key = ensemble_key(model)
             except ValidationError as exc:
                 found = scene_problems(exc, data, lambda _path: None)
             except SceneError as error:
@@ -186,7 +194,7 @@ def expand(sweep: Sweep, *, check: bool = True) -> list[SweepRun]:
                 SceneProblem(f"run {index} ({label}): {p.path}".rstrip(": "), p.message, p.got)
                 for p in found
             ][: max(MAX_LISTED - len(problems), 0)]
-        runs.append(SweepRun(index, values, name, data, _digest(data)))
+        runs.append(SweepRun(index, values, name, data, _digest(data), key))
     if problems:
         if failed > 1 or len(problems) >= MAX_LISTED:
             problems.append(

@@ -1,78 +1,57 @@
-"""Running a sweep: every run through :func:`~visviva.scenes.run_scene`, on any executor.
+"""Running a sweep: every run, alone or in a batch, on any executor.
 
-Each run is an independent task (:class:`RunTask`: the scene as plain data, picklable) that
-writes ``summary.json`` (and, if kept, ``recording.h5`` and the extra outputs) into
-``directory/runs/<index>-<values>/``, then ``run.json`` (its index, values, the digest of its
-scene, success and error). A run that fails or diverges is recorded with its error and the
-others go on. With ``resume``, a run whose directory holds ``run.json`` for the same scene
-digest and values, and a ``summary.json`` that was not interrupted, is not run again (a diverged
-run counts as finished: the same scene diverges the same way). On Ctrl-C the runs under way stop
-(their directories are removed), no new run starts, and the finished ones are kept and listed in
-the results. ``results.csv`` and ``results.json`` (:mod:`.results`) are written at the end,
-atomically, also after an interrupt.
+Each run is an independent task (:class:`~visviva.sweeps.tasks.RunTask`: the scene as plain
+data, picklable) that writes ``summary.json`` (and, if kept, ``recording.h5`` and the extra
+outputs) into ``directory/runs/<index>-<values>/``, then ``run.json`` (its index, values, the
+digest of its scene, success and error). Runs whose models are one named system with the same
+equations and settings — a sweep over starting angles — are grouped into batches
+(:class:`~visviva.sweeps.tasks.BatchTask`) that advance side by side in one batched state and
+write exactly what each run would have written alone. A run that fails or diverges is recorded
+with its error and the others go on. With ``resume``, a run whose directory holds ``run.json``
+for the same scene digest and values, and a ``summary.json`` that was not interrupted, is not run
+again (a diverged run counts as finished: the same scene diverges the same way). On Ctrl-C the
+runs under way stop (their directories are removed), no new run starts, and the finished ones
+are kept and listed in the results. ``results.csv`` and ``results.json`` (:mod:`.results`) are
+written at the end, atomically, also after an interrupt.
 """
 
 from __future__ import annotations
 
-import json
+import math
 import multiprocessing
 import multiprocessing.context
 import os
-import shutil
-import signal
 from collections.abc import Callable
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed, wait
 from dataclasses import dataclass
 from pathlib import Path
-from types import FrameType
 from typing import Any, Literal
 
 from .._validation import whole_number
-from ..errors import ModelError, VisvivaError
-from ..io.files import atomic_path, check_directory
-from ..io.job import plain_json
+from ..errors import ModelError
+from ..io.files import check_directory
 from ..simulation.interrupt import Interrupted
 from ..simulation.progress import Progress
 from .description import Sweep, load_sweep
 from .design import SweepRun, expand
-from .results import flatten_summary, write_results
+from .results import write_results
+from .tasks import BatchTask, RunTask, finished_row, perform, start_worker
 
-__all__ = ["RunTask", "SweepInterrupted", "SweepResult", "run_task", "sweep"]
+__all__ = ["SweepInterrupted", "SweepResult", "sweep"]
 
-#: A run's own record, written after its summary: what it was run with, and how it ended.
-RUN_FILE = "run.json"
 #: Modules the pool's fork server imports once, so that each worker starts with them loaded.
-WORKER_PRELOAD = ("visviva.sweeps.runner", "visviva.scenes", "visviva.simulation")
-# In a worker of the sweep's own pool: True, and the stop signal once one arrived.
-_in_pool_worker = False
-_stopped_worker: str | None = None
-#: Summary entries already in the row as ``success`` and ``error``.
-_OUTCOME = ("success", "message")
-
-
-@dataclass(frozen=True)
-class RunTask:
-    """What a worker needs to do one run (plain data: it travels to other processes).
-
-    Attributes:
-        index: The run's index in the design.
-        name: Its directory name.
-        directory: Its directory (absolute).
-        scene: Its scene as plain data (validated before the sweep started).
-        values: Its parameters' values, by path.
-        digest: SHA-256 of ``scene``.
-        formats: Extra outputs to write (mp4, html, ...).
-        keep_recording: Keep ``recording.h5`` (else it is removed after the run).
-    """
-
-    index: int
-    name: str
-    directory: str
-    scene: dict[str, Any]
-    values: dict[str, Any]
-    digest: str
-    formats: tuple[str, ...] = ()
-    keep_recording: bool = False
+WORKER_PRELOAD = (
+    "visviva.sweeps.tasks",
+    "visviva.scenes",
+    "visviva.simulation",
+    "visviva.simulation.ensemble",
+)
+#: A batch needs at least this many runs: below it, separate runs on separate cores finish
+#: sooner than one batch on one core.
+MIN_BATCH = 2
+#: Most runs in one batch: a batch keeps the frames of the members whose recordings are kept
+#: until it ends, and more members per batch gain nothing once the per-step work is shared.
+MAX_BATCH = 1024
 
 
 @dataclass(frozen=True)
@@ -109,75 +88,6 @@ class SweepInterrupted(Interrupted):
         self.result = result
 
 
-def run_task(task: RunTask) -> dict[str, Any]:
-    """Do one run; return its results row (or ``{"interrupted": signal}`` if it was stopped,
-    its directory removed). Never raises for a failure of the run itself."""
-    from ..model.build import build_model
-    from ..model.scene import Scene
-    from ..scenes import run_scene
-
-    global _stopped_worker
-    if _stopped_worker is not None:  # the queued runs of a pool told to stop do not start
-        return {"index": task.index, "interrupted": _stopped_worker}
-    directory = Path(task.directory)
-    marker = directory / RUN_FILE
-    marker.unlink(missing_ok=True)  # the run.json of an older run must not vouch for this one
-    summary: dict[str, Any] | None = None
-    error: str | None = None
-    try:
-        model = build_model(Scene.model_validate(task.scene))
-        report = run_scene(model, directory, formats=task.formats, force=True, progress=False)
-        summary = report.summary
-    except Interrupted as stop:
-        shutil.rmtree(directory, ignore_errors=True)
-        if _in_pool_worker:
-            _stopped_worker = stop.signal
-        return {"index": task.index, "interrupted": stop.signal}
-    except VisvivaError as failure:  # diverged, failed to converge, an output not written
-        error = str(failure)
-        summary = failure.report.summary if failure.report is not None else None
-    except Exception as failure:  # one broken run must not end the others
-        error = f"{type(failure).__name__}: {failure}"
-    if not task.keep_recording:
-        (directory / "recording.h5").unlink(missing_ok=True)
-    info = {
-        "index": task.index,
-        "run": task.name,
-        "values": task.values,
-        "digest": task.digest,
-        "success": error is None and bool(summary and summary.get("success")),
-        "error": error,
-    }
-    directory.mkdir(parents=True, exist_ok=True)
-    with atomic_path(marker) as temporary:
-        temporary.write_text(json.dumps(plain_json(info), indent=2, allow_nan=False) + "\n")
-    return _row(info, summary)
-
-
-def _row(info: dict[str, Any], summary: dict[str, Any] | None) -> dict[str, Any]:
-    figures = flatten_summary({k: v for k, v in (summary or {}).items() if k not in _OUTCOME})
-    return (
-        {"index": info["index"], "run": info["run"]}
-        | info["values"]
-        | {"success": info["success"], "error": info["error"]}
-        | figures
-    )
-
-
-def _finished(directory: Path, run: SweepRun) -> dict[str, Any] | None:
-    """The row of a run already done in ``directory`` with the same scene, or ``None``."""
-    try:
-        info = json.loads((directory / RUN_FILE).read_text())
-        summary = json.loads((directory / "summary.json").read_text())
-    except (OSError, ValueError):
-        return None
-    if not isinstance(info, dict) or not isinstance(summary, dict) or "interrupted" in summary:
-        return None
-    if info.get("digest") != run.digest or info.get("values") != plain_json(run.values):
-        return None
-    return _row(info, summary)
-
-
 def sweep(
     description: Sweep | str | os.PathLike[str],
     directory: str | os.PathLike[str],
@@ -185,6 +95,7 @@ def sweep(
     executor: Executor | Literal["serial"] | None = None,
     workers: int | None = None,
     resume: bool = True,
+    batch: bool = True,
     progress: bool | None = None,
 ) -> SweepResult:
     """Run every run of a sweep into ``directory/runs/`` and tabulate the results.
@@ -197,6 +108,9 @@ def sweep(
             ``None`` for a process pool of ``workers`` processes.
         workers: Processes of the default pool (default: every core).
         resume: Skip runs already finished in ``directory`` with the same scene.
+        batch: Advance runs that share their equations (one named system, only the start
+            differing) together in batches; each run's files and numbers are the same either
+            way, bit for bit for the explicit and symplectic methods.
         progress: Progress bar over runs (default: when stderr is a terminal).
 
     Returns:
@@ -222,29 +136,33 @@ def sweep(
     check_directory(root, "sweep directory")
     (root / "runs").mkdir(parents=True, exist_ok=True)
     rows: dict[int, dict[str, Any]] = {}
-    pending = []
+    pending: list[tuple[SweepRun, RunTask]] = []
     for run in runs:
-        found = _finished(root / "runs" / run.name, run) if resume else None
+        task = _task(chosen, root, run)
+        found = finished_row(Path(task.directory), run.digest, run.values) if resume else None
         if found is not None:
             rows[run.index] = found
         else:
-            pending.append(_task(chosen, root, run))
+            pending.append((run, task))
+    slots = 1 if executor == "serial" else workers or os.cpu_count() or 1
+    tasks = _plan(pending, slots if batch else 0)
     skipped = len(rows)
     stopped: str | None = None
     with Progress(len(runs), f"sweep {chosen.info.name}", progress) as bar:
         bar.advance(skipped)
 
-        def collect(row: dict[str, Any]) -> bool:
+        def collect(done: list[dict[str, Any]]) -> bool:
             nonlocal stopped
-            if "interrupted" in row:
-                stopped = stopped or row["interrupted"]
-                return False
-            rows[row["index"]] = row
-            bar.advance(1)
-            return True
+            for row in done:
+                if "interrupted" in row:
+                    stopped = stopped or row["interrupted"]
+                else:
+                    rows[row["index"]] = row
+                    bar.advance(1)
+            return stopped is None
 
         try:
-            _execute(pending, executor, workers, collect)
+            _execute(tasks, executor, workers, collect)
         except KeyboardInterrupt:
             stopped = "SIGINT"
     ordered = [rows[index] for index in sorted(rows)]
@@ -281,19 +199,41 @@ def _task(chosen: Sweep, root: Path, run: SweepRun) -> RunTask:
     )
 
 
+def _plan(pending: list[tuple[SweepRun, RunTask]], slots: int) -> list[RunTask | BatchTask]:
+    """The tasks for the runs to do: runs with one batch key grouped into batches of
+    :data:`MIN_BATCH` to :data:`MAX_BATCH` runs, split so that each of ``slots`` workers gets
+    a share (no batches with ``slots`` 0), the rest alone; in the order of their first run."""
+    tasks: list[RunTask | BatchTask] = []
+    groups: dict[Any, list[RunTask]] = {}
+    for run, task in pending:
+        if slots and run.batch_key is not None:
+            groups.setdefault(run.batch_key, []).append(task)
+        else:
+            tasks.append(task)
+    for members in groups.values():
+        if len(members) < MIN_BATCH:
+            tasks += members
+            continue
+        size = max(MIN_BATCH, min(MAX_BATCH, math.ceil(len(members) / slots)))
+        for start in range(0, len(members), size):
+            chunk = members[start : start + size]
+            tasks += [BatchTask(tuple(chunk))] if len(chunk) >= MIN_BATCH else chunk
+    return sorted(tasks, key=lambda t: t.runs[0].index if isinstance(t, BatchTask) else t.index)
+
+
 def _execute(
-    tasks: list[RunTask],
+    tasks: list[RunTask | BatchTask],
     executor: Executor | Literal["serial"] | None,
     workers: int | None,
-    collect: Callable[[dict[str, Any]], bool],
+    collect: Callable[[list[dict[str, Any]]], bool],
 ) -> None:
-    """Run ``tasks``, handing each row to ``collect`` as it comes; a row that says the run
-    was interrupted (``collect`` returns false) stops the sweep."""
+    """Run ``tasks``, handing the rows of each to ``collect`` as they come; a row that says
+    its run was interrupted (``collect`` returns false) stops the sweep."""
     if not tasks:
         return
     if executor == "serial":
         for task in tasks:
-            if not collect(run_task(task)):
+            if not collect(perform(task)):
                 return
         return
     own = executor is None
@@ -302,14 +242,14 @@ def _execute(
         ProcessPoolExecutor(
             max_workers=processes,
             mp_context=_worker_context(),
-            initializer=_start_worker,
+            initializer=start_worker,
             initargs=(max(1, (os.cpu_count() or 1) // processes),),
         )
         if executor is None
         else executor
     )
-    futures = {pool.submit(run_task, task): task for task in tasks}
-    seen: set[Future[dict[str, Any]]] = set()
+    futures = {pool.submit(perform, task): task for task in tasks}
+    seen: set[Future[list[dict[str, Any]]]] = set()
     try:
         try:
             for future in as_completed(futures):
@@ -330,18 +270,19 @@ def _execute(
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _outcome(future: Future[dict[str, Any]], task: RunTask) -> dict[str, Any]:
-    """The row of a finished future; a worker that died is the run's error."""
+def _outcome(
+    future: Future[list[dict[str, Any]]], task: RunTask | BatchTask
+) -> list[dict[str, Any]]:
+    """The rows of a finished future; a worker that died is the error of its task's runs."""
     try:
         return future.result()
-    except Exception as failure:  # a broken worker fails its run only
-        return {
-            "index": task.index,
-            "run": task.name,
-            **task.values,
-            "success": False,
-            "error": f"{type(failure).__name__}: {failure}",
-        }
+    except Exception as failure:  # a broken worker fails its task's runs only
+        runs = task.runs if isinstance(task, BatchTask) else (task,)
+        error = f"{type(failure).__name__}: {failure}"
+        return [
+            {"index": run.index, "run": run.name, **run.values, "success": False, "error": error}
+            for run in runs
+        ]
 
 
 def _worker_context() -> multiprocessing.context.BaseContext:
@@ -353,23 +294,3 @@ def _worker_context() -> multiprocessing.context.BaseContext:
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(list(WORKER_PRELOAD))
     return context
-
-
-def _start_worker(threads: int) -> None:
-    """Prepare a pool worker: a share of the cores for Numba's parallel kernels (the pool
-    already runs one run per core: more threads only contend, 10x slower on 2 cores), and a
-    SIGINT between runs remembered so that no queued run starts after it; during a run,
-    run_scene's own handler stops it cleanly (a Ctrl-C at the terminal reaches every process
-    of the group)."""
-    import numba
-
-    global _in_pool_worker
-    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))  # type: ignore[attr-defined]
-    _in_pool_worker = True
-    signal.signal(signal.SIGINT, _remember_stop)
-
-
-def _remember_stop(number: int, frame: FrameType | None) -> None:
-    """A pool worker's SIGINT between runs: the runs queued to it will not start."""
-    global _stopped_worker
-    _stopped_worker = signal.Signals(number).name
