@@ -246,7 +246,8 @@ class RunFigures:
 
     The energy is followed frame by frame (first, last, largest change), so nothing in
     memory grows with the number of frames. ``wall_time_s`` is time spent before the job's
-    own clock started (a share of a batch the run was computed in), 0 for a run of its own.
+    own clock started and ``batch_size`` the number of runs computed together with this one
+    (:mod:`visviva.simulation.ensemble`), 0 for a run of its own.
     """
 
     t_reached: float = float("nan")
@@ -258,6 +259,7 @@ class RunFigures:
     energy_change: float = 0.0
     emitters: dict[str, dict[str, int]] = field(default_factory=dict)
     wall_time_s: float = 0.0
+    batch_size: int = 0
 
     def see(self, t: float, energy: Any) -> None:
         self.t_reached = t
@@ -312,7 +314,9 @@ def recording_attrs(model: Model, seconds: float) -> dict[str, Any]:
     } | model.recording_attrs()
 
 
-def final_attrs(run: RunFigures, failure: VisvivaError | None, wall_time_s: float) -> dict[str, Any]:
+def final_attrs(
+    run: RunFigures, failure: VisvivaError | None, wall_time_s: float
+) -> dict[str, Any]:
     """The attributes a scene run's recording ends with: work, time and outcome."""
     from .simulation.interrupt import Interrupted
 
@@ -410,6 +414,8 @@ def _summary(
     }
     if isinstance(failure, Interrupted):
         summary["interrupted"] = failure.signal
+    if run.batch_size:
+        summary["batch_size"] = run.batch_size
     if run.emitters:
         summary["emitters"] = run.emitters
     for name, counts in run.emitters.items():

@@ -9,12 +9,14 @@ through the one loop (:func:`~visviva.simulation.loop.advance`): one evaluation 
 per stage for the whole batch instead of one per member, and no process per member.
 
 Each member computes exactly what its own run (:class:`~visviva.simulation.Simulation` of its
-model) computes, bit for bit: the same method, step schedule, recorded frames and energy, with
-the batch's row ``i`` evaluated by member ``i``'s function. The divergence watch uses the
-smallest of the members' limits; a member that fails (diverges, or takes the batch down with a
-failure that names no member) is taken out of the batch, which goes on from its last good state
-without it, and is reported so that the caller runs it alone, where it fails exactly as it
-would have (with its own limit and message).
+model) computes, bit for bit: the same explicit or symplectic method, step schedule, recorded
+frames and energy, with the batch's row ``i`` evaluated by member ``i``'s function. (Implicit
+methods do not batch: their Newton iterations would run until every member converged.)
+
+The divergence watch uses the smallest of the members' limits; a member that fails (diverges,
+or takes the batch down with a failure that names no member) is taken out of the batch, which
+goes on from its last good state without it, and is reported so that the caller runs it alone,
+where it fails exactly as it would have (with its own limit and message).
 """
 
 from __future__ import annotations
@@ -46,9 +48,13 @@ MemberFrame = Callable[[int, State, "float | None"], None]
 
 def ensemble_key(model: Model) -> Hashable | None:
     """What models must share to advance in one batch, or ``None`` if ``model`` cannot join
-    one: it holds anything but a single named system, or that system's problem cannot be
-    stacked. The key compares equal only within one process (it holds the functions)."""
+    one: it holds anything but a single named system, that system's problem cannot be stacked,
+    or its method is implicit (Newton's iterations run until every member of a batch has
+    converged, so a member would take other iterations than alone). The key compares equal
+    only within one process (it holds the functions)."""
     if model.particle_count or model.body_count or model.stages or len(model.systems) != 1:
+        return None
+    if get(model.integration.method).implicit:
         return None
     equations = equations_key(model.systems[0].problem)
     if equations is None:
@@ -139,7 +145,7 @@ def run_ensemble(
             # limit would have let through runs alone, where its own limit applies.
             limit = min(DivergenceWatch.default_limit(starts[m]) for m in members)
             watch = DivergenceWatch(system, integrator, settings.dt, state, limit)
-            stepper = Stepper(system, integrator, watch)
+            stepper = _Rewinding(system, integrator, watch)
             piece = Schedule.build(origin, until, settings.dt, settings.substeps, done)
             try:
                 advance(stepper, state, piece, settings.record_every, recorder, bar)
@@ -156,6 +162,23 @@ def run_ensemble(
     result.counters = system.counters.as_dict()
     result.wall_time_s = time.perf_counter() - started
     return result
+
+
+class _Rewinding(Stepper):
+    """A stepper whose failed step leaves no work in the counters: the batch takes that step
+    again without the member that failed it, and each member counts what it counts alone."""
+
+    def step(
+        self, state: State, h: float, t_after: float, index: int, boundary: bool = True
+    ) -> State:
+        counters = self.system.counters
+        before = counters.as_dict()
+        try:
+            return super().step(state, h, t_after, index, boundary)
+        except SimulationError:
+            for name, value in before.items():
+                setattr(counters, name, value)
+            raise
 
 
 def _failed_rows(failure: SimulationError, count: int) -> list[int]:

@@ -144,7 +144,7 @@ def run_batch(task: BatchTask) -> list[dict[str, Any]]:
                 if run.index in failed:
                     alone.append(run)
                 else:
-                    rows[run.index] = _write_member(run, model, figure, frames, len(members))
+                    rows[run.index] = _write_member(run, model, figure, frames)
         except (Interrupted, KeyboardInterrupt) as stop:
             name = stop.signal if isinstance(stop, Interrupted) else stops.requested or "SIGINT"
             return [rows.get(run.index) or _interrupted(run, name) for run in task.runs]
@@ -182,6 +182,7 @@ def _advance_together(
     for figure, _ in figures:
         figure.counters = dict(counters)
         figure.wall_time_s = share
+        figure.batch_size = len(members)
     failed = {members[i][0].index for i in result.failed}
     return figures, failed
 
@@ -199,7 +200,7 @@ class _Frames:
 
 
 def _write_member(
-    run: RunTask, model: Model, figure: RunFigures, frames: list[Any] | None, size: int
+    run: RunTask, model: Model, figure: RunFigures, frames: list[Any] | None
 ) -> dict[str, Any]:
     """Write a batch member's files, as its own run would have, and conclude it."""
     from ..io.writer import RecordingWriter
@@ -237,7 +238,7 @@ def _write_member(
         return _conclude(run, summary, str(failure))
     if not run.keep_recording:
         (Path(run.directory) / "recording.h5").unlink(missing_ok=True)
-    return _conclude(run, report.summary | {"batch_size": size}, None)
+    return _conclude(run, report.summary, None)
 
 
 def _clear(task: RunTask) -> None:
