@@ -8,8 +8,10 @@ others go on. With ``resume``, a run whose directory holds ``run.json`` for the 
 digest and values, and a ``summary.json`` that was not interrupted, is not run again (a diverged
 run counts as finished: the same scene diverges the same way). On Ctrl-C the runs under way stop
 (their directories are removed), no new run starts, and the finished ones are kept and listed in
-the results. ``results.csv`` and ``results.json`` (:mod:`.results`) are written at the end,
-atomically, also after an interrupt.
+the results; on another executor (a Dask cluster) the runs not started are cancelled and those
+under way are left to finish there. A run done by another executor must leave its files where
+this process sees them (:mod:`.shared_files`). ``results.csv`` and ``results.json``
+(:mod:`.results`) are written at the end, atomically, also after an interrupt.
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ from ..simulation.progress import Progress
 from .description import Sweep, load_sweep
 from .design import SweepRun, expand
 from .results import flatten_summary, write_results
+from .shared_files import SharedFiles
 
 __all__ = ["RunTask", "SweepInterrupted", "SweepResult", "run_task", "sweep"]
 
@@ -192,9 +195,12 @@ def sweep(
     Args:
         description: A sweep file (``.toml``/``.json``) or a loaded :class:`Sweep`.
         directory: Output directory (created if missing).
-        executor: Where the runs go: any :class:`concurrent.futures.Executor` (a Dask client's
-            ``get_executor()``, say), ``"serial"`` for one after the other in this process, or
-            ``None`` for a process pool of ``workers`` processes.
+        executor: Where the runs go: any :class:`concurrent.futures.Executor` (a Dask
+            cluster's: :func:`~visviva.sweeps.dask_executor`, or a client's
+            ``get_executor()``), ``"serial"`` for one after the other in this process, or
+            ``None`` for a process pool of ``workers`` processes. The runs of another
+            executor than the pool must write where this process can read: on a cluster,
+            ``directory`` must be on a file system the workers share.
         workers: Processes of the default pool (default: every core).
         resume: Skip runs already finished in ``directory`` with the same scene.
         progress: Progress bar over runs (default: when stderr is a terminal).
@@ -223,8 +229,11 @@ def sweep(
     (root / "runs").mkdir(parents=True, exist_ok=True)
     rows: dict[int, dict[str, Any]] = {}
     pending = []
+    # Only directories listed here are read: a failed look-up of a run not yet done could be
+    # cached by a network file system and hide that run's files when a worker writes them.
+    present = set(os.listdir(root / "runs")) if resume else set()
     for run in runs:
-        found = _finished(root / "runs" / run.name, run) if resume else None
+        found = _finished(root / "runs" / run.name, run) if run.name in present else None
         if found is not None:
             rows[run.index] = found
         else:
@@ -308,23 +317,44 @@ def _execute(
         if executor is None
         else executor
     )
-    futures = {pool.submit(run_task, task): task for task in tasks}
+    # Another executor's workers may be other machines: each run's files must be seen here.
+    shared = None if own else SharedFiles(collect, RUN_FILE)
+    futures: dict[Future[dict[str, Any]], RunTask] = {}
     seen: set[Future[dict[str, Any]]] = set()
+    complete = False
+
+    def take(future: Future[dict[str, Any]]) -> bool:
+        task = futures[future]
+        row = _outcome(future, task)
+        if shared is None or future.exception() is not None:  # a lost worker wrote no files
+            return collect(row)
+        return shared(row, task.directory)
+
     try:
         try:
+            for task in tasks:  # submitted inside the try: a Ctrl-C here cancels them too
+                futures[pool.submit(run_task, task)] = task
             for future in as_completed(futures):
                 seen.add(future)
-                if not collect(_outcome(future, futures[future])):
+                if not take(future):
                     break
+            else:
+                complete = True
         finally:
-            # After a stop (an interrupted row, or Ctrl-C here): cancel the runs not started,
-            # wait for those under way (the signal stops them too), keep what finished.
+            # After a stop (an interrupted row, or Ctrl-C here): cancel the runs not started
+            # and keep what finished. The runs under way on the own pool got the signal too
+            # and stop within a step: wait for them. Elsewhere (a cluster) they may be far
+            # from done, so do not: they finish on their own, and a later sweep resumes.
             for future in futures:
                 future.cancel()
-            running = [f for f in futures if f not in seen and not f.cancelled()]
-            wait(running)
-            for future in running:
-                collect(_outcome(future, futures[future]))
+            rest = [f for f in futures if f not in seen and not f.cancelled()]
+            if own:
+                wait(rest)
+            for future in rest:
+                if future.done():
+                    take(future)
+            if shared is not None:
+                shared.settle(wait=complete)
     finally:
         if own:
             pool.shutdown(wait=True, cancel_futures=True)
