@@ -304,3 +304,30 @@ def test_a_run_whose_files_this_machine_cannot_see_is_recorded_as_failed(
     # The next sweep runs again only the run whose files never arrived.
     again = vv.sweep(path, out, executor=executor)
     assert (again.ran, again.skipped, again.failed) == (1, 5, 0)
+
+
+class Cancelling(Executor):
+    """Runs each task at once, but cancels run ``cancelled`` before it starts (as Dask does
+    with the runs of a client that lost its scheduler)."""
+
+    def __init__(self, cancelled: int) -> None:
+        self.cancelled = cancelled
+
+    def submit(self, fn, /, task, **kwargs):  # type: ignore[override]
+        future: Future = Future()
+        if task.index == self.cancelled:
+            future.cancel()
+            future.set_running_or_notify_cancel()
+        else:
+            future.set_result(fn(task))
+        return future
+
+
+def test_a_run_the_executor_cancels_is_recorded_as_failed_and_runs_on_resume(tmp_path):
+    path = write(tmp_path, spring_sweep(TWO_RUNS))
+    out = tmp_path / "out"
+    result = vv.sweep(path, out, executor=Cancelling(cancelled=0))
+    assert (result.ran, result.failed) == (2, 1)
+    assert result.rows[0]["error"].startswith("the executor cancelled the run before it finished")
+    assert result.rows[1]["success"]
+    assert vv.sweep(path, out, executor="serial").ran == 1

@@ -23,7 +23,14 @@ import os
 import shutil
 import signal
 from collections.abc import Callable
-from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed, wait
+from concurrent.futures import (
+    CancelledError,
+    Executor,
+    Future,
+    ProcessPoolExecutor,
+    as_completed,
+    wait,
+)
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
@@ -326,8 +333,8 @@ def _execute(
     def take(future: Future[dict[str, Any]]) -> bool:
         task = futures[future]
         row = _outcome(future, task)
-        if shared is None or future.exception() is not None:  # a lost worker wrote no files
-            return collect(row)
+        if shared is None or future.cancelled() or future.exception() is not None:
+            return collect(row)  # a run that did not come back wrote no files to look for
         return shared(row, task.directory)
 
     try:
@@ -361,17 +368,15 @@ def _execute(
 
 
 def _outcome(future: Future[dict[str, Any]], task: RunTask) -> dict[str, Any]:
-    """The row of a finished future; a worker that died is the run's error."""
+    """The row of a finished future; a worker that died, or a run the executor cancelled (a
+    cluster that lost its scheduler), is the run's error."""
     try:
         return future.result()
+    except CancelledError:
+        error = "the executor cancelled the run before it finished; run the sweep again"
     except Exception as failure:  # a broken worker fails its run only
-        return {
-            "index": task.index,
-            "run": task.name,
-            **task.values,
-            "success": False,
-            "error": f"{type(failure).__name__}: {failure}",
-        }
+        error = f"{type(failure).__name__}: {failure}"
+    return {"index": task.index, "run": task.name, **task.values, "success": False, "error": error}
 
 
 def _worker_context() -> multiprocessing.context.BaseContext:
