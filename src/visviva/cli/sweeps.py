@@ -15,11 +15,27 @@ def sweep_command(
     description: Annotated[Path, typer.Argument(help="Sweep file (.toml or .json).")],
     output: Annotated[Path, typer.Option("--output", "-o", help="Output directory.")] = Path("out"),
     workers: Annotated[
-        int | None, typer.Option("--workers", help="Processes of the pool (default: all cores).")
+        int | None,
+        typer.Option(
+            "--workers", help="Processes of the pool or of the --dask cluster (default: all cores)."
+        ),
     ] = None,
     serial: Annotated[
         bool, typer.Option("--serial", help="Run one after the other in this process.")
     ] = False,
+    dask: Annotated[
+        bool,
+        typer.Option("--dask", help="Run on a Dask LocalCluster started on this machine."),
+    ] = False,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            "--scheduler",
+            metavar="ADDRESS",
+            help="Run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); "
+            "DIR must be on a file system its workers share.",
+        ),
+    ] = None,
     no_resume: Annotated[
         bool, typer.Option("--no-resume", help="Run again the runs already finished in DIR.")
     ] = False,
@@ -34,10 +50,17 @@ def sweep_command(
 ) -> None:
     """Run a sweep: every run into DIR/runs/, the table into DIR/results.csv and results.json."""
     from ..errors import ModelError
-    from ..sweeps import expand, load_sweep, sweep
+    from ..sweeps import dask_executor, expand, load_sweep, sweep
 
-    if serial and workers is not None:
-        raise ModelError("--serial runs in this process; drop --workers (or --serial)")
+    on_dask = dask or scheduler is not None
+    if serial and (workers is not None or on_dask):
+        other = "--workers" if workers is not None else "--scheduler" if scheduler else "--dask"
+        raise ModelError(f"--serial runs in this process; drop {other} (or --serial)")
+    if scheduler is not None and workers is not None:
+        raise ModelError(
+            "--workers sizes the pool or the --dask cluster; the cluster at --scheduler has its "
+            "own workers: drop --workers"
+        )
     chosen = load_sweep(description)
     if dry_run:
         runs = expand(chosen)
@@ -51,14 +74,22 @@ def sweep_command(
         for run in runs:
             typer.echo("\t".join([str(run.index), *(_shown(run.values[p]) for p in paths)]))
         return
-    result = sweep(
-        chosen,
-        output,
-        executor="serial" if serial else None,
-        workers=workers,
-        resume=not no_resume,
-        batch=not no_batch,
-    )
+    if on_dask:
+        # Connected (or started) before the sweep begins: a scheduler that does not answer
+        # is reported before anything is written.
+        with dask_executor(scheduler, workers=workers) as executor:
+            result = sweep(
+                chosen, output, executor=executor, resume=not no_resume, batch=not no_batch
+            )
+    else:
+        result = sweep(
+            chosen,
+            output,
+            executor="serial" if serial else None,
+            workers=workers,
+            resume=not no_resume,
+            batch=not no_batch,
+        )
     _print_result(result)
 
 

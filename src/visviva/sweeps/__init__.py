@@ -4,11 +4,13 @@ A sweep file names a base scene, the parameters to vary and how (grid, zip or ra
 :mod:`.description`, :mod:`.design`); :func:`sweep` runs every run through
 :func:`~visviva.scenes.run_scene` on a process pool, in this process, or on any
 :class:`concurrent.futures.Executor` — runs that share their equations advance together in
-batches (:mod:`.tasks`) — resumes where an interrupted sweep stopped, and writes a
-results table (:mod:`.results`). A front layer like :mod:`visviva.scenes`: the physics packages
-never import it.
+batches (:mod:`.tasks`) — resumes where an interrupted sweep stopped, and writes a results table
+(:mod:`.results`). :func:`dask_executor` (:mod:`.cluster`) gives an executor on a Dask cluster,
+local or at an address. A front layer like :mod:`visviva.scenes`: the physics packages never
+import it.
 """
 
+from .cluster import dask_executor
 from .description import Outputs, Parameter, Sweep, SweepInfo, load_sweep, parse_sweep
 from .design import SweepRun, expand, run_values
 from .runner import SweepInterrupted, SweepResult, sweep
@@ -24,6 +26,7 @@ __all__ = [
     "SweepInterrupted",
     "SweepResult",
     "SweepRun",
+    "dask_executor",
     "expand",
     "load_sweep",
     "parse_sweep",

@@ -11,8 +11,10 @@ with its error and the others go on. With ``resume``, a run whose directory hold
 for the same scene digest and values, and a ``summary.json`` that was not interrupted, is not run
 again (a diverged run counts as finished: the same scene diverges the same way). On Ctrl-C the
 runs under way stop (their directories are removed), no new run starts, and the finished ones
-are kept and listed in the results. ``results.csv`` and ``results.json`` (:mod:`.results`) are
-written at the end, atomically, also after an interrupt.
+are kept and listed in the results; on another executor (a Dask cluster) the runs not started
+are cancelled and those under way are left to finish there. A run done by another executor
+must leave its files where this process sees them (:mod:`.shared_files`). ``results.csv`` and
+``results.json`` (:mod:`.results`) are written at the end, atomically, also after an interrupt.
 """
 
 from __future__ import annotations
@@ -22,7 +24,14 @@ import multiprocessing
 import multiprocessing.context
 import os
 from collections.abc import Callable
-from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed, wait
+from concurrent.futures import (
+    CancelledError,
+    Executor,
+    Future,
+    ProcessPoolExecutor,
+    as_completed,
+    wait,
+)
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -35,7 +44,8 @@ from ..simulation.progress import Progress
 from .description import Sweep, load_sweep
 from .design import SweepRun, expand
 from .results import write_results
-from .tasks import BatchTask, RunTask, finished_row, perform, start_worker
+from .shared_files import SharedFiles
+from .tasks import RUN_FILE, BatchTask, RunTask, finished_row, perform, start_worker
 
 __all__ = ["SweepInterrupted", "SweepResult", "sweep"]
 
@@ -103,9 +113,12 @@ def sweep(
     Args:
         description: A sweep file (``.toml``/``.json``) or a loaded :class:`Sweep`.
         directory: Output directory (created if missing).
-        executor: Where the runs go: any :class:`concurrent.futures.Executor` (a Dask client's
-            ``get_executor()``, say), ``"serial"`` for one after the other in this process, or
-            ``None`` for a process pool of ``workers`` processes.
+        executor: Where the runs go: any :class:`concurrent.futures.Executor` (a Dask
+            cluster's: :func:`~visviva.sweeps.dask_executor`, or a client's
+            ``get_executor()``), ``"serial"`` for one after the other in this process, or
+            ``None`` for a process pool of ``workers`` processes. The runs of another
+            executor than the pool must write where this process can read: on a cluster,
+            ``directory`` must be on a file system the workers share.
         workers: Processes of the default pool (default: every core).
         resume: Skip runs already finished in ``directory`` with the same scene.
         batch: Advance runs that share their equations (one named system, only the start
@@ -137,9 +150,16 @@ def sweep(
     (root / "runs").mkdir(parents=True, exist_ok=True)
     rows: dict[int, dict[str, Any]] = {}
     pending: list[tuple[SweepRun, RunTask]] = []
+    # Only directories listed here are read: a failed look-up of a run not yet done could be
+    # cached by a network file system and hide that run's files when a worker writes them.
+    present = set(os.listdir(root / "runs")) if resume else set()
     for run in runs:
         task = _task(chosen, root, run)
-        found = finished_row(Path(task.directory), run.digest, run.values) if resume else None
+        found = (
+            finished_row(Path(task.directory), run.digest, run.values)
+            if run.name in present
+            else None
+        )
         if found is not None:
             rows[run.index] = found
         else:
@@ -248,23 +268,48 @@ def _execute(
         if executor is None
         else executor
     )
-    futures = {pool.submit(perform, task): task for task in tasks}
+    # Another executor's workers may be other machines: each run's files must be seen here.
+    shared = None if own else SharedFiles(lambda row: collect([row]), RUN_FILE)
+    futures: dict[Future[list[dict[str, Any]]], RunTask | BatchTask] = {}
     seen: set[Future[list[dict[str, Any]]]] = set()
+    complete = False
+
+    def take(future: Future[list[dict[str, Any]]]) -> bool:
+        task = futures[future]
+        done = _outcome(future, task)
+        if shared is None or future.cancelled() or future.exception() is not None:
+            return collect(done)  # a task that did not come back wrote no files to look for
+        directories = {run.index: run.directory for run in _runs(task)}
+        go_on = True
+        for row in done:
+            go_on = shared(row, directories[row["index"]]) and go_on
+        return go_on
+
     try:
         try:
+            for task in tasks:  # submitted inside the try: a Ctrl-C here cancels them too
+                futures[pool.submit(perform, task)] = task
             for future in as_completed(futures):
                 seen.add(future)
-                if not collect(_outcome(future, futures[future])):
+                if not take(future):
                     break
+            else:
+                complete = True
         finally:
-            # After a stop (an interrupted row, or Ctrl-C here): cancel the runs not started,
-            # wait for those under way (the signal stops them too), keep what finished.
+            # After a stop (an interrupted row, or Ctrl-C here): cancel the runs not started
+            # and keep what finished. The runs under way on the own pool got the signal too
+            # and stop within a step: wait for them. Elsewhere (a cluster) they may be far
+            # from done, so do not: they finish on their own, and a later sweep resumes.
             for future in futures:
                 future.cancel()
-            running = [f for f in futures if f not in seen and not f.cancelled()]
-            wait(running)
-            for future in running:
-                collect(_outcome(future, futures[future]))
+            rest = [f for f in futures if f not in seen and not f.cancelled()]
+            if own:
+                wait(rest)
+            for future in rest:
+                if future.done():
+                    take(future)
+            if shared is not None:
+                shared.settle(wait=complete)
     finally:
         if own:
             pool.shutdown(wait=True, cancel_futures=True)
@@ -273,16 +318,22 @@ def _execute(
 def _outcome(
     future: Future[list[dict[str, Any]]], task: RunTask | BatchTask
 ) -> list[dict[str, Any]]:
-    """The rows of a finished future; a worker that died is the error of its task's runs."""
+    """The rows of a finished future; a worker that died, or a task the executor cancelled (a
+    cluster that lost its scheduler), is the error of its task's runs."""
     try:
         return future.result()
+    except CancelledError:
+        error = "the executor cancelled the run before it finished; run the sweep again"
     except Exception as failure:  # a broken worker fails its task's runs only
-        runs = task.runs if isinstance(task, BatchTask) else (task,)
         error = f"{type(failure).__name__}: {failure}"
-        return [
-            {"index": run.index, "run": run.name, **run.values, "success": False, "error": error}
-            for run in runs
-        ]
+    return [
+        {"index": run.index, "run": run.name, **run.values, "success": False, "error": error}
+        for run in _runs(task)
+    ]
+
+
+def _runs(task: RunTask | BatchTask) -> tuple[RunTask, ...]:
+    return task.runs if isinstance(task, BatchTask) else (task,)
 
 
 def _worker_context() -> multiprocessing.context.BaseContext:
