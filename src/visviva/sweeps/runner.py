@@ -9,7 +9,8 @@ digest and values, and a ``summary.json`` that was not interrupted, is not run a
 run counts as finished: the same scene diverges the same way). On Ctrl-C the runs under way stop
 (their directories are removed), no new run starts, and the finished ones are kept and listed in
 the results. ``results.csv`` and ``results.json`` (:mod:`.results`) are written at the end,
-atomically, also after an interrupt.
+atomically, also after an interrupt, and then ``results.h5``, the plots and ``index.html``
+(:mod:`.reports`).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from ..simulation.interrupt import Interrupted
 from ..simulation.progress import Progress
 from .description import Sweep, load_sweep
 from .design import SweepRun, expand
+from .reports import write_reports
 from .results import flatten_summary, write_results
 
 __all__ = ["RunTask", "SweepInterrupted", "SweepResult", "run_task", "sweep"]
@@ -85,7 +87,9 @@ class SweepResult:
         ran: Runs done by this call.
         skipped: Runs found finished and not run again.
         failed: Rows with ``success`` false (done now or before).
-        files: ``results.csv`` and ``results.json``.
+        files: ``results.csv`` and ``results.json``, then ``results.h5``, the plots' files and
+            ``index.html``.
+        warnings: The files that could not be written besides the table, each with its reason.
     """
 
     directory: Path
@@ -93,7 +97,8 @@ class SweepResult:
     ran: int
     skipped: int
     failed: int
-    files: tuple[Path, Path]
+    files: tuple[Path, ...]
+    warnings: tuple[str, ...] = ()
 
 
 class SweepInterrupted(Interrupted):
@@ -255,13 +260,15 @@ def sweep(
         "runs_total": len(runs),
     }
     files = write_results(root, heading, chosen.paths, ordered)
+    reports = write_reports(root, chosen, heading, ordered)
     result = SweepResult(
         directory=root,
         rows=ordered,
         ran=len(rows) - skipped,
         skipped=skipped,
         failed=sum(1 for row in ordered if not row["success"]),
-        files=files,
+        files=(*files, *reports.files),
+        warnings=reports.warnings,
     )
     if stopped is not None:
         raise SweepInterrupted(stopped, result, len(runs))
