@@ -16,7 +16,7 @@ from __future__ import annotations
 import csv
 import json
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -81,10 +81,12 @@ def write_reports(
     labels = _Labels(sweep)
     for plot in sweep.plots:
         assert plot.name is not None  # named by load_sweep
-        try:
-            files += write_plot(directory / "plots", plot, rows, labels)
+        try:  # one figure must not cost the others, or the index
+            points = reduce_plot(plot, rows)
+            files.append(_write_table(directory / "plots", points))
+            files += _write_figure(directory / "plots", points, labels)
             drawn.append((plot.name, _title(plot)))
-        except Exception as failure:  # one figure must not cost the others, or the index
+        except Exception as failure:
             warnings.append(f"plot {plot.name!r} was not drawn: {_reason(failure)}")
     try:
         files.append(write_index(directory, heading, sweep.paths, rows, drawn, warnings))
@@ -141,7 +143,10 @@ class _Labels:
 
 
 def write_plot(
-    folder: Path, plot: Plot, rows: Sequence[Mapping[str, Any]], label: Any = str
+    folder: Path,
+    plot: Plot,
+    rows: Sequence[Mapping[str, Any]],
+    label: Callable[[str], str] = str,
 ) -> tuple[Path, ...]:
     """Write ``plot``'s table (``<name>.csv``) and figure (``<name>.png``, ``.svg``) into
     ``folder``; return their paths.
@@ -153,6 +158,12 @@ def write_plot(
         label: Gives an axis label (with its unit) for a column name.
     """
     points = reduce_plot(plot, rows)
+    return (_write_table(folder, points), *_write_figure(folder, points, label))
+
+
+def _write_table(folder: Path, points: PlotPoints) -> Path:
+    """``<name>.csv``: x, the series value (with a series), y and the runs behind each point."""
+    plot = points.plot
     folder.mkdir(parents=True, exist_ok=True)
     table = folder / f"{plot.name}.csv"
     with atomic_path(table) as temporary, temporary.open("w", newline="") as handle:
@@ -162,14 +173,21 @@ def write_plot(
         for point in points.points:
             chosen = [_csv(point.series)] if plot.series is not None else []
             writer.writerow([_csv(point.x), *chosen, repr(point.y), point.runs])
+    return table
+
+
+def _write_figure(
+    folder: Path, points: PlotPoints, label: Callable[[str], str]
+) -> tuple[Path, Path]:
+    """``<name>.png`` and ``<name>.svg``."""
     figure = _figure(points, label)
     images = []
     for suffix in (".png", ".svg"):
-        image = folder / f"{plot.name}{suffix}"
+        image = folder / f"{points.plot.name}{suffix}"
         with atomic_path(image) as temporary:
             figure.savefig(temporary, format=suffix[1:])
         images.append(image)
-    return (table, *images)
+    return images[0], images[1]
 
 
 def _csv(value: Any) -> str:
@@ -180,7 +198,7 @@ def _csv(value: Any) -> str:
     return shown(value)
 
 
-def _figure(points: PlotPoints, label: Any) -> Any:
+def _figure(points: PlotPoints, label: Callable[[str], str]) -> Any:
     """The figure of ``points``: one line per series value, points off a log axis left out."""
     from ..viz.sweep_plots import plot_against_parameter
 
