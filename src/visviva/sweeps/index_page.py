@@ -3,15 +3,17 @@
 The page is one self-contained file (its style and its few lines of script inline; no request
 leaves the directory, and it works from ``file://``): the sweep's name, description and counts,
 links to the tables, each plot (``plots/<name>.png``) with its table, and the table of runs: the
-values, the outcome, a few figures, the error of a failed run and links to the files the run
-wrote. Clicking a column's header sorts the runs by it. Every text that comes from the user
-(names, description, values, errors) is escaped; links are relative and percent-encoded.
+index (a link to the run's directory), the values, the outcome, a few figures, links to the
+files the run wrote and the error of a failed run. Clicking a column's header sorts the runs by
+it. Every text that comes from the user (names, description, values, errors) is escaped; links
+are relative and percent-encoded.
 """
 
 from __future__ import annotations
 
 import html
 import os
+import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -26,11 +28,13 @@ __all__ = ["MAX_LISTED_RUNS", "write_index"]
 MAX_LISTED_RUNS = 5000
 #: Figures of each run shown in the table, when some run has them.
 KEY_FIGURES = ("steps", "t_reached_s", "energy_drift", "max_energy_error", "wall_time_s")
+#: Characters of a failed run's error shown in the table.
+_ERROR_WIDTH = 160
 #: Files listed first among a run's outputs; the others follow by name.
 _FIRST = ("summary.json", "recording.h5")
 
 _STYLE = """
-body { font: 14px/1.45 system-ui, sans-serif; margin: 1.5em auto; max-width: 78em;
+body { font: 14px/1.45 system-ui, sans-serif; margin: 1.5em auto; max-width: 110em;
        padding: 0 1em; color: #1d2330; background: #fbfcfd; }
 h1 { margin-bottom: 0.2em; } .description { white-space: pre-wrap; max-width: 60em; }
 .counts { font-weight: 600; } .warning { color: #8a4b00; }
@@ -44,8 +48,9 @@ th { position: sticky; top: 0; background: #eef1f5; cursor: pointer; user-select
 th[aria-sort="ascending"]::after { content: " \\25B2"; }
 th[aria-sort="descending"]::after { content: " \\25BC"; }
 td.number { text-align: right; font-variant-numeric: tabular-nums; }
-tr.failed { background: #fdf0ef; } td.error { max-width: 32em; white-space: pre-wrap; }
-td.files a { margin-right: 0.5em; }
+tr.failed { background: #fdf0ef; } td.error { min-width: 28em; }
+.scroll { overflow-x: auto; }
+td.files { white-space: nowrap; } td.files a { margin-right: 0.5em; }
 """
 
 # Sorts the runs by the clicked column: numbers by value (each cell's data-value), other cells
@@ -176,7 +181,7 @@ def _runs_table(
 ) -> str:
     """The ``<h2>`` and ``<table>`` of the runs (the first :data:`MAX_LISTED_RUNS`)."""
     figures = [f for f in KEY_FIGURES if any(row.get(f) is not None for row in rows)]
-    headers = ["index", "run", *parameters, "success", *figures, "error", "files"]
+    headers = ["index", *parameters, "success", *figures, "files", "error"]
     listed = rows[:MAX_LISTED_RUNS]
     more = (
         f" (the first {len(listed)} of {len(rows)}; all are in results.csv)"
@@ -185,23 +190,32 @@ def _runs_table(
     )
     parts = [
         f"<h2>Runs{more}</h2>",
-        '<table id="runs"><thead><tr>',
+        '<div class="scroll"><table id="runs"><thead><tr>',
         *(f"<th>{_e(header)}</th>" for header in headers),
         "</tr></thead><tbody>",
     ]
     for row in listed:
-        run = str(row.get("run", ""))
-        links = " ".join(
-            f'<a href="{_href("runs", run, file)}">{_e(file)}</a>'
-            for file in _outputs(directory / "runs" / run)
+        run = str(row.get("run") or "")
+        files = _outputs(directory / "runs" / run) if run else []
+        links = " ".join(f'<a href="{_href("runs", run, file)}">{_e(file)}</a>' for file in files)
+        # The index links to the run's directory, and names it on hovering.
+        index = row.get("index")
+        number = (
+            f'<td class="number" data-value="{_e(index)}"><a href="{_href("runs", run)}/" '
+            f'title="{_e(run)}">{_e(index)}</a></td>'
+            if files
+            else _cell(index)
         )
-        error = row.get("error")
+        error = str(row.get("error") or "")
+        # The first sentence in the table (the advisor's advice can run to a paragraph); the
+        # whole message shows on hovering, and is in results.csv.
+        brief = textwrap.shorten(error.split(". ")[0], _ERROR_WIDTH, placeholder=" …")
         parts.append(
-            f'<tr class="{"ok" if row.get("success") else "failed"}">'
-            + "".join(_cell(row.get(h)) for h in ("index", "run", *parameters, "success"))
-            + "".join(_cell(row.get(f)) for f in figures)
-            + (f'<td class="error">{_e(error)}</td>' if error else "<td></td>")
-            + f'<td class="files">{links}</td></tr>'
+            f'<tr class="{"ok" if row.get("success") else "failed"}">{number}'
+            + "".join(_cell(row.get(h)) for h in (*parameters, "success", *figures))
+            + f'<td class="files">{links}</td>'
+            + (f'<td class="error" title="{_e(error)}">{_e(brief)}</td>' if error else "<td></td>")
+            + "</tr>"
         )
-    parts.append("</tbody></table>")
+    parts.append("</tbody></table></div>")
     return "\n".join(parts)
