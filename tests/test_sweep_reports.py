@@ -23,13 +23,15 @@ from urllib.parse import unquote, urlparse
 import h5py
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from PIL import Image
 from playwright.sync_api import sync_playwright
 
 import visviva as vv
 from test_sweeps import GRID, InlineExecutor, spring_sweep, write
 from test_viewer import CHROMIUM, CHROMIUM_FLAGS
-from visviva.errors import SweepError
+from visviva.errors import ModelError, SweepError
 from visviva.sweeps import SweepInterrupted, parse_sweep
 from visviva.sweeps.index_page import write_index
 from visviva.sweeps.plot_spec import Plot
@@ -208,6 +210,49 @@ log_x = true
         "max_stable_dt",
     ]
     assert sweep.plots[3].only == "success" and sweep.plots[3].log_x and not sweep.plots[3].log_y
+
+
+_columns = st.sampled_from(
+    ["integration.dt", "integration.method", "entities[pair].stiffness", "steps", "energy_drift",
+     "counts.particles", "method", "world.gravity", "integration.dt ", "", "x" * 600]
+)  # fmt: skip
+_anything = st.one_of(
+    st.none(), st.booleans(), st.integers(-(2**70), 2**70), st.floats(), st.text(max_size=8),
+    st.lists(st.integers(), max_size=2),
+)  # fmt: skip
+_plot = st.fixed_dictionaries(
+    {"x": _columns | _anything, "y": _columns | _anything},
+    optional={
+        "series": _columns | _anything,
+        "reduce": st.sampled_from(["max", "min", "mean", "median", "count", "sum"]) | _anything,
+        "only": st.sampled_from(["all", "success", "failed"]) | _anything,
+        "log_x": _anything, "log_y": _anything, "abs_y": _anything, "title": _anything,
+        "name": st.sampled_from(["a", "a", "b.c", "../x", "-x"]) | _anything,
+        "extra": _anything,
+    },
+)  # fmt: skip
+
+
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(plots=st.lists(_plot, max_size=3) | _anything)
+def test_hostile_plots_are_refused_or_reduced_without_a_traceback(plots):
+    document = tomllib.loads(plotted("")) | {"plots": plots}
+    try:
+        sweep = parse_sweep(json.dumps(document), "json")
+    except ModelError as error:
+        assert str(error).strip()
+        return
+    rows = [
+        {"index": i, "run": str(i), "success": i % 2 == 0, "integration.dt": 0.01 * (i + 1),
+         "integration.method": "rk4" if i < 2 else "euler", "entities[pair].stiffness": 10.0,
+         "steps": i, "energy_drift": [None, float("nan"), -1.0, "inf"][i]}
+        for i in range(4)
+    ]  # fmt: skip
+    names = [plot.name for plot in sweep.plots]
+    assert len(set(names)) == len(names)
+    for plot in sweep.plots:
+        found = reduce_plot(plot, rows)
+        assert sum(p.runs for p in found.points) + sum(found.left_out.values()) == 4
 
 
 # ---------------------------------------------------------------- reductions
@@ -547,16 +592,34 @@ def test_an_interrupted_sweep_still_writes_its_reports(tmp_path):
     text = spring_sweep(
         GRID + '[[plots]]\nx = "entities[pair].stiffness"\ny = "steps"\nseries = '
         '"integration.method"\n'
-    )
+    ).replace("duration = 0.5", "duration = 0.05")
     out = tmp_path / "out"
     with pytest.raises(SweepInterrupted) as caught:
         vv.sweep(write(tmp_path, text), out, executor=InlineExecutor(interrupt_at=3))
     assert len(caught.value.result.rows) == 3
     table = list(csv.reader((out / "plots" / "steps_vs_stiffness.csv").open()))
     assert table[0] == ["entities[pair].stiffness", "integration.method", "steps", "runs"]
-    assert len(table) == 4  # the three finished runs
+    assert table[1:] == [  # the three finished runs, by series then x; 0.05 s in steps of 0.01 s
+        ["10.0", "explicit_euler", "5.0", "1"],
+        ["100.0", "explicit_euler", "5.0", "1"],
+        ["10.0", "rk4", "5.0", "1"],
+    ]
     assert "3 of 6 runs (3 not finished)" in (out / "index.html").read_text()
     assert len(read_results_h5(out / "results.h5")[1]) == 3
+
+
+def test_the_command_prints_the_files_and_the_warnings(stability, capsys):
+    from dataclasses import replace
+
+    from visviva.cli.sweeps import _print_result
+
+    _print_result(replace(stability, warnings=("plot 'p' was not drawn: RuntimeError: x",)))
+    out, err = capsys.readouterr()
+    assert out.splitlines()[-1] == (
+        "wrote results.csv, results.json, results.h5, index.html and 1 plot in plots/ into "
+        f"{stability.directory}/"
+    )
+    assert err == "warning: plot 'p' was not drawn: RuntimeError: x\n"
 
 
 def test_importing_visviva_and_its_sweeps_loads_no_matplotlib():
