@@ -190,7 +190,7 @@ y = "max_energy_error"
 reduce = "max"
 only = "all"
 [[plots]]
-x = "integration.dt"
+x = "integration. dt"
 y = "counts.particles"
 reduce = "mean"
 [[plots]]
@@ -210,6 +210,7 @@ log_x = true
         "max_stable_dt",
     ]
     assert sweep.plots[3].only == "success" and sweep.plots[3].log_x and not sweep.plots[3].log_y
+    assert sweep.plots[2].x == "integration.dt"  # as the table's column is named
 
 
 _columns = st.sampled_from(

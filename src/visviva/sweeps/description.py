@@ -298,7 +298,7 @@ def parse_sweep(text: str, format: str = "toml", source: str | None = None) -> S
         outputs=description.outputs,
         base=base.model_dump(mode="python", exclude_none=True),
         source=source,
-        plots=named(description.plots),
+        plots=named(description.plots, [p.path for p in description.parameters]),
     )
 
 

@@ -7,7 +7,7 @@ runs sharing an x and a series into one point. :func:`plot_problems` checks the 
 the sweep's parameters when the file is loaded (the runs have not run yet, so a figure is known
 by name: the fixed figures of every run's ``summary.json``, or a nested one such as
 ``counts.particles`` whose presence is only known afterwards); :func:`named` gives each plot its
-file name. Drawing is :mod:`.reports`' work.
+file name and its paths as the table's columns. Drawing is :mod:`.reports`' work.
 """
 
 from __future__ import annotations
@@ -199,12 +199,20 @@ def _axis_problem(key: str, log: bool, values: list[object] | None) -> str | Non
     return None
 
 
-def named(plots: Sequence[Plot]) -> tuple[Plot, ...]:
-    """The plots with a ``name`` each: the given one, else ``<reduce>_<y>_vs_<x>`` from the
-    paths' last fields (``max_dt_vs_stiffness``), with ``-2``, ``-3``... where names repeat."""
+def named(plots: Sequence[Plot], paths: Sequence[str]) -> tuple[Plot, ...]:
+    """The plots ready to draw: ``x``, ``series`` and a parameter ``y`` written as the sweep's
+    parameter path (the table's column: ``integration. dt`` → ``integration.dt``), and a
+    ``name`` each: the given one, else ``<reduce>_<y>_vs_<x>`` from the paths' last fields
+    (``max_dt_vs_stiffness``), with ``-2``, ``-3``... where names repeat."""
     taken = {plot.name for plot in plots if plot.name is not None}
     result = []
     for plot in plots:
+        update: dict[str, str] = {}
+        for key in ("x", "series", "y"):
+            path = getattr(plot, key)
+            position = None if path is None else _find(path, paths)
+            if position is not None:
+                update[key] = paths[position]
         if plot.name is None:
             stem = "_".join(
                 part
@@ -217,8 +225,8 @@ def named(plots: Sequence[Plot]) -> tuple[Plot, ...]:
                 number += 1
                 name = f"{stem}-{number}"
             taken.add(name)
-            plot = plot.model_copy(update={"name": name})
-        result.append(plot)
+            update["name"] = name
+        result.append(plot.model_copy(update=update))
     return tuple(result)
 
 

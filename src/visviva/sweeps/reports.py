@@ -26,6 +26,7 @@ from pydantic import BaseModel
 from ..io.files import atomic_path
 from ..io.job import plain_json
 from ..model.scene import Scene, System
+from ..model.systems import SYSTEMS
 from .description import Sweep
 from .index_page import write_index
 from .plot_spec import FIGURES, Plot
@@ -130,8 +131,6 @@ class _Labels:
                 found = _UNIT.search(described)
                 unit = found.group(1).strip() if found else None
                 if isinstance(node, System) and key == "parameters":
-                    from ..model.systems import SYSTEMS
-
                     table = SYSTEMS[node.system].parameters
                     return table[str(keys[-1])].unit if str(keys[-1]) in table else None
                 node = getattr(node, key)
