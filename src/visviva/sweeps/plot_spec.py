@@ -117,64 +117,81 @@ def plot_problems(
         design: The sweep's design (``grid``, ``zip`` or ``random``).
     """
     problems: list[tuple[int, str, str]] = []
-    listed = ", ".join(paths)
     explicit = [plot.name for plot in plots if plot.name is not None]
     for index, plot in enumerate(plots):
+        found = _one_plot(plot, paths, values, counts, design)
+        if plot.name is not None and explicit.count(plot.name) > 1:
+            found.append(
+                ("name", f"the name {plot.name!r} is given to several plots; give each its own")
+            )
+        problems += [(index, key, message) for key, message in found]
+    return problems
 
-        def problem(key: str, message: str, index: int = index) -> None:
-            problems.append((index, key, message))
 
-        found: dict[str, int] = {}
-        for key in ("x", "series"):
-            path = getattr(plot, key)
-            if path is None:
-                continue
-            position = _find(path, paths)
-            if position is None:
-                problem(
+def _one_plot(
+    plot: Plot,
+    paths: Sequence[str],
+    values: Sequence[list[object] | None],
+    counts: Sequence[int | None],
+    design: str,
+) -> list[tuple[str, str]]:
+    """The problems of one plot as ``(key, message)`` (see :func:`plot_problems`)."""
+    problems: list[tuple[str, str]] = []
+    listed = ", ".join(paths)
+    found: dict[str, int] = {}
+    for key in ("x", "series"):
+        path = getattr(plot, key)
+        position = None if path is None else _find(path, paths)
+        if position is not None:
+            found[key] = position
+        elif path is not None:
+            problems.append(
+                (
                     key,
                     f"`{key}` must be one of the sweep's parameter paths (got {path!r})."
                     f"{did_you_mean(path, paths)} Parameters: {listed}",
                 )
-            else:
-                found[key] = position
-        if "x" in found and found.get("series") == found["x"]:
-            problem("series", "`series` and `x` are the same parameter; choose another series")
-        y = _find(plot.y, paths)
-        if y is not None:
-            found["y"] = y
-        elif plot.y in _TEXT_COLUMNS:
-            problem(
+            )
+    if "x" in found and found.get("series") == found["x"]:
+        problems.append(("series", "`series` and `x` are the same parameter; choose another"))
+    y = _find(plot.y, paths)
+    if y is not None:
+        found["y"] = y
+    elif plot.y in _TEXT_COLUMNS:
+        problems.append(
+            (
                 "y",
                 f"`y` is drawn as a number, and {plot.y!r} is a text; give it as `series` "
                 "to draw one line per value",
             )
-        elif plot.y not in FIGURES and not plot.y.startswith(NESTED_FIGURES):
-            options = [*FIGURES, *paths]
-            problem(
+        )
+    elif plot.y not in FIGURES and not plot.y.startswith(NESTED_FIGURES):
+        problems.append(
+            (
                 "y",
                 f"`y` must be a figure of the results or a parameter path (got {plot.y!r})."
-                f"{did_you_mean(plot.y, options)} Figures: {', '.join(FIGURES)}, "
+                f"{did_you_mean(plot.y, [*FIGURES, *paths])} Figures: {', '.join(FIGURES)}, "
                 f"counts.<what>; parameters: {listed}",
             )
-        for key, log in (("x", plot.log_x), ("y", plot.log_y)):
-            if key in found and (message := _axis_problem(key, log, values[found[key]])):
-                problem(key, message)
-        if plot.reduce is None and design == "grid" and "x" in found:
-            shared = [
-                f"{paths[i]} ({counts[i]} values)"
-                for i in range(len(paths))
-                if i not in (found["x"], found.get("series")) and (counts[i] or 1) > 1
-            ]
-            if shared:
-                problem(
+        )
+    for key, log in (("x", plot.log_x), ("y", plot.log_y)):
+        if key in found and (message := _axis_problem(key, log, values[found[key]])):
+            problems.append((key, message))
+    if plot.reduce is None and design == "grid" and "x" in found:
+        shared = [
+            f"{paths[i]} ({counts[i]} values)"
+            for i in range(len(paths))
+            if i not in (found["x"], found.get("series")) and (counts[i] or 1) > 1
+        ]
+        if shared:
+            problems.append(
+                (
                     "reduce",
                     "several runs share each x and series, differing in "
                     f"{', '.join(shared)}; give `reduce` (max, min, mean, median or count) to "
                     "combine them, or make that parameter the `series`",
                 )
-        if plot.name is not None and explicit.count(plot.name) > 1:
-            problem("name", f"the name {plot.name!r} is given to several plots; give each its own")
+            )
     return problems
 
 
