@@ -32,12 +32,11 @@ import visviva as vv
 from test_sweeps import GRID, InlineExecutor, spring_sweep, write
 from test_viewer import CHROMIUM, CHROMIUM_FLAGS
 from visviva.errors import ModelError, SweepError
-from visviva.sweeps import SweepInterrupted, parse_sweep
+from visviva.sweeps import Plot, SweepInterrupted, parse_sweep, read_results_h5
 from visviva.sweeps.index_page import write_index
-from visviva.sweeps.plot_spec import Plot
 from visviva.sweeps.reductions import reduce_plot
 from visviva.sweeps.reports import write_plot, write_reports
-from visviva.sweeps.results_h5 import read_results_h5, write_results_h5
+from visviva.sweeps.results_h5 import write_results_h5
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "sweeps"
 #: Pixels of a plot's PNG: 7.5 × 5 inches at 110 per inch.
