@@ -48,7 +48,8 @@ def sweep_command(
         typer.Option("--dry-run", help="Validate, expand and print the runs; write nothing."),
     ] = False,
 ) -> None:
-    """Run a sweep: every run into DIR/runs/, the table into DIR/results.csv and results.json."""
+    """Run a sweep: every run into DIR/runs/, the table into DIR/results.csv, .json and .h5, the
+    plots into DIR/plots/ and a page of it all, DIR/index.html."""
     from ..errors import ModelError
     from ..sweeps import dask_executor, expand, load_sweep, sweep
 
@@ -105,4 +106,9 @@ def _print_result(result: Any) -> None:
     for row in result.rows:
         if not row["success"]:
             typer.echo(f"run {row['run']}: {str(row['error']).splitlines()[0]}")
-    typer.echo(f"wrote {result.files[0]} and {result.files[1].name}")
+    for warning in result.warnings:
+        typer.echo(f"warning: {warning}", err=True)
+    names = [file.name for file in result.files if file.parent == result.directory]
+    plots = len([file for file in result.files if file.suffix == ".png"])
+    drawn = f" and {plots} plot{'s' if plots != 1 else ''} in plots/" if plots else ""
+    typer.echo(f"wrote {', '.join(names)}{drawn} into {result.directory}/")

@@ -100,8 +100,9 @@ def _allowed_keys(
         rest = path[2:]
     elif schema is None:
         model = None if path else Scene
-    for key in rest:  # a table inside the entity (a body's `handle`)
-        model = _table_of(model, key)
+    for key in rest:  # a table inside the entity (a body's `handle`), or a sweep's list
+        if not isinstance(key, int):  # an item of a list of tables has the list's schema
+            model = _table_of(model, key)
     return list(model.model_fields) if model is not None else []
 
 

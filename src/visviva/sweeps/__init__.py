@@ -5,14 +5,17 @@ A sweep file names a base scene, the parameters to vary and how (grid, zip or ra
 :func:`~visviva.scenes.run_scene` on a process pool, in this process, or on any
 :class:`concurrent.futures.Executor` — runs that share their equations advance together in
 batches (:mod:`.tasks`) — resumes where an interrupted sweep stopped, and writes a results table
-(:mod:`.results`). :func:`dask_executor` (:mod:`.cluster`) gives an executor on a Dask cluster,
-local or at an address. A front layer like :mod:`visviva.scenes`: the physics packages never
-import it.
+(:mod:`.results`, :mod:`.results_h5`), the ``[[plots]]`` of the description (:mod:`.plot_spec`,
+:mod:`.reductions`) and an index page (:mod:`.index_page`, all written by :mod:`.reports`).
+:func:`dask_executor` (:mod:`.cluster`) gives an executor on a Dask cluster, local or at an
+address. A front layer like :mod:`visviva.scenes`: the physics packages never import it.
 """
 
 from .cluster import dask_executor
 from .description import Outputs, Parameter, Sweep, SweepInfo, load_sweep, parse_sweep
 from .design import SweepRun, expand, run_values
+from .plot_spec import Plot
+from .results_h5 import read_results_h5
 from .runner import SweepInterrupted, SweepResult, sweep
 from .tasks import BatchTask, RunTask, run_batch, run_task
 
@@ -20,6 +23,7 @@ __all__ = [
     "BatchTask",
     "Outputs",
     "Parameter",
+    "Plot",
     "RunTask",
     "Sweep",
     "SweepInfo",
@@ -30,6 +34,7 @@ __all__ = [
     "expand",
     "load_sweep",
     "parse_sweep",
+    "read_results_h5",
     "run_batch",
     "run_task",
     "run_values",

@@ -1,11 +1,12 @@
 """The sweep description: a base scene, the parameters to vary and the outputs to keep.
 
 A sweep file (``.toml`` or ``.json``) holds a ``[sweep]`` table (name, the base scene's file,
-seed, design), one ``[[parameters]]`` table per varied value and an optional ``[outputs]``
-table; the base scene may instead be written inline under ``[scene]`` (a whole scene:
-``[scene.integration]``, ``[[scene.entities]]``...). Validation follows the scene files': unknown
-keys are refused with a did-you-mean, numbers must be finite, a value of the wrong type is
-refused rather than converted, and every problem is reported at once with its line.
+seed, design), one ``[[parameters]]`` table per varied value, an optional ``[outputs]`` table
+and optional ``[[plots]]`` of the results against a parameter (:mod:`.plot_spec`); the base
+scene may instead be written inline under ``[scene]`` (a whole scene: ``[scene.integration]``,
+``[[scene.entities]]``...). Validation follows the scene files': unknown keys are refused with a
+did-you-mean, numbers must be finite, a value of the wrong type is refused rather than
+converted, and every problem is reported at once with its line.
 :func:`load_sweep` reads a file into a :class:`Sweep`; :mod:`.design` expands it into runs.
 """
 
@@ -28,8 +29,18 @@ from ..model.scene import OutputFormat, Scene
 from ..model.scene_errors import scene_problems
 from ..model.scene_fields import Finite, Name, Strict
 from .paths import PathProblem, resolve
+from .plot_spec import Plot, named, plot_problems
 
-__all__ = ["MAX_RUNS", "Outputs", "Parameter", "Sweep", "SweepFile", "SweepInfo", "load_sweep"]
+__all__ = [
+    "MAX_RUNS",
+    "Outputs",
+    "Parameter",
+    "Plot",
+    "Sweep",
+    "SweepFile",
+    "SweepInfo",
+    "load_sweep",
+]
 
 #: Most runs one sweep may expand to: a description, not a way to exhaust memory.
 MAX_RUNS = 1_000_000
@@ -163,6 +174,9 @@ class SweepFile(Strict):
     scene: dict[str, Any] | None = Field(None, description="the base scene, inline")
     parameters: Annotated[list[Parameter], Field(min_length=1, max_length=64)]
     outputs: Outputs = Outputs()
+    plots: Annotated[list[Plot], Field(max_length=64)] = Field(
+        default_factory=list, description="figures of the results against a parameter"
+    )
 
     @model_validator(mode="after")
     def _one_scene_and_distinct_paths(self) -> SweepFile:
@@ -191,6 +205,7 @@ class Sweep:
         outputs: The ``[outputs]`` table.
         base: The base scene as plain data (what ``Scene.model_dump`` gives).
         source: The sweep file's name, when read from one.
+        plots: The ``[[plots]]`` tables, each with its ``name``.
     """
 
     info: SweepInfo
@@ -199,6 +214,7 @@ class Sweep:
     outputs: Outputs
     base: dict[str, Any]
     source: str | None = None
+    plots: tuple[Plot, ...] = ()
 
     @property
     def paths(self) -> tuple[str, ...]:
@@ -270,6 +286,9 @@ def parse_sweep(text: str, format: str = "toml", source: str | None = None) -> S
         except PathProblem as problem:
             line = locate(text, ("parameters", index, "path"))
             problems.append(SceneProblem(f"parameters[{index}].path", str(problem), line=line))
+    for index, key, message in _plot_problems(description):
+        line = locate(text, ("plots", index, key))
+        problems.append(SceneProblem(f"plots[{index}].{key}", message, line=line))
     if problems:
         raise SweepError(problems, source)
     return Sweep(
@@ -279,6 +298,28 @@ def parse_sweep(text: str, format: str = "toml", source: str | None = None) -> S
         outputs=description.outputs,
         base=base.model_dump(mode="python", exclude_none=True),
         source=source,
+        plots=named(description.plots, [p.path for p in description.parameters]),
+    )
+
+
+def _plot_problems(description: SweepFile) -> list[tuple[int, str, str]]:
+    """The plots' problems (:func:`.plot_spec.plot_problems`) given the parameters' values."""
+    random = description.sweep.design == "random"
+    counts: list[int | None] = []
+    for parameter in description.parameters:
+        bounds = parameter.range or parameter.log_range
+        if random:
+            counts.append(None)
+        elif parameter.values is not None:
+            counts.append(len(parameter.values))
+        else:
+            counts.append(int(bounds[2]) if bounds is not None and len(bounds) == 3 else None)
+    return plot_problems(
+        description.plots,
+        [p.path for p in description.parameters],
+        [p.values for p in description.parameters],
+        counts,
+        description.sweep.design,
     )
 
 

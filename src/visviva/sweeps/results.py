@@ -17,7 +17,7 @@ from typing import Any
 from ..io.files import atomic_path
 from ..io.job import plain_json
 
-__all__ = ["flatten_summary", "write_results"]
+__all__ = ["flatten_summary", "results_columns", "write_results"]
 
 #: Summary entries that are not figures of the run (the file list, the scene's name).
 _NOT_FIGURES = ("outputs", "scene")
@@ -54,9 +54,7 @@ def write_results(
         parameters: The parameters' paths (their columns follow ``index`` and ``run``).
         rows: One mapping per run (see :mod:`visviva.sweeps.runner`), in index order.
     """
-    columns = ["index", "run", *parameters, "success", "error"]
-    for row in rows:
-        columns += [key for key in row if key not in columns]
+    columns = results_columns(parameters, rows)
     table = directory / "results.csv"
     with atomic_path(table) as temporary, temporary.open("w", newline="") as handle:
         writer = csv.writer(handle)
@@ -68,6 +66,19 @@ def write_results(
         data = dict(sweep) | {"parameters": list(parameters), "runs": list(rows)}
         temporary.write_text(json.dumps(plain_json(data), indent=2, allow_nan=False) + "\n")
     return table, document
+
+
+def results_columns(parameters: Sequence[str], rows: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The table's columns: ``index``, ``run``, the parameters, ``success``, ``error``, then
+    every other key of the rows in the order first met."""
+    columns = ["index", "run", *parameters, "success", "error"]
+    known = set(columns)
+    for row in rows:
+        for key in row:
+            if key not in known:
+                columns.append(key)
+                known.add(key)
+    return columns
 
 
 def _cell(value: Any) -> str:

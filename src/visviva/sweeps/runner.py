@@ -14,7 +14,8 @@ runs under way stop (their directories are removed), no new run starts, and the 
 are kept and listed in the results; on another executor (a Dask cluster) the runs not started
 are cancelled and those under way are left to finish there. A run done by another executor
 must leave its files where this process sees them (:mod:`.shared_files`). ``results.csv`` and
-``results.json`` (:mod:`.results`) are written at the end, atomically, also after an interrupt.
+``results.json`` (:mod:`.results`) are written at the end, atomically, also after an interrupt,
+and then ``results.h5``, the plots and ``index.html`` (:mod:`.reports`).
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ from ..simulation.interrupt import Interrupted
 from ..simulation.progress import Progress
 from .description import Sweep, load_sweep
 from .design import SweepRun, expand
+from .reports import write_reports
 from .results import write_results
 from .shared_files import SharedFiles
 from .tasks import RUN_FILE, BatchTask, RunTask, finished_row, perform, start_worker
@@ -74,7 +76,9 @@ class SweepResult:
         ran: Runs done by this call.
         skipped: Runs found finished and not run again.
         failed: Rows with ``success`` false (done now or before).
-        files: ``results.csv`` and ``results.json``.
+        files: ``results.csv`` and ``results.json``, then ``results.h5``, the plots' files and
+            ``index.html``.
+        warnings: The files that could not be written besides the table, each with its reason.
     """
 
     directory: Path
@@ -82,7 +86,8 @@ class SweepResult:
     ran: int
     skipped: int
     failed: int
-    files: tuple[Path, Path]
+    files: tuple[Path, ...]
+    warnings: tuple[str, ...] = ()
 
 
 class SweepInterrupted(Interrupted):
@@ -193,13 +198,15 @@ def sweep(
         "runs_total": len(runs),
     }
     files = write_results(root, heading, chosen.paths, ordered)
+    reports = write_reports(root, chosen, heading, ordered)
     result = SweepResult(
         directory=root,
         rows=ordered,
         ran=len(rows) - skipped,
         skipped=skipped,
         failed=sum(1 for row in ordered if not row["success"]),
-        files=files,
+        files=(*files, *reports.files),
+        warnings=reports.warnings,
     )
     if stopped is not None:
         raise SweepInterrupted(stopped, result, len(runs))
