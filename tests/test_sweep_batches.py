@@ -93,6 +93,24 @@ def test_a_batch_writes_bit_for_bit_what_runs_alone_write(tmp_path, method):
     assert {row["batch_size"] for row in together.rows} == {6}
     assert all("batch_size" not in row for row in alone.rows)
     assert_same_runs(together, alone)
+    # Each row ends with the pendulum's final state: the recording's last frame.
+    last = load_recording(together.directory / "runs" / together.rows[4]["run"] / "recording.h5")
+    assert together.rows[4]["final.generalized_position[1]"] == last["generalized_position"][-1, 1]
+    assert together.rows[4]["final.generalized_velocity[0]"] == last["generalized_velocity"][-1, 0]
+
+
+def test_without_recordings_a_batch_gives_the_same_table(tmp_path):
+    # Then the batch follows every member's energy and final state as arrays over the members,
+    # never drawing a frame: the same figures, by the same arithmetic.
+    text = sweep_text("velocity_verlet").replace("recordings = true", "recordings = false")
+    together, alone = run_both(tmp_path, text)
+    assert not list((tmp_path / "batch" / "runs").glob("*/recording.h5"))
+    assert {row["batch_size"] for row in together.rows} == {6}
+    for one, other in zip(together.rows, alone.rows, strict=True):
+        assert {k: v for k, v in one.items() if k not in _NOT_PHYSICS} == {
+            k: v for k, v in other.items() if k not in _NOT_PHYSICS
+        }
+        assert one["counts.points"] == 3 and "final.generalized_position[0]" in one
 
 
 def test_implicit_methods_run_alone(tmp_path):
@@ -232,8 +250,9 @@ def test_run_ensemble_frames_are_those_of_each_simulation():
     models = [pendulum_model(theta1=a, theta2=0.3) for a in (0.2, 1.1, 2.9)]
     seen: dict[int, list[tuple[float, np.ndarray, float]]] = {i: [] for i in range(3)}
 
-    def keep(member, state, energy):
-        seen[member].append((state.t, np.array(state["generalized_position"]), energy))
+    def keep(state, energy, rows):
+        for row, member in enumerate(rows):
+            seen[member].append((state.t, np.array(state.q[row]), float(energy[row])))
 
     result = run_ensemble(models, 0.5, on_frame=keep)
     assert result.failed == {} and result.counters["accepted_steps"] == 50

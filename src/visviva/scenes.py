@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -34,7 +34,15 @@ if TYPE_CHECKING:
     from .ode.state import State
     from .simulation.interrupt import Interrupted, StopOnSignal
 
-__all__ = ["DryRun", "RunFigures", "dry_run", "load_model", "run_scene", "write_run"]
+__all__ = [
+    "DryRun",
+    "RunFigures",
+    "dry_run",
+    "final_values",
+    "load_model",
+    "run_scene",
+    "write_run",
+]
 
 
 def load_model(path: str | os.PathLike[str]) -> Model:
@@ -245,7 +253,8 @@ class RunFigures:
     """What a run leaves besides its recording: outcome, work and energy figures.
 
     The energy is followed frame by frame (first, last, largest change), so nothing in
-    memory grows with the number of frames. ``wall_time_s`` is time spent before the job's
+    memory grows with the number of frames. ``final`` holds the named systems' coordinates at
+    the last frame (see :func:`final_values`). ``wall_time_s`` is time spent before the job's
     own clock started and ``batch_size`` the number of runs computed together with this one
     (:mod:`visviva.simulation.ensemble`), 0 for a run of its own.
     """
@@ -260,6 +269,7 @@ class RunFigures:
     emitters: dict[str, dict[str, int]] = field(default_factory=dict)
     wall_time_s: float = 0.0
     batch_size: int = 0
+    final: dict[str, float] = field(default_factory=dict)
 
     def see(self, t: float, energy: Any) -> None:
         self.t_reached = t
@@ -290,8 +300,31 @@ class RunFigures:
             writer.append(state.t, fields)
             self.see(state.t, energy)
             self.points = fields["points"].shape[0] if "points" in fields else 0
+            self.final = final_values(fields)
 
         return record
+
+
+#: Recorded fields whose values at the end of a run join its summary, if they are small.
+FINAL_FIELDS = ("generalized_position", "generalized_velocity", "y")
+#: Most values of one field in the summary: the state of a pendulum or a double pendulum, not
+#: of a thousand bodies.
+MAX_FINAL_VALUES = 16
+
+
+def final_values(fields: Mapping[str, np.ndarray]) -> dict[str, float]:
+    """The named systems' coordinates in a frame, by name and index
+    (``{"generalized_position[1]": 0.42, ...}``), for fields of at most
+    :data:`MAX_FINAL_VALUES` values: what an ensemble's results table compares across runs
+    (where a chaotic pendulum ends up)."""
+    return {
+        f"{name}[{i}]": float(value)
+        for name in FINAL_FIELDS
+        if name in fields
+        and np.size(fields[name]) <= MAX_FINAL_VALUES
+        and not np.iscomplexobj(fields[name])
+        for i, value in enumerate(np.ravel(fields[name]))
+    }
 
 
 def recording_attrs(model: Model, seconds: float) -> dict[str, Any]:
@@ -414,6 +447,8 @@ def _summary(
     }
     if isinstance(failure, Interrupted):
         summary["interrupted"] = failure.signal
+    if run.final:
+        summary["final"] = run.final
     if run.batch_size:
         summary["batch_size"] = run.batch_size
     if run.emitters:

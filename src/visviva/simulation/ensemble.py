@@ -26,6 +26,8 @@ from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from ..errors import ModelError, SimulationDiverged, SimulationError
 from ..integrators import get
 from ..ode.stacking import equations_key, stack
@@ -39,11 +41,12 @@ from .watch import DivergenceWatch
 if TYPE_CHECKING:
     from ..model import Model
 
-__all__ = ["EnsembleRun", "ensemble_key", "run_ensemble"]
+__all__ = ["EnsembleFrame", "EnsembleRun", "ensemble_key", "run_ensemble"]
 
-#: ``on_frame(member, state, energy)``: a recorded frame of one member (its index in the
-#: models given), as its own run would record it; the arrays belong to the run: copy them.
-MemberFrame = Callable[[int, State, "float | None"], None]
+#: ``on_frame(state, energy, members)``: a recorded frame of the batch — its state (row ``r``
+#: is member ``members[r]``, an index into the models given), each row's energy ``(rows,)`` or
+#: ``None`` — at the times each member's own run records; the arrays belong to the run.
+EnsembleFrame = Callable[[State, "np.ndarray | None", Sequence[int]], None]
 
 
 def ensemble_key(model: Model) -> Hashable | None:
@@ -83,7 +86,7 @@ def run_ensemble(
     models: Sequence[Model],
     until: float,
     *,
-    on_frame: MemberFrame | None = None,
+    on_frame: EnsembleFrame | None = None,
     progress: bool | None = False,
 ) -> EnsembleRun:
     """Run every model of an ensemble from its start to ``until`` [s] in one batch.
@@ -91,9 +94,9 @@ def run_ensemble(
     Args:
         models: Models with one :func:`ensemble_key` (checked).
         until: End time [s], as for :meth:`Simulation.run <visviva.simulation.Simulation.run>`.
-        on_frame: Called with each member's recorded frames (its start, every
-            ``record_every``-th step and the last), member by member within a frame. A
-            member that fails has had its frames up to the failure passed: discard them.
+        on_frame: Called with each recorded frame of the batch (the start, every
+            ``record_every``-th step and the last; see :data:`EnsembleFrame`). A member that
+            fails has had its frames up to the failure passed: discard them.
         progress: Show a progress bar over the batch's steps.
 
     Returns:
@@ -129,12 +132,8 @@ def run_ensemble(
     started = time.perf_counter()
 
     def record(frame: State, energy: Any) -> None:
-        if on_frame is None:
-            return
-        for row, member in enumerate(members):
-            parts = tuple(part[row] for part in frame.parts)
-            value = None if energy is None else float(energy[row])
-            on_frame(member, starts[member].from_parts(frame.t, parts), value)
+        if on_frame is not None:
+            on_frame(frame, energy, members)
 
     schedule = Schedule.build(origin, until, settings.dt, settings.substeps)
     with Progress(schedule.steps, f"{integrator.name} x{len(models)}", progress) as bar:

@@ -41,8 +41,9 @@ FIGURES: dict[str, str] = {
     "warnings": "",
 }
 #: Tables of ``summary.json`` whose entries depend on the scene (``counts.particles``,
-#: ``emitters.<name>.births``): accepted by name, found or not once the runs are done.
-NESTED_FIGURES = ("counts.", "emitters.")
+#: ``emitters.<name>.births``, a system's ``final.generalized_position[1]``): accepted by name,
+#: found or not once the runs are done.
+NESTED_FIGURES = ("counts.", "emitters.", "final.")
 #: Columns of the table that hold text, not numbers.
 _TEXT_COLUMNS = ("method", "run", "error", "interrupted")
 
@@ -171,7 +172,7 @@ def _one_plot(
                 "y",
                 f"`y` must be a figure of the results or a parameter path (got {plot.y!r})."
                 f"{did_you_mean(plot.y, [*FIGURES, *paths])} Figures: {', '.join(FIGURES)}, "
-                f"counts.<what>; parameters: {listed}",
+                f"counts.<what>, final.<coordinate>; parameters: {listed}",
             )
         )
     for key, log in (("x", plot.log_x), ("y", plot.log_y)):

@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import shutil
 import signal
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
@@ -158,45 +159,115 @@ def _advance_together(
 ) -> tuple[list[tuple[RunFigures, list[Any] | None]], set[int]]:
     """Run the members' models as one ensemble; each member's figures (and frames, if its
     recording is kept or made into outputs), and the indices of the members that failed."""
-    from ..scenes import RunFigures
     from ..simulation.ensemble import run_ensemble
 
     if not members:
         return [], set()
-    figures: list[tuple[RunFigures, list[Any] | None]] = [
-        (RunFigures(), [] if run.keep_recording or run.formats else None) for run, _ in members
-    ]
-    sinks = [
-        figure.recorder(model, _Frames(frames))
-        for (figure, frames), (_, model) in zip(figures, members, strict=True)
-    ]
-
-    def on_frame(member: int, state: State, energy: float | None) -> None:
-        sinks[member](state, energy)
-
     models = [model for _, model in members]
+    figures = _Figures(models)
+    kept: dict[int, list[Any]] = {
+        i: [] for i, (run, _) in enumerate(members) if run.keep_recording or run.formats
+    }
+    sinks = {i: figures.recorder(i, _Frames(frames)) for i, frames in kept.items()}
+
+    def on_frame(state: State, energy: np.ndarray | None, rows: Sequence[int]) -> None:
+        figures.see(state, energy, rows)
+        for row, member in enumerate(rows):
+            if member in sinks:
+                sinks[member](figures.member_state(member, state, row), _row_of(energy, row))
+
     with stops.polled():
         result = run_ensemble(models, models[0].integration.duration, on_frame=on_frame)
-    share = result.wall_time_s / len(members)
     counters = {"steps": result.counters["accepted_steps"]} | result.counters
-    for figure, _ in figures:
+    done = []
+    for i in range(len(members)):
+        figure = figures.of(i)
         figure.counters = dict(counters)
-        figure.wall_time_s = share
+        figure.wall_time_s = result.wall_time_s / len(members)
         figure.batch_size = len(members)
-    failed = {members[i][0].index for i in result.failed}
-    return figures, failed
+        done.append((figure, kept.get(i)))
+    return done, {members[i][0].index for i in result.failed}
+
+
+def _row_of(energy: np.ndarray | None, row: int) -> float | None:
+    return None if energy is None else float(energy[row])
+
+
+class _Figures:
+    """What :class:`~visviva.scenes.RunFigures` keeps of a run, for every member of a batch
+    at once: frame by frame, as arrays over the members, with the same arithmetic (a member's
+    figures are those of its own run, bit for bit); the drawn frame of a member is made only
+    for its last frame (its final coordinates) or when its recording is kept."""
+
+    def __init__(self, models: list[Model]) -> None:
+        count = len(models)
+        self.models = models
+        self.starts = [model.initial_state() for model in models]
+        self.frames = np.zeros(count, dtype=np.int64)
+        self.t_reached = np.full(count, np.nan)
+        self.energy_start = np.full(count, np.nan)
+        self.energy_last = np.full(count, np.nan)
+        self.energy_change = np.zeros(count)
+        self.has_energy = False
+        self.last: tuple[State, list[int]] | None = None  # the latest frame, copied, and its rows
+        self.individual: dict[int, RunFigures] = {}
+
+    def member_state(self, member: int, state: State, row: int) -> State:
+        """Member ``member``'s own state from row ``row`` of a batch ``state``."""
+        return self.starts[member].from_parts(state.t, tuple(p[row] for p in state.parts))
+
+    def see(self, state: State, energy: np.ndarray | None, rows: Sequence[int]) -> None:
+        members = np.asarray(rows, dtype=np.int64)
+        self.frames[members] += 1
+        self.t_reached[members] = state.t
+        if energy is not None:
+            self.has_energy = True
+            value = np.asarray(energy, dtype=np.float64)
+            first = self.frames[members] == 1
+            self.energy_start[members[first]] = value[first]
+            self.energy_last[members] = value
+            change = np.abs(value - self.energy_start[members])
+            self.energy_change[members] = np.maximum(self.energy_change[members], change)
+        self.last = (state.from_parts(state.t, tuple(np.array(p) for p in state.parts)), list(rows))
+
+    def recorder(self, member: int, writer: Any) -> Callable[[State, Any], None]:
+        """The recorder of a member whose frames are kept (its figures come from it)."""
+        from ..scenes import RunFigures
+
+        figure = self.individual[member] = RunFigures()
+        return figure.recorder(self.models[member], writer)
+
+    def of(self, member: int) -> RunFigures:
+        """Member ``member``'s figures, as its own run would have them."""
+        from ..scenes import RunFigures, final_values
+
+        if member in self.individual:
+            return self.individual[member]
+        model, fields = self.models[member], {}
+        if self.last is not None and member in self.last[1]:
+            state, rows = self.last
+            fields = model.frame(self.member_state(member, state, rows.index(member)))
+        figure = RunFigures(
+            t_reached=float(self.t_reached[member]),
+            frames=int(self.frames[member]),
+            points=fields["points"].shape[0] if "points" in fields else 0,
+            final=final_values(fields),
+        )
+        if self.has_energy:
+            figure.energy_start = float(self.energy_start[member])
+            figure.energy_last = float(self.energy_last[member])
+            figure.energy_change = float(self.energy_change[member])
+        return figure
 
 
 class _Frames:
-    """A member's recorded frames kept in memory (``append(t, fields)`` like a writer), or
-    dropped when nothing but its summary is kept."""
+    """A member's recorded frames kept in memory (``append(t, fields)`` like a writer)."""
 
-    def __init__(self, store: list[Any] | None) -> None:
+    def __init__(self, store: list[Any]) -> None:
         self.store = store
 
     def append(self, t: float, fields: dict[str, Any]) -> None:
-        if self.store is not None:
-            self.store.append((t, {name: value.copy() for name, value in fields.items()}))
+        self.store.append((t, {name: value.copy() for name, value in fields.items()}))
 
 
 def _write_member(
