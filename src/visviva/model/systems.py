@@ -91,7 +91,7 @@ for _system in (
         "Dahlquist's test equation y' = lambda y (no picture)",
         {
             "lambda": Parameter(-1.0, "1/s", "rate"),
-            "y0": Parameter(1.0, "", "initial value"),
+            "y0": Parameter(1.0, "", "initial value", initial=True),
         },
         _test_equation,
     ),
