@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 import visviva as vv
+from test_sweeps import run_main
 from visviva.errors import ModelError
 from visviva.io.recording import load_recording
 from visviva.model.build import build_model
@@ -221,6 +222,21 @@ def test_the_chaos_example_shortened_is_smooth_for_small_releases_and_chaotic_fo
     # RK4 at h = 2 ms: the energy error is O(h^4) per unit time, here below 1e-4 of E.
     assert max(row["max_energy_error"] for row in result.rows[1:]) < 1e-4
     assert (tmp_path / "out" / "plots" / "final_angle.png").stat().st_size > 0
+
+
+def test_the_command_says_which_runs_batch_and_no_batch_runs_them_alone(
+    tmp_path, monkeypatch, capsys
+):
+    path = tmp_path / "pendulums.toml"
+    path.write_text(sweep_text("rk4").replace("recordings = true", "recordings = false"))
+    status, stdout, _ = run_main(monkeypatch, capsys, "sweep", path, "--dry-run")
+    assert status == 0
+    assert "6 runs share their equations (1 group) and would advance together" in stdout
+    out = tmp_path / "out"
+    status, stdout, _ = run_main(monkeypatch, capsys, "sweep", path, "-o", out, "--no-batch")
+    assert status == 0 and "6 runs; 6 succeeded, 0 failed" in stdout
+    rows = json.loads((out / "results.json").read_text())["runs"]
+    assert all("batch_size" not in row for row in rows)
 
 
 # ---------------------------------------------------------------- who joins a batch

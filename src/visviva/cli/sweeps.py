@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import Counter
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -70,6 +71,14 @@ def sweep_command(
             f"{description}: sweep {info.name!r}, {info.design} design, {len(runs)} runs, "
             f"all scenes valid; would write into {output}/runs/"
         )
+        keys = [run.batch_key for run in runs if run.batch_key is not None]
+        groups = [count for count in Counter(keys).values() if count > 1]
+        together = sum(groups)
+        if together and not no_batch:
+            typer.echo(
+                f"{together} runs share their equations ({len(groups)} group"
+                f"{'s' if len(groups) > 1 else ''}) and would advance together in batches"
+            )
         paths = list(chosen.paths)
         typer.echo("\t".join(["index", *paths]))
         for run in runs:
