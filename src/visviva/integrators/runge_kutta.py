@@ -106,11 +106,9 @@ class Stages:
     """The stage derivatives ``k_1 … k_s`` of one Runge–Kutta step.
 
     Each state part keeps its stages as the rows of one ``(s, size)`` array. A weighted sum
-    ``Σ_j w_j k_j`` is summed entry by entry in stage order, skipping zero weights, never as a
-    BLAS matrix–vector product: BLAS kernels order their sums by the array's length and
-    alignment, so one system would step differently alone and in a batch (a chaotic pendulum
-    then parts from itself within seconds). Entry-wise, every entry of every system is computed
-    the same way whatever surrounds it.
+    ``Σ_j w_j k_j`` is one pass of :func:`~visviva.integrators.stage_sums.weighted_sum`, entry
+    by entry in stage order, so every entry of every system is computed the same way whatever
+    surrounds it (alone or in a batch).
     """
 
     def __init__(self, parts: tuple[np.ndarray, ...], count: int) -> None:
@@ -137,13 +135,13 @@ class Stages:
 
     def weighted(self, h: float, weights: np.ndarray) -> tuple[np.ndarray, ...]:
         """``h Σ_j weights[j] k_j`` over the first ``len(weights)`` stages, part by part."""
-        n = self._filled(weights)
+        from .stage_sums import weighted_sum
+
+        scaled = h * np.asarray(weights, dtype=np.float64)[: self._filled(weights)]
         sums = []
         for rows, shape in self._layout:
-            total = np.zeros(rows.shape[1], dtype=rows.dtype)
-            for j in range(n):
-                if weights[j] != 0.0:
-                    total += (h * weights[j]) * rows[j]
+            total = np.empty(rows.shape[1], dtype=rows.dtype)
+            weighted_sum(rows, scaled, total)
             sums.append(total.reshape(shape))
         return tuple(sums)
 

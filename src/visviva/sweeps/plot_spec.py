@@ -81,6 +81,9 @@ class Plot(Strict):
     log_x: Flag = Field(False, description="logarithmic horizontal axis")
     log_y: Flag = Field(False, description="logarithmic vertical axis")
     abs_y: Flag = Field(False, description="draw |y| (a signed figure such as energy_drift)")
+    lines: Flag = Field(
+        True, description="join the points of a series (false: points only, for scatter)"
+    )
     title: Annotated[str, Field(strict=True, max_length=200)] | None = Field(
         None, description="the figure's title (default: what is drawn against what)"
     )

@@ -238,4 +238,5 @@ def _figure(points: PlotPoints, label: Callable[[str], str]) -> Any:
         x_labels=[shown(x) for x in points.x_order] if points.categorical else None,
         legend_title=plot.series,
         note="; ".join(notes),
+        joined=plot.lines,
     )

@@ -35,8 +35,10 @@ def plot_against_parameter(
     x_labels: Sequence[str] | None = None,
     legend_title: str | None = None,
     note: str = "",
+    joined: bool = True,
 ) -> Figure:
-    """One line with markers per ``(label, x, y)`` of ``lines``.
+    """One line with markers per ``(label, x, y)`` of ``lines`` (markers only unless
+    ``joined``: a scatter, where neighbouring points need not be close).
 
     Args:
         lines: Each line's legend label (empty: no legend entry), x and y values, x ascending.
@@ -49,6 +51,7 @@ def plot_against_parameter(
             (the lines' x are then positions).
         legend_title: Title of the legend (what the series are).
         note: Text under the axes: what was left out, and why.
+        joined: Join each line's points.
     """
     from matplotlib.figure import Figure
 
@@ -56,7 +59,15 @@ def plot_against_parameter(
     ax = figure.subplots()
     drawn = [line for line in lines if len(line[1])]
     for (label, x, y), style in zip(drawn, _styles(len(drawn)), strict=True):
-        ax.plot(x, y, marker="o", markersize=4, linewidth=1.3, label=label or None, **style)
+        ax.plot(
+            x,
+            y,
+            marker="o",
+            markersize=4 if joined else 2.5,
+            linewidth=1.3 if joined else 0.0,
+            label=label or None,
+            **style,
+        )
     if not drawn:
         ax.text(0.5, 0.5, "nothing to plot", transform=ax.transAxes, ha="center", va="center")
     if log_x:
