@@ -118,7 +118,8 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
             forces = force_objects(scene, groups, arrays["mass"])
             forces += penalty_forces(scene, groups, arrays, h)
             forces += spring_forces(scene, groups, count)
-        bodies, body_forces = rigid_bodies(scene, names)
+        with np.errstate(over="ignore"):  # a weight beyond the float range diverges, named
+            bodies, body_forces = rigid_bodies(scene, names)
         collisions = collision_stage(scene, groups, arrays["pinned"], h)
         stages += contact_stages(scene, groups, arrays, collisions, h)
         if collisions is not None:

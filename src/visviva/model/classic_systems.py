@@ -11,6 +11,7 @@ systems.
 
 from __future__ import annotations
 
+import math
 from collections import OrderedDict
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -55,7 +56,7 @@ def _lagrangian(
     """A named system from a Lagrangian system factory ``make(values, g)``."""
 
     def system(values: Mapping[str, float], gravity: np.ndarray) -> Any:
-        g = float(np.linalg.norm(gravity))
+        g = math.hypot(*gravity)
         equations = {k: v for k, v in values.items() if not parameters[k].initial}
         return _cached(name, equations, g, lambda: make(equations, g))
 
@@ -139,7 +140,7 @@ def _constrained_pendulum(values: Mapping[str, float], gravity: np.ndarray) -> P
         values["omega0"],
         length=values["length"],
         mass=values["mass"],
-        g=float(np.linalg.norm(gravity)),
+        g=math.hypot(*gravity),
         stabilization=values["stabilization"],
     )
     return problem

@@ -258,7 +258,7 @@ class Model:
         stage = next((s for s in self.stages if isinstance(s, ParticleContacts)), None)
         if stage is None:
             raise ModelError(
-                'this scene\'s particles do not collide with each other: add an entity of type '
+                "this scene's particles do not collide with each other: add an entity of type "
                 '"particle_collisions" (SceneBuilder.add_particle_collisions)'
             )
         return stage.pair_contacts(state, gap)

@@ -9,6 +9,7 @@ damping (:mod:`visviva.forces.body_forces`).
 
 from __future__ import annotations
 
+import math
 import warnings
 from typing import Any
 
@@ -150,7 +151,7 @@ def _shape(entity: RigidBody) -> dict[str, Any]:
 def _start(index: int, entity: RigidBody) -> BodyStart:
     """How the body starts; a non-unit orientation is normalized, with a warning."""
     q = np.asarray(entity.orientation, dtype=np.float64)
-    norm = float(np.linalg.norm(q))
+    norm = math.hypot(*q)  # no overflow for components near the float limit
     if not np.isfinite(norm) or norm == 0.0:
         raise Located(
             f"entities[{index}].orientation",
