@@ -137,7 +137,8 @@ class Stages:
         """``h Σ_j weights[j] k_j`` over the first ``len(weights)`` stages, part by part."""
         from .stage_sums import weighted_sum
 
-        scaled = h * np.asarray(weights, dtype=np.float64)[: self._filled(weights)]
+        self._filled(weights)
+        scaled = h * np.asarray(weights, dtype=np.float64)
         sums = []
         for rows, shape in self._layout:
             total = np.empty(rows.shape[1], dtype=rows.dtype)

@@ -127,8 +127,8 @@ def sweep(
         workers: Processes of the default pool (default: every core).
         resume: Skip runs already finished in ``directory`` with the same scene.
         batch: Advance runs that share their equations (one named system, only the start
-            differing) together in batches; each run's files and numbers are the same either
-            way, bit for bit for the explicit and symplectic methods.
+            differing, an explicit or symplectic method) together in batches; each run's
+            files and numbers are the same either way, bit for bit.
         progress: Progress bar over runs (default: when stderr is a terminal).
 
     Returns:
@@ -170,7 +170,7 @@ def sweep(
         else:
             pending.append((run, task))
     slots = 1 if executor == "serial" else workers or os.cpu_count() or 1
-    tasks = _plan(pending, slots if batch else 0)
+    tasks = _plan(pending, slots) if batch else [task for _, task in pending]
     skipped = len(rows)
     stopped: str | None = None
     with Progress(len(runs), f"sweep {chosen.info.name}", progress) as bar:
@@ -229,11 +229,11 @@ def _task(chosen: Sweep, root: Path, run: SweepRun) -> RunTask:
 def _plan(pending: list[tuple[SweepRun, RunTask]], slots: int) -> list[RunTask | BatchTask]:
     """The tasks for the runs to do: runs with one batch key grouped into batches of
     :data:`MIN_BATCH` to :data:`MAX_BATCH` runs, split so that each of ``slots`` workers gets
-    a share (no batches with ``slots`` 0), the rest alone; in the order of their first run."""
+    a share, the rest alone; in the order of their first run."""
     tasks: list[RunTask | BatchTask] = []
     groups: dict[Any, list[RunTask]] = {}
     for run, task in pending:
-        if slots and run.batch_key is not None:
+        if run.batch_key is not None:
             groups.setdefault(run.batch_key, []).append(task)
         else:
             tasks.append(task)

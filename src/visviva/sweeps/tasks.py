@@ -172,7 +172,7 @@ def _advance_together(
 
     def on_frame(state: State, energy: np.ndarray | None, rows: Sequence[int]) -> None:
         figures.see(state, energy, rows)
-        for row, member in enumerate(rows):
+        for row, member in enumerate(rows if sinks else ()):
             if member in sinks:
                 sinks[member](figures.member_state(member, state, row), _row_of(energy, row))
 
