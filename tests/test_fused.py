@@ -58,6 +58,46 @@ def test_fused_and_generic_steps_agree_to_round_off(steps):
     assert fused.energy() == pytest.approx(generic.energy(), rel=1e-9)
 
 
+def test_a_ball_landing_within_a_step_bounces_for_the_rest_of_it():
+    """With only a floor, the fused step's first pass takes the floor's contact itself; a
+    ball that lands within a step must still take the time-of-impact path (seed 003), as the
+    generic pipeline does: on the step's chord y(λ) = s + λ h u, with u = v − g h the
+    symplectic Euler velocity, it touches at y(λ) = r, its velocity there v + λ (u − v)
+    reflects to e |·|, and it flies the rest of the step, (1 − λ) h, under gravity."""
+    builder = vv.SceneBuilder(name="bounce")
+    dt, e, r, g = 0.002, 0.9, 0.05, 9.81
+    builder.set_integration(method="symplectic_euler", dt=dt, duration=1.0)
+    builder.add_particles([[0.0, 1.0, 0.0]], radius=r)
+    builder.add_collider("plane", restitution=e)
+    model = builder.build()
+    fused, generic = vv.Simulation(model), vv.Simulation(model, compiled=False)
+    assert fused.compiled
+    for _ in range(300):
+        s, v = (
+            generic.raw_state["particle_position"][0, 1],
+            generic.raw_state["particle_velocity"][0, 1],
+        )
+        fused.step()
+        generic.step()
+        np.testing.assert_array_equal(fused.raw_state.parts[0], generic.raw_state.parts[0])
+        np.testing.assert_array_equal(fused.raw_state.parts[1], generic.raw_state.parts[1])
+        if generic.raw_state["particle_velocity"][0, 1] > 0.0:
+            break
+    else:
+        pytest.fail("the ball never bounced")
+    u = v - g * dt
+    fraction = (s - r) / (-u * dt)
+    assert 0.0 < fraction < 1.0  # it landed within the step, not at its end
+    rest = (1.0 - fraction) * dt
+    out = e * abs(v + fraction * (u - v))
+    y, vy = (
+        generic.raw_state["particle_position"][0, 1],
+        generic.raw_state["particle_velocity"][0, 1],
+    )
+    assert vy == pytest.approx(out - g * rest, rel=1e-6)
+    assert y == pytest.approx(r + out * rest - 0.5 * g * rest**2, abs=1e-7)
+
+
 def test_fused_step_is_taken_only_where_it_applies():
     model = _scene()
     assert vv.Simulation(model).compiled

@@ -494,6 +494,14 @@ def _fused(
         px, py, pz = sx + h * ux, sy + h * uy, sz + h * uz
         r = radius[i]
         mask = common_mask if collider_masks is None else collider_masks[i]
+        # A particle that may hit a plane within the step needs its time of impact: special
+        # (judged by where the step would take it, before any contact moves it out).
+        odd = False
+        if impact_planes is not None:
+            for k in range(0, len(impact_planes), 8):
+                plane = _plane_at(impact_planes, k)
+                bit = (mask >> np.uint64(plane[7])) & one
+                odd |= _impact_possible(plane, bit, sx, sy, sz, px, py, pz, r)
         # The first plane's contact (the floor, most often) is taken here; a particle near
         # another collider is special. (The compiler vectorizes one contact, not four.)
         d, nx, ny, nz = _plane_gap(floor, px, py, pz)
@@ -501,16 +509,10 @@ def _fused(
             px, py, pz, ux, uy, uz = _contact(
                 sx, sy, sz, px, py, pz, ux, uy, uz, d, nx, ny, nz, r, e, mu, rests
             )
-        odd = False
         if near_planes is not None:
             for k in range(0, len(near_planes), 8):
                 plane = _plane_at(near_planes, k)
                 odd |= _near(plane, (mask >> np.uint64(plane[7])) & one, px, py, pz, r)
-        if impact_planes is not None:
-            for k in range(0, len(impact_planes), 8):
-                plane = _plane_at(impact_planes, k)
-                bit = (mask >> np.uint64(plane[7])) & one
-                odd |= _impact_possible(plane, bit, sx, sy, sz, px, py, pz, r)
         if others is not None:
             odd |= (mask >> beyond) != 0
         if kinds is not None:
