@@ -231,7 +231,7 @@ def test_the_command_says_which_runs_batch_and_no_batch_runs_them_alone(
     path.write_text(sweep_text("rk4").replace("recordings = true", "recordings = false"))
     status, stdout, _ = run_main(monkeypatch, capsys, "sweep", path, "--dry-run")
     assert status == 0
-    assert "6 runs share their equations (1 group) and would advance together" in stdout
+    assert "6 runs would advance together in batches (1 group of" in stdout
     out = tmp_path / "out"
     status, stdout, _ = run_main(monkeypatch, capsys, "sweep", path, "-o", out, "--no-batch")
     assert status == 0 and "6 runs; 6 succeeded, 0 failed" in stdout
@@ -255,7 +255,8 @@ def test_only_runs_with_the_same_equations_share_a_batch_key():
     start = pendulum_model(theta1=1.0)
     assert ensemble_key(start) == ensemble_key(pendulum_model(theta1=2.0, omega2=1.0))
     assert ensemble_key(start) != ensemble_key(pendulum_model(theta1=1.0, m2=2.0))
-    builder = vv.SceneBuilder(name="falling")
+    builder = vv.SceneBuilder(name="pendulum and ball")
+    builder.add_system("pendulum")
     builder.add_particles([[0.0, 1.0, 0.0]])
     assert ensemble_key(builder.build()) is None
 
@@ -295,9 +296,10 @@ def test_run_ensemble_frames_are_those_of_each_simulation():
     models = [pendulum_model(theta1=a, theta2=0.3) for a in (0.2, 1.1, 2.9)]
     seen: dict[int, list[tuple[float, np.ndarray, float]]] = {i: [] for i in range(3)}
 
-    def keep(state, energy, rows):
-        for row, member in enumerate(rows):
-            seen[member].append((state.t, np.array(state.q[row]), float(energy[row])))
+    def keep(frame):
+        for k, member in enumerate(frame.members):
+            position = frame.state(k)["generalized_position"]
+            seen[member].append((frame.t, position, float(frame.energy[k])))
 
     result = run_ensemble(models, 0.5, on_frame=keep)
     assert result.failed == {} and result.counters["accepted_steps"] == 50
@@ -318,6 +320,10 @@ def test_run_ensemble_frames_are_those_of_each_simulation():
 def test_run_ensemble_refuses_models_that_do_not_share_equations():
     with pytest.raises(ModelError, match="cannot advance in one batch"):
         run_ensemble([pendulum_model(theta1=1.0), pendulum_model(m1=3.0)], 0.5)
+    builder = vv.SceneBuilder(name="falling")
+    builder.add_particles([[0.0, 1.0, 0.0]])
+    with pytest.raises(ModelError, match="cannot advance in one batch"):
+        run_ensemble([pendulum_model(theta1=1.0), builder.build()], 0.5)
     with pytest.raises(ModelError, match="empty"):
         run_ensemble([], 0.5)
 

@@ -367,8 +367,10 @@ def test_resume_skips_finished_runs_and_reruns_what_changed(tmp_path):
 def test_an_interrupt_keeps_the_finished_runs_and_the_next_sweep_resumes(tmp_path):
     path = write(tmp_path, spring_sweep(GRID))
     out = tmp_path / "out"
+    # Runs alone, one task each (the springs would batch; an interrupt mid-batch is
+    # test_sweep_batches.py's).
     with pytest.raises(SweepInterrupted, match="2 of 6 runs finished") as caught:
-        vv.sweep(path, out, executor=InlineExecutor(interrupt_at=2))
+        vv.sweep(path, out, executor=InlineExecutor(interrupt_at=2), batch=False)
     assert [row["index"] for row in caught.value.result.rows] == [0, 1]
     assert len((out / "results.csv").read_text().splitlines()) == 3
     assert len(list((out / "runs").iterdir())) == 2

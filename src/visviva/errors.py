@@ -136,6 +136,8 @@ class SimulationDiverged(SimulationError):
         suggested_dt: The stability advisor's largest stable step for the method, from the
             Jacobian at the last finite state, or ``None`` if it could not be estimated.
         system: The offender's system (row) in a batch, or ``None`` for a single system.
+        entry: Where the offender is: the index of its integrated array in the state's parts
+            and its flat index in that array (of its row, in a batch), or ``None``.
     """
 
     def __init__(
@@ -148,12 +150,14 @@ class SimulationDiverged(SimulationError):
         value: float,
         suggested_dt: float | None,
         system: int | None = None,
+        entry: tuple[int, int] | None = None,
     ) -> None:
         super().__init__(message, t=t, step=step)
         self.component = component
         self.value = value
         self.suggested_dt = suggested_dt
         self.system = system
+        self.entry = entry
 
 
 class NewtonConvergenceError(SimulationError):

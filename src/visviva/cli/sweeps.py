@@ -76,8 +76,8 @@ def sweep_command(
         together = sum(groups)
         if together and not no_batch:
             typer.echo(
-                f"{together} runs share their equations ({len(groups)} group"
-                f"{'s' if len(groups) > 1 else ''}) and would advance together in batches"
+                f"{together} runs would advance together in batches ({len(groups)} group"
+                f"{'s' if len(groups) > 1 else ''} of the same equations or particle entities)"
             )
         paths = list(chosen.paths)
         typer.echo("\t".join(["index", *paths]))

@@ -156,9 +156,7 @@ def run_demo(
             for file_name in extras:
                 try:
                     with output.writing(file_name) as path:
-                        write_output(
-                            primary, path, fps, demo.speed, demo.trail, demo.color_by
-                        )
+                        write_output(primary, path, fps, demo.speed, demo.trail, demo.color_by)
                 except KeyboardInterrupt:
                     interrupted = Interrupted(stops.requested or "SIGINT", seconds)
                     summary["interrupted"] = interrupted.signal

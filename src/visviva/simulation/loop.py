@@ -35,7 +35,7 @@ from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get
 from .interrupt import Interrupted, stop_requested
 from .progress import Progress
-from .recorder import FrameCallback, FrameRecorder
+from .recorder import FrameCallback, FrameRecorder, FrameSink
 from .recording import Recording
 from .stepper import Stepper
 from .watch import DivergenceWatch
@@ -278,7 +278,7 @@ def advance(
     state: State,
     schedule: Schedule,
     record_every: int,
-    recorder: FrameRecorder | None,
+    recorder: FrameSink | None,
     bar: Progress,
 ) -> State:
     """Run ``schedule`` from ``state`` through ``stepper``: the one fixed-step loop.

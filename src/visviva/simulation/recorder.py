@@ -9,7 +9,7 @@ recorded. Runs that stream their frames to a file instead pass ``on_frame`` and 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -19,11 +19,18 @@ if TYPE_CHECKING:
     from ..ode.state import State
     from ..ode.system import System
 
-__all__ = ["FrameCallback", "FrameRecorder"]
+__all__ = ["FrameCallback", "FrameRecorder", "FrameSink"]
 
 #: ``on_frame(state, energy)``: a recorded state and its energy (``None`` if the system has
 #: none). The state's arrays belong to the run: copy what you keep.
 FrameCallback = Callable[["State", "np.ndarray | None"], None]
+
+
+class FrameSink(Protocol):
+    """What the loop records frames into (a :class:`FrameRecorder`, or an ensemble's)."""
+
+    def append(self, state: State) -> None:
+        """Record ``state`` as the next frame."""
 
 
 class FrameRecorder:

@@ -71,7 +71,7 @@ class DivergenceWatch:
 
     def diverged(self, state: State, step: int, last_good: State) -> SimulationDiverged:
         """The exception describing why ``state`` (reached by step ``step``) is not healthy."""
-        component, value, system_index = self._first_offender(state)
+        component, value, system_index, entry = self._first_offender(state)
         suggestion = suggested_dt(self.system, self.method, last_good, system_index)
         problem = (
             "is not finite" if not np.isfinite(value) else (f"exceeds the limit {self.limit:.3g}")
@@ -88,10 +88,12 @@ class DivergenceWatch:
             value=value,
             suggested_dt=suggestion,
             system=system_index,
+            entry=entry,
         )
 
-    def _first_offender(self, state: State) -> tuple[str, float, int | None]:
-        """The first bad entry: its label (part name and index), value and batch system."""
+    def _first_offender(self, state: State) -> tuple[str, float, int | None, tuple[int, int]]:
+        """The first bad entry: its label (part name and index), value, batch system, and
+        integrated array with its flat index there (in its row)."""
         for array, part in enumerate(state.parts):
             with np.errstate(invalid="ignore"):
                 bad = ~(np.abs(part) <= self.limit)
@@ -103,7 +105,8 @@ class DivergenceWatch:
                 label = f"{name}[{', '.join(map(str, where))}]"
                 if part.ndim == 2:
                     label += f" (system {index[0]})"
-                return label, value, (index[0] if part.ndim == 2 else None)
+                system = index[0] if part.ndim == 2 else None
+                return label, value, system, (array, index[-1])
         raise ValueError("state is healthy")
 
 

@@ -3,8 +3,9 @@
 A sweep file names a base scene, the parameters to vary and how (grid, zip or random design,
 :mod:`.description`, :mod:`.design`); :func:`sweep` runs every run through
 :func:`~visviva.scenes.run_scene` on a process pool, in this process, or on any
-:class:`concurrent.futures.Executor` — runs that share their equations advance together in
-batches (:mod:`.tasks`) — resumes where an interrupted sweep stopped, and writes a results table
+:class:`concurrent.futures.Executor` — runs that share their equations, or particle scenes
+with the same entities, advance together in batches (:mod:`.tasks`) — resumes where an
+interrupted sweep stopped, and writes a results table
 (:mod:`.results`, :mod:`.results_h5`), the ``[[plots]]`` of the description (:mod:`.plot_spec`,
 :mod:`.reductions`) and an index page (:mod:`.index_page`, all written by :mod:`.reports`).
 :func:`dask_executor` (:mod:`.cluster`) gives an executor on a Dask cluster, local or at an

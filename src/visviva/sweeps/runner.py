@@ -126,9 +126,11 @@ def sweep(
             ``directory`` must be on a file system the workers share.
         workers: Processes of the default pool (default: every core).
         resume: Skip runs already finished in ``directory`` with the same scene.
-        batch: Advance runs that share their equations (one named system, only the start
-            differing, an explicit or symplectic method) together in batches; each run's
-            files and numbers are the same either way, bit for bit.
+        batch: Advance runs that can together in batches (one named system with the same
+            equations, or particle scenes with the same entities; an explicit or symplectic
+            method: :func:`~visviva.simulation.ensemble.ensemble_key`); each run's files and
+            numbers are the same either way (bit for bit, or to round-off where a particle
+            batch sums a force by another path: :mod:`visviva.model.replicas`).
         progress: Progress bar over runs (default: when stderr is a terminal).
 
     Returns:

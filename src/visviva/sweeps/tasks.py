@@ -1,13 +1,15 @@
-"""What a worker does: one run of a sweep, or a batch of runs that share their equations.
+"""What a worker does: one run of a sweep, or a batch of runs that can advance together.
 
 A :class:`RunTask` is one run (its scene as plain data, picklable): it goes through
 :func:`~visviva.scenes.run_scene` into its directory, then ``run.json`` records its index,
 values, the digest of its scene, success and error. A :class:`BatchTask` holds runs whose
-models are one named system with the same equations and settings, only the start differing (a
-thousand pendulums from a thousand angles): they advance side by side in one batched state
-(:func:`~visviva.simulation.ensemble.run_ensemble`) and each then writes exactly the files its
-own run would have written, with the same numbers, bit for bit. A member that fails in the
-batch, or cannot join it, runs alone. Every task returns one results row per run; a failure of
+models share an :func:`~visviva.simulation.ensemble.ensemble_key` (a thousand pendulums from a
+thousand angles, a ball on floors of fifty restitutions): they advance side by side in
+batches (:func:`~visviva.simulation.ensemble.run_ensemble`, as many members at a time as
+:func:`~visviva.simulation.ensemble.ensemble_capacity` allows) and each then writes exactly the
+files its own run would have written, with the same numbers (see the ensemble module for
+where "the same" is to round-off). A member that fails in the batch, or cannot join it, runs
+alone. Every task returns one results row per run; a failure of
 a run is its row's error, never an exception.
 """
 
@@ -16,7 +18,7 @@ from __future__ import annotations
 import json
 import shutil
 import signal
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
@@ -34,6 +36,7 @@ if TYPE_CHECKING:
     from ..model import Model
     from ..ode.state import State
     from ..scenes import RunFigures
+    from ..simulation.ensemble import EnsembleFrame
     from ..simulation.interrupt import StopOnSignal
 
 __all__ = ["RUN_FILE", "BatchTask", "RunTask", "finished_row", "perform", "run_batch", "run_task"]
@@ -157,12 +160,29 @@ def run_batch(task: BatchTask) -> list[dict[str, Any]]:
 def _advance_together(
     members: list[tuple[RunTask, Model]], stops: StopOnSignal
 ) -> tuple[list[tuple[RunFigures, list[Any] | None]], set[int]]:
-    """Run the members' models as one ensemble; each member's figures (and frames, if its
-    recording is kept or made into outputs), and the indices of the members that failed."""
+    """Run the members' models as one ensemble (in as many batches as
+    :func:`~visviva.simulation.ensemble.ensemble_capacity` asks); each member's figures (and
+    frames, if its recording is kept or made into outputs), and the indices of the members
+    that failed."""
+    from ..simulation.ensemble import ensemble_capacity
+
+    done: list[tuple[RunFigures, list[Any] | None]] = []
+    failed: set[int] = set()
+    while len(done) < len(members):
+        rest = members[len(done) :]
+        chunk = rest[: ensemble_capacity([model for _, model in rest])]
+        figures, lost = _advance_batch(chunk, stops)
+        done += figures
+        failed |= lost
+    return done, failed
+
+
+def _advance_batch(
+    members: list[tuple[RunTask, Model]], stops: StopOnSignal
+) -> tuple[list[tuple[RunFigures, list[Any] | None]], set[int]]:
+    """Run the members' models as one batch (see :func:`_advance_together`)."""
     from ..simulation.ensemble import run_ensemble
 
-    if not members:
-        return [], set()
     models = [model for _, model in members]
     figures = _Figures(models)
     kept: dict[int, list[Any]] = {
@@ -170,11 +190,12 @@ def _advance_together(
     }
     sinks = {i: figures.recorder(i, _Frames(frames)) for i, frames in kept.items()}
 
-    def on_frame(state: State, energy: np.ndarray | None, rows: Sequence[int]) -> None:
-        figures.see(state, energy, rows)
-        for row, member in enumerate(rows if sinks else ()):
+    def on_frame(frame: EnsembleFrame) -> None:
+        figures.see(frame)
+        for k, member in enumerate(frame.members if sinks else ()):
             if member in sinks:
-                sinks[member](figures.member_state(member, state, row), _row_of(energy, row))
+                energy = None if frame.energy is None else float(frame.energy[k])
+                sinks[member](frame.state(k), energy)
 
     with stops.polled():
         result = run_ensemble(models, models[0].integration.duration, on_frame=on_frame)
@@ -189,46 +210,37 @@ def _advance_together(
     return done, {members[i][0].index for i in result.failed}
 
 
-def _row_of(energy: np.ndarray | None, row: int) -> float | None:
-    return None if energy is None else float(energy[row])
-
-
 class _Figures:
     """What :class:`~visviva.scenes.RunFigures` keeps of a run, for every member of a batch
     at once: frame by frame, as arrays over the members, with the same arithmetic (a member's
-    figures are those of its own run, bit for bit); the drawn frame of a member is made only
-    for its last frame (its final coordinates) or when its recording is kept."""
+    figures are those of its own run); the drawn frame of a member is made only for its last
+    frame (its final coordinates) or when its recording is kept."""
 
     def __init__(self, models: list[Model]) -> None:
         count = len(models)
         self.models = models
-        self.starts = [model.initial_state() for model in models]
         self.frames = np.zeros(count, dtype=np.int64)
         self.t_reached = np.full(count, np.nan)
         self.energy_start = np.full(count, np.nan)
         self.energy_last = np.full(count, np.nan)
         self.energy_change = np.zeros(count)
         self.has_energy = False
-        self.last: tuple[State, list[int]] | None = None  # the latest frame, copied, and its rows
+        self.last: EnsembleFrame | None = None  # the latest frame, copied
         self.individual: dict[int, RunFigures] = {}
 
-    def member_state(self, member: int, state: State, row: int) -> State:
-        """Member ``member``'s own state from row ``row`` of a batch ``state``."""
-        return self.starts[member].from_parts(state.t, tuple(p[row] for p in state.parts))
-
-    def see(self, state: State, energy: np.ndarray | None, rows: Sequence[int]) -> None:
-        members = np.asarray(rows, dtype=np.int64)
+    def see(self, frame: EnsembleFrame) -> None:
+        members = np.asarray(frame.members, dtype=np.int64)
         self.frames[members] += 1
-        self.t_reached[members] = state.t
-        if energy is not None:
+        self.t_reached[members] = frame.t
+        if frame.energy is not None:
             self.has_energy = True
-            value = np.asarray(energy, dtype=np.float64)
+            value = np.asarray(frame.energy, dtype=np.float64)
             first = self.frames[members] == 1
             self.energy_start[members[first]] = value[first]
             self.energy_last[members] = value
             change = np.abs(value - self.energy_start[members])
             self.energy_change[members] = np.maximum(self.energy_change[members], change)
-        self.last = (state.from_parts(state.t, tuple(np.array(p) for p in state.parts)), list(rows))
+        self.last = frame.kept()
 
     def recorder(self, member: int, writer: Any) -> Callable[[State, Any], None]:
         """The recorder of a member whose frames are kept (its figures come from it)."""
@@ -244,9 +256,8 @@ class _Figures:
         if member in self.individual:
             return self.individual[member]
         model, fields = self.models[member], {}
-        if self.last is not None and member in self.last[1]:
-            state, rows = self.last
-            fields = model.frame(self.member_state(member, state, rows.index(member)))
+        if self.last is not None and member in self.last.members:
+            fields = model.frame(self.last.state(self.last.members.index(member)))
         figure = RunFigures(
             t_reached=float(self.t_reached[member]),
             frames=int(self.frames[member]),
