@@ -276,3 +276,15 @@ def test_a_particle_sweep_in_batches_writes_what_runs_alone_write(tmp_path):
         second = load_recording(tmp_path / "alone" / "runs" / other["run"] / "recording.h5")
         for name, values in first.fields.items():
             np.testing.assert_array_equal(values, second.fields[name], err_msg=name)
+
+
+def test_a_batch_that_cannot_be_made_runs_its_members_alone(tmp_path, monkeypatch):
+    def broken(members):
+        raise RuntimeError("no room")
+
+    monkeypatch.setattr(Replicas, "of", broken)
+    data = bounce_sweep()
+    data["parameters"] = [{"path": "entities[floor].restitution", "values": [0.3, 0.6]}]
+    result = vv.sweep(parse_sweep(json.dumps(data), format="json"), tmp_path, executor="serial")
+    assert result.failed == 0 and result.ran == 2
+    assert all("batch_size" not in row for row in result.rows)

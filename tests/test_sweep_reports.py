@@ -596,7 +596,7 @@ def test_an_interrupted_sweep_still_writes_its_reports(tmp_path):
     ).replace("duration = 0.5", "duration = 0.05")
     out = tmp_path / "out"
     with pytest.raises(SweepInterrupted) as caught:
-        vv.sweep(write(tmp_path, text), out, executor=InlineExecutor(interrupt_at=3))
+        vv.sweep(write(tmp_path, text), out, executor=InlineExecutor(interrupt_at=3), batch=False)
     assert len(caught.value.result.rows) == 3
     table = list(csv.reader((out / "plots" / "steps_vs_stiffness.csv").open()))
     assert table[0] == ["entities[pair].stiffness", "integration.method", "steps", "runs"]

@@ -164,19 +164,19 @@ def test_ctrl_c_on_dask_keeps_the_finished_runs_and_resume_skips_them(client, tm
     path = write(tmp_path, spring_sweep(STEADY))
     out = tmp_path / "out"
     with pytest.raises(SweepInterrupted, match="of 6 runs finished") as caught:
-        vv.sweep(path, out, executor=CtrlCAfter(client.get_executor(), at=5, after=2))
+        vv.sweep(path, out, executor=CtrlCAfter(client.get_executor(), at=5, after=2), batch=False)
     kept = caught.value.result.rows
     assert 2 <= len(kept) < 6 and all(row["success"] for row in kept)
     assert len((out / "results.csv").read_text().splitlines()) == len(kept) + 1
 
     idle(client)  # runs under way when Ctrl-C came may finish in the background: let them
     stamps = {p: p.stat().st_mtime_ns for p in (out / "runs").glob("*/summary.json")}
-    resumed = vv.sweep(path, out, executor=client.get_executor())
+    resumed = vv.sweep(path, out, executor=client.get_executor(), batch=False)
     assert resumed.skipped >= len(kept) and resumed.ran + resumed.skipped == 6
     assert resumed.failed == 0 and [row["index"] for row in resumed.rows] == list(range(6))
     for summary, stamp in stamps.items():  # the finished runs were not run again
         assert summary.stat().st_mtime_ns == stamp
-    again = vv.sweep(path, out, executor=client.get_executor())
+    again = vv.sweep(path, out, executor=client.get_executor(), batch=False)
     assert (again.ran, again.skipped) == (0, 6) and again.rows == resumed.rows
 
 
@@ -287,9 +287,8 @@ def test_a_run_whose_files_this_machine_cannot_see_is_recorded_as_failed(
     executor, _ = cluster
     path = write(tmp_path, spring_sweep(STEADY))
     out = tmp_path / "out"
-    result = vv.sweep(
-        path, out, executor=Elsewhere(executor, tmp_path / "worker-disk", hidden=1, late=5)
-    )
+    where = Elsewhere(executor, tmp_path / "worker-disk", hidden=1, late=5)
+    result = vv.sweep(path, out, executor=where, batch=False)  # the executor moves runs
     assert (result.ran, result.failed) == (6, 1)
     hidden = result.rows[1]
     assert hidden["success"] is False
@@ -302,7 +301,7 @@ def test_a_run_whose_files_this_machine_cannot_see_is_recorded_as_failed(
     assert late["success"] and (out / "runs" / late["run"] / "run.json").exists()
     assert "cannot see them" in (out / "results.csv").read_text()
     # The next sweep runs again only the run whose files never arrived.
-    again = vv.sweep(path, out, executor=executor)
+    again = vv.sweep(path, out, executor=executor, batch=False)
     assert (again.ran, again.skipped, again.failed) == (1, 5, 0)
 
 
@@ -326,7 +325,7 @@ class Cancelling(Executor):
 def test_a_run_the_executor_cancels_is_recorded_as_failed_and_runs_on_resume(tmp_path):
     path = write(tmp_path, spring_sweep(TWO_RUNS))
     out = tmp_path / "out"
-    result = vv.sweep(path, out, executor=Cancelling(cancelled=0))
+    result = vv.sweep(path, out, executor=Cancelling(cancelled=0), batch=False)
     assert (result.ran, result.failed) == (2, 1)
     assert result.rows[0]["error"].startswith("the executor cancelled the run before it finished")
     assert result.rows[1]["success"]

@@ -143,7 +143,13 @@ def run_batch(task: BatchTask) -> list[dict[str, Any]]:
     rows: dict[int, dict[str, Any]] = {}
     with StopOnSignal() as stops:
         try:
-            figures, failed = _advance_together(members, stops)
+            try:
+                figures, failed = _advance_together(members, stops)
+            except (Interrupted, KeyboardInterrupt):
+                raise
+            except Exception:  # a batch that could not be made: its members run alone
+                alone += [run for run, _ in members]
+                members, figures, failed = [], [], set()
             for (run, model), (figure, frames) in zip(members, figures, strict=True):
                 if run.index in failed:
                     alone.append(run)
