@@ -15,7 +15,8 @@ Run ``python benchmarks/bench_particle_sweeps.py`` (a few minutes on 2 cores) or
 2. **Where batches pay**: members of n particles (a cloud of n balls over a floor of its own
    restitution, 0.2 s at h = 1 ms), 64 members as one batch against the same 64 runs one after
    another in this process (no files, no processes: the step alone), for symplectic Euler (the
-   fused step) and RK4 (the generic pipeline), n from 1 to 10,000 (``MAX_MEMBER_PARTICLES``).
+   fused step) and RK4 (the generic pipeline), n from 1 to 10,000 (runs of more than
+   ``MAX_MEMBER_PARTICLES`` = 1,000 particles do not batch: this shows why).
 
 Checks: the runs alone give the batches' figures (energy drift, steps) to round-off; the
 in-process members' final positions equal their runs alone to 1e-9 m. This is not a test: it

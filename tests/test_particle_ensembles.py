@@ -27,7 +27,12 @@ from visviva.model.build import build_model
 from visviva.model.replicas import Replicas, replica_capacity, replica_key
 from visviva.model.scene import Scene
 from visviva.simulation import Simulation
-from visviva.simulation.ensemble import ensemble_capacity, ensemble_key, run_ensemble
+from visviva.simulation.ensemble import (
+    MAX_MEMBER_PARTICLES,
+    ensemble_capacity,
+    ensemble_key,
+    run_ensemble,
+)
 from visviva.sweeps import parse_sweep
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "sweeps"
@@ -102,6 +107,9 @@ def test_particle_scenes_with_the_same_entities_share_a_key_whatever_their_value
     assert ensemble_key(model(duration=2.0)) != key  # a member must stop when its run does
     assert ensemble_key(model(method="rk4")) != key
     assert ensemble_key(model(method="backward_euler")) is None  # Newton would couple them
+    big = scene()
+    big["entities"].append({"type": "particle_cloud", "count": MAX_MEMBER_PARTICLES})
+    assert ensemble_key(build_model(Scene.model_validate(big))) is None  # batches stop paying
 
 
 @pytest.mark.parametrize(

@@ -60,8 +60,10 @@ __all__ = [
 ]
 
 #: Most particles a member of a particle ensemble may hold: beyond, one member's step is
-#: already long enough that a batch saves little, and the batch's memory grows with it.
-MAX_MEMBER_PARTICLES = 10_000
+#: long enough that a batch saves little, and each particle's collider copies (one per
+#: member, where a collider's values differ) cost more than the batch saves
+#: (``benchmarks/bench_particle_sweeps.py``).
+MAX_MEMBER_PARTICLES = 1_000
 
 
 def ensemble_key(model: Model) -> Hashable | None:
