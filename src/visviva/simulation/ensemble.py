@@ -30,6 +30,7 @@ where it fails exactly as it would have (with its own limit and message).
 from __future__ import annotations
 
 import time
+from abc import ABC, abstractmethod
 from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -251,7 +252,7 @@ def run_ensemble(
     return result
 
 
-class _Batch:
+class _Batch(ABC):
     """Members advancing as one: the system the integrator steps, its stages and fused step,
     and the passage between the batch's state and each member's."""
 
@@ -259,21 +260,21 @@ class _Batch:
     stages: tuple[Stage, ...] = ()
     fused: FusedStep | None = None
 
+    @abstractmethod
     def join(self, states: Sequence[State]) -> State:
         """The batch's state whose members are ``states`` (one per member, at one time)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def member_state(self, state: State, k: int) -> State:
         """Member ``k``'s own state (its own layout, arrays copied) from the batch's."""
-        raise NotImplementedError
 
+    @abstractmethod
     def energies(self, state: State) -> np.ndarray | None:
         """Each member's energy [J] in ``state``, ``(members,)``, or ``None``."""
-        raise NotImplementedError
 
+    @abstractmethod
     def failed_rows(self, failure: SimulationError) -> list[int]:
         """The members a failure is about: the one it names, or all if it names none."""
-        raise NotImplementedError
 
 
 class _Stacked(_Batch):
