@@ -4,6 +4,7 @@ against finite differences, both backends, energy under a symplectic method, bad
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 import pytest
@@ -366,3 +367,48 @@ def test_bad_states_and_backend():
         system.problem([0.1], [0.0], backend="numbaa")
     with pytest.raises(ModelError, match="q0"):
         system.problem([float("inf")], [0.0])
+
+
+# ---------------------------------------------------------------- compiled once per machine
+
+_BUILD_TWICE = """
+import visviva as vv
+system = vv.mechanics.classic.double_pendulum()
+problem = system.problem([1.0, 0.5], [0.0, 0.0])
+functions = [f.func for f in (problem.force, problem.jacobian, problem.energy) if f is not None]
+solution = vv.solve(problem, "rk4", dt=0.01, t_end=0.5)
+hits = sum(sum(f.stats.cache_hits.values()) for f in functions)
+print(hits, repr(float(solution.q[-1, 1])))
+"""
+
+
+def run_fresh(tmp_path, cache) -> tuple[int, str]:
+    import subprocess
+    import sys
+
+    environment = {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
+    done = subprocess.run(
+        [sys.executable, "-c", _BUILD_TWICE],
+        capture_output=True,
+        text=True,
+        env=environment,
+        cwd=tmp_path,
+        timeout=600,
+        check=True,
+    )
+    hits, last = done.stdout.split()
+    return int(hits), last
+
+
+def test_generated_equations_compile_once_per_machine(tmp_path):
+    # The second process loads the machine code the first compiled: the same numbers, no
+    # compilation (Numba counts a cache hit per function loaded).
+    cache = tmp_path / "cache"
+    first_hits, first = run_fresh(tmp_path, cache)
+    assert first_hits == 0 and list((cache / "visviva-equations").glob("*.py"))
+    again_hits, again = run_fresh(tmp_path, cache)
+    assert again_hits >= 2 and again == first
+    # A cache that cannot be written: compiled in memory, the same numbers.
+    blocked = tmp_path / "blocked"
+    blocked.write_text("a file where the cache directory would be")
+    assert run_fresh(tmp_path, blocked) == (0, first)

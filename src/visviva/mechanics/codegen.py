@@ -12,26 +12,35 @@ scalar arithmetic only. The same text then serves both flavours:
   ``numba.njit``. Straight-line scalar code compiles in a fraction of a second, where array
   temporaries, slice stores and calls into other compiled functions cost Numba seconds.
 
-The generated source is registered with :mod:`linecache`, so a traceback through it shows the
-line that failed.
+Numba functions are compiled once per machine: their source is written to a file named by its
+digest in the equations cache (:func:`equations_cache`) and compiled with ``cache=True``, so
+another process — a worker of a sweep's pool, the next ``visviva run`` — loads the machine code
+instead of compiling the same text again (seconds for a double pendulum). Where the cache cannot
+be written, the function is compiled from the text in memory. The source of a NumPy function is
+registered with :mod:`linecache`, so a traceback through it shows the line that failed (a file
+in the cache shows its lines by itself).
 """
 
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import linecache
 import math
+import os
+import sys
+import tempfile
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
-import numpy as np
 import sympy
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE
 
 from ..errors import ModelError
 
-__all__ = ["FLAVOURS", "SourceWriter", "UnrolledLDLT"]
+__all__ = ["FLAVOURS", "SourceWriter", "UnrolledLDLT", "equations_cache"]
 
 FLAVOURS = ("numba", "numpy")
 
@@ -148,21 +157,66 @@ class SourceWriter:
         return "\n".join(self._lines) + "\n"
 
     def compile(self) -> Any:
-        """The function: plain Python for ``"numpy"``, a Numba dispatcher for ``"numba"``."""
-        source = self.source()
-        digest = hashlib.sha1(source.encode()).hexdigest()[:12]
-        filename = f"<visviva generated {self.name} {digest}>"
-        linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
-        namespace: dict[str, Any] = {"numpy": np}
-        exec(compile(source, filename, "exec"), namespace)
-        function = namespace[self.name]
+        """The function: plain Python for ``"numpy"``, a Numba dispatcher for ``"numba"``
+        (compiled once per machine, see the module docstring)."""
+        source = "import numpy\n\n\n" + self.source()
+        digest = hashlib.sha256(source.encode()).hexdigest()[:24]
         if self.flavour == "numba":
             import numba
 
+            cached = _cached_function(self.name, digest, source)
             # Division by zero gives inf/NaN as in NumPy (the divergence watch reports it)
             # instead of raising inside a compiled loop.
-            return numba.njit(function, error_model="numpy")
-        return function
+            if cached is not None:
+                return numba.njit(cached, error_model="numpy", cache=True)
+            return numba.njit(_function(self.name, digest, source), error_model="numpy")
+        return _function(self.name, digest, source)
+
+
+def equations_cache() -> Path:
+    """Where generated equations are kept: ``$NUMBA_CACHE_DIR/visviva-equations`` if Numba's
+    cache is moved there, else ``visviva/equations`` in the user's cache directory
+    (``$XDG_CACHE_HOME``, by default ``~/.cache``)."""
+    numba_cache = os.environ.get("NUMBA_CACHE_DIR")
+    if numba_cache:
+        return Path(numba_cache) / "visviva-equations"
+    home = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(home) / "visviva" / "equations"
+
+
+def _function(name: str, digest: str, source: str) -> Any:
+    """Function ``name`` of ``source``, compiled in memory."""
+    filename = f"<visviva generated {name} {digest[:12]}>"
+    linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
+    namespace: dict[str, Any] = {}
+    exec(compile(source, filename, "exec"), namespace)
+    return namespace[name]
+
+
+def _cached_function(name: str, digest: str, source: str) -> Any | None:
+    """Function ``name`` of ``source`` from its file in the equations cache (written first if
+    it is not there, atomically: processes that write it at once write the same text), or
+    ``None`` if the cache cannot be written or read."""
+    path = equations_cache() / f"{name}_{digest}.py"
+    try:
+        if not path.exists():
+            path.parent.mkdir(parents=True, exist_ok=True)
+            handle, temporary = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+            with os.fdopen(handle, "w") as file:
+                file.write(source)
+            os.replace(temporary, path)
+        elif path.read_text() != source:
+            return None  # not ours after all: compile from memory
+        spec = importlib.util.spec_from_file_location(f"visviva_equations_{digest}", path)
+        if spec is None or spec.loader is None:
+            return None
+        module = importlib.util.module_from_spec(spec)
+        # Importable by name: Numba's cache refers to the function's module by it.
+        sys.modules[spec.name] = module
+        spec.loader.exec_module(module)
+    except (OSError, SyntaxError, UnicodeDecodeError):
+        return None
+    return getattr(module, name, None)
 
 
 class UnrolledLDLT:
