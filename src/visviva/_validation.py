@@ -32,6 +32,11 @@ def describe(value: Any) -> str:
     return text if len(text) <= 80 else text[:77] + "..."
 
 
+def with_article(noun: str) -> str:
+    """``noun`` after "a" or "an": ``with_article("ellipsoid")`` is "an ellipsoid"."""
+    return f"{'an' if noun[:1] in 'aeiou' else 'a'} {noun}"
+
+
 def real_number(
     name: str,
     value: Any,

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import describe
+from .._validation import describe, with_article
 from ..errors import ModelError
 from .mass_properties import MassProperties
 
@@ -49,7 +49,7 @@ def dimension(shape: str, name: str, value: Any, unit: str, *, zero: bool = Fals
     requirement = "zero or positive" if zero else "positive"
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ModelError(
-            f"`{name}` of a {shape} must be a {requirement} number in {unit} "
+            f"`{name}` of {with_article(shape)} must be a {requirement} number in {unit} "
             f"(got {describe(value)})"
         )
     try:
@@ -58,7 +58,7 @@ def dimension(shape: str, name: str, value: Any, unit: str, *, zero: bool = Fals
         number = math.inf
     if not math.isfinite(number) or not (number >= 0.0 if zero else number > 0.0):
         raise ModelError(
-            f"`{name}` of a {shape} must be {requirement} and finite, in {unit} "
+            f"`{name}` of {with_article(shape)} must be {requirement} and finite, in {unit} "
             f"(got {describe(value)})"
         )
     return number
@@ -72,13 +72,14 @@ def dimensions3(shape: str, name: str, value: Any, meaning: str) -> np.ndarray:
         array = None
     if array is None or array.shape != (3,):
         raise ModelError(
-            f"`{name}` of a {shape} must be 3 positive numbers in m, its {meaning} "
+            f"`{name}` of {with_article(shape)} must be 3 positive numbers in m, its {meaning} "
             f"(got {describe(value)})"
         )
     bad = ~(np.isfinite(array) & (array > 0.0))
     if bad.any():
         raise ModelError(
-            f"`{name}` of a {shape} must be 3 positive finite numbers in m, its {meaning}; "
+            f"`{name}` of {with_article(shape)} must be 3 positive finite numbers in m, its "
+            f"{meaning}; "
             f"entry {int(np.flatnonzero(bad)[0])} is {describe(array[bad][0])}"
         )
     return array
@@ -101,7 +102,8 @@ def _result(
     figures = np.array([volume, mass, *moments])
     if not (np.isfinite(figures).all() and (figures > 0.0).all()):
         raise ModelError(
-            f"a {shape} of {described} and `density` {density!r} kg/m³ has volume {volume:.3g} "
+            f"{with_article(shape)} of {described} and `density` {density!r} kg/m³ has volume "
+            f"{volume:.3g} "
             f"m³, mass {mass:.3g} kg and principal moments {describe(np.array(moments))} "
             "kg·m²: beyond what float64 holds (about 1e-308 to 1e308); express its "
             "dimensions and density in other units"
@@ -116,7 +118,7 @@ def box_mass_properties(extents: Any, density: Any) -> MassProperties:
     >>> box_mass_properties([1.0, 2.0, 3.0], density=1000.0).inertia.diagonal().tolist()
     [6500.0, 5000.0, 2500.0]
     """
-    a, b, c = dimensions3("box", "extents", extents, "full edge lengths along x, y, z")
+    a, b, c = dimensions3("box", "extents", extents, "full edge lengths along x, y, z").tolist()
     rho = _density("box", density)
     volume = a * b * c
     m = rho * volume
@@ -136,7 +138,7 @@ def sphere_mass_properties(radius: Any, density: Any) -> MassProperties:
 def ellipsoid_mass_properties(semi_axes: Any, density: Any) -> MassProperties:
     """A solid ellipsoid of ``semi_axes`` ``(a, b, c)`` [m] along x, y, z, centred on the
     origin: V = 4πabc/3, I = m diag(b² + c², a² + c², a² + b²)/5."""
-    a, b, c = dimensions3("ellipsoid", "semi_axes", semi_axes, "semi-axes along x, y, z")
+    a, b, c = dimensions3("ellipsoid", "semi_axes", semi_axes, "semi-axes along x, y, z").tolist()
     rho = _density("ellipsoid", density)
     volume = 4.0 / 3.0 * math.pi * a * b * c
     m = rho * volume

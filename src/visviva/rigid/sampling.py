@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import describe, whole_number
+from .._validation import describe, whole_number, with_article
 from ..deformables.mesh_files import read_triangle_mesh
 from ..errors import ModelError
 from ..geometry.mesh_topology import check_closed_mesh
@@ -241,7 +241,8 @@ def sampled_mass_properties(
     figures = np.concatenate([[result.mass, result.mass_error], result.inertia.ravel()])
     if not np.isfinite(figures).all():
         raise ModelError(
-            f"a {shape} of `density` {rho!r} kg/m³ and volume about {result.volume:.3g} m³ has "
+            f"{with_article(shape)} of `density` {rho!r} kg/m³ and volume about "
+            f"{result.volume:.3g} m³ has "
             "a mass or inertia beyond what float64 holds; express its dimensions and density "
             "in other units"
         )

@@ -12,7 +12,7 @@ import os
 from dataclasses import dataclass
 from typing import Any
 
-from .._validation import describe, did_you_mean
+from .._validation import describe, did_you_mean, with_article
 from ..errors import ModelError
 from .mass_properties import MassProperties
 from .mesh_integrals import mesh_file_mass_properties, mesh_mass_properties
@@ -63,14 +63,15 @@ def shape_dimensions(shape: Any, given: dict[str, Any]) -> Dimensions:
     extra = sorted(set(present) - set(wanted))
     if extra:
         raise ModelError(
-            f"`{extra[0]}` is not a dimension of a {shape}; a {shape} takes "
+            f"`{extra[0]}` is not a dimension of {with_article(shape)}; "
+            f"{with_article(shape)} takes "
             f"{' and '.join(f'`{name}`' for name in wanted)}"
             + (" (or `path`, a mesh file)" if shape == "mesh" and wanted != ("path",) else "")
         )
     missing = [name for name in wanted if name not in present]
     if missing:
         raise ModelError(
-            f"a {shape} needs `{missing[0]}`; its dimensions are "
+            f"{with_article(shape)} needs `{missing[0]}`; its dimensions are "
             f"{' and '.join(f'`{name}`' for name in wanted)}"
             + (" (or `path`, a mesh file)" if shape == "mesh" else "")
         )
