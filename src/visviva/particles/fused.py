@@ -125,7 +125,10 @@ class FusedParticles:
         self._spring_force = np.empty(
             (3, 0 if self._springs[0] is None else len(self._springs[0][0]))
         )
-        self.pinned = pinned if pinned is not None and pinned.any() else None
+        # A writable copy: a read-only array is another type to Numba, another compilation.
+        self.pinned = (
+            np.array(pinned, dtype=np.bool_) if pinned is not None and pinned.any() else None
+        )
         general = contacts or self.emission is not None or len(laws) > 0
         self._special = np.zeros(count, dtype=np.bool_) if general else None
         # The working copy: positions and velocities, (3, N) each (one contiguous array per
@@ -547,9 +550,36 @@ def _fused(
         # The watch's check (a particle flagged wrongly costs only the watch's exact check).
         extent = abs(px) + abs(py) + abs(pz) + abs(ux) + abs(uy) + abs(uz)
         suspects += 0 if extent <= limit else 1
-    if pending == 0:
+    if special is None or pending == 0:
         return suspects
-    # Pass 2: the special particles, each by the general path.
+    return suspects + _general_pass(
+        x, y, z, vx, vy, vz, inverse_mass, h, g, drag, air, damping, kinds, parameters,
+        law_masks, alive, radius, age, lifetime, size, slot_emitter, size_ramps, end,
+        collider_masks, common_mask, restitution, friction, resting, toi, planes, rows, others,
+        everything, limit, special, spring_force, lists, point_force,
+    )  # fmt: skip
+
+
+# fmt: off
+@njit(cache=True, parallel=True, error_model="numpy")
+def _general_pass(
+    x, y, z, vx, vy, vz, inverse_mass, h, g, drag, air, damping, kinds, parameters, law_masks,
+    alive, radius, age, lifetime, size, slot_emitter, size_ramps, end,
+    collider_masks, common_mask, restitution, friction, resting, toi, planes, rows, others,
+    everything, limit, special, spring_force, lists, point_force,
+):  # pragma: no cover - compiled
+    """Pass 2 of :func:`_fused`: each ``special`` particle by the general path from its start
+    values (in place); returns how many may be beyond ``limit`` or not finite.
+
+    A function of its own, not inlined: it holds the collision stage's whole per-particle
+    path, and the pass-1 kernel is compiled once for each scene shape (which planes, springs,
+    pins); this pass depends on fewer of them, so each of its variants is compiled (and
+    cached) once and shared by the pass-1 variants that call it.
+    """
+    # fmt: on
+    one = np.uint64(1)
+    gx, gy, gz, wx, wy, wz = g[0], g[1], g[2], air[0], air[1], air[2]
+    suspects = 0
     for i in prange(end):
         if not special[i]:
             continue
