@@ -25,7 +25,9 @@ it). Then, in two passes:
 2. a pass over those few, each by the general path from its start values: the fields by their
    law (:mod:`visviva.forces.laws`), the collision stage's own per-particle function
    (:func:`visviva.collision.response.resolve`), the emission stage's ageing and death
-   (:func:`visviva.particles.emission.age_one`);
+   (:func:`visviva.particles.emission.age_one`). A kernel of its own, called by pass 1's
+   when some particle needs it: pass 1 is compiled once for each scene shape, this pass for
+   fewer, and its compilation (most of the whole, for the collision stage it holds) is shared;
 
 then the step's births (:meth:`~visviva.particles.emission.Emission.give_birth`) and the
 handles' particles put on their paths at the step's end (:class:`~.handles.Handles`; pinned in
@@ -50,7 +52,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numba import njit, prange
 
-from ..collision.colliders import UNROLLED_PLANES
+from ..collision.colliders import UNROLLED_PLANES, ColliderSet
 from ..collision.queries import plane_distance
 from ..collision.response import ParticleCollisions, _contact, _tolerance, resolve
 from ..forces.fields import Attractor, Damping, Drag, QuadraticDrag, UniformGravity, Vortex
@@ -113,7 +115,9 @@ class FusedParticles:
         self.collisions = next((s for s in stages if isinstance(s, ParticleCollisions)), None)
         self.emission = next((s for s in stages if isinstance(s, Emission)), None)
         self.handles = next((s for s in stages if isinstance(s, Handles)), None)
-        self._collision, contacts = _collision_arguments(self.collisions)
+        self._pass_1_collisions, self._colliders, contacts = _collision_arguments(
+            self.collisions, count
+        )
         # Which particles take the kernel's pass 2 (none can without emitters, fields by law,
         # and colliders other than a first plane without time of impact).
         # Springs on lattices are summed per point by their stencils, into ``_point_force``
@@ -121,10 +125,10 @@ class FusedParticles:
         # ``_spring_force`` (each spring's force on its first particle) and the CSR gather.
         self._stencils = [f.stencil for f in springs if f.stencil is not None]
         self._point_force = np.zeros((3, count if self._stencils else 0))
-        self._springs = _spring_arguments([f for f in springs if f.stencil is None], count)
-        self._spring_force = np.empty(
-            (3, 0 if self._springs[0] is None else len(self._springs[0][0]))
+        self._springs, self._lists = _spring_arguments(
+            [f for f in springs if f.stencil is None], count
         )
+        self._spring_force = np.empty((3, 0 if self._springs is None else len(self._springs[0])))
         # A writable copy: a read-only array is another type to Numba, another compilation.
         self.pinned = (
             np.array(pinned, dtype=np.bool_) if pinned is not None and pinned.any() else None
@@ -186,12 +190,19 @@ class FusedParticles:
             self._load(state)
         carried = dict(state.carried)
         emission = self.emission
-        springs, lists = self._springs
-        if springs is not None:
-            spring_forces(*springs, *self._x, *self._v, *self._spring_force)
+        if self._springs is not None:
+            spring_forces(*self._springs, *self._x, *self._v, *self._spring_force)
         for stencil in self._stencils:
             start = stencil.start
             stencil.forces(self._x, self._v, self._point_force[:, start : start + stencil.points])
+        alive, radius = carried["particle_alive"], carried["particle_radius"]
+        if emission is None:
+            age, ageing, ages = _NO_AGES[0], (None, None), _NO_AGES[1:]
+        else:
+            age, lifetime = carried["particle_age"], carried["particle_lifetime"]
+            ageing = (lifetime, emission.slot_ramped)
+            ages = (lifetime, carried["particle_size"], emission.slot_emitter, emission.size_ramps)
+        has_laws = self.kinds.shape[0] > 0
         suspects = _fused(
             *self._x,
             *self._v,
@@ -201,20 +212,29 @@ class FusedParticles:
             self.drag,
             self.air,
             self.damping,
-            self.kinds if self.kinds.shape[0] else None,
-            self.parameters,
-            self.law_masks,
-            carried["particle_alive"],
-            carried["particle_radius"],
-            *_emission_arguments(carried, emission),
+            self.law_masks if has_laws else None,
+            alive,
+            radius,
+            age,
+            *ageing,
             self._end,
-            *self._collision,
+            *self._pass_1_collisions,
             limit,
             self._special,
-            None if springs is None else self._spring_force,
-            lists,
+            None if self._springs is None else self._spring_force,
+            self._lists if self._springs is not None else None,
             self._point_force if self._stencils else None,
             self.pinned,
+            (
+                self.kinds,
+                self.parameters,
+                self.law_masks,
+                *ages,
+                *self._colliders,
+                self._spring_force,
+                self._lists,
+                self._point_force,
+            ),
         )
         if emission is not None:
             born = emission.give_birth(state.t, t_after, self._x.T, self._v.T, carried)
@@ -291,12 +311,12 @@ _FIELDS = (*_FOLDED, QuadraticDrag, Attractor, Vortex)
 
 def _spring_arguments(
     springs: list[Springs], count: int
-) -> tuple[tuple[np.ndarray, ...] | None, tuple[np.ndarray, ...] | None]:
-    """The scene's springs as one set for the kernels: ``(first, second, rest, k, c)`` and
-    each particle's CSR lists of the springs it is the first and the second end of (``None``,
-    ``None`` without springs)."""
+) -> tuple[tuple[np.ndarray, ...] | None, tuple[np.ndarray, ...]]:
+    """The scene's springs as one set for the kernels: ``(first, second, rest, k, c)``
+    (``None`` without springs) and each particle's CSR lists of the springs it is the first
+    and the second end of (empty lists without springs)."""
     if not springs:
-        return None, None
+        return None, (*spring_incidence(np.zeros(0, np.int64), count),) * 2
     pairs = np.concatenate([f.pairs for f in springs])
     ends = tuple(np.ascontiguousarray(pairs[:, e], dtype=np.int32) for e in range(2))
     values = tuple(
@@ -322,49 +342,43 @@ def _law(force: Force) -> tuple[int, list[float]]:
     raise TypeError(f"{type(force).__name__} has no fused law")  # pragma: no cover
 
 
-def _emission_arguments(
-    carried: dict[str, np.ndarray], emission: Emission | None
-) -> tuple[Any, ...]:
-    if emission is None:
-        return (None,) * 6
-    return (
-        carried["particle_age"],
-        carried["particle_lifetime"],
-        carried["particle_size"],
-        emission.slot_emitter,
-        emission.size_ramps,
-        emission.slot_ramped,
-    )
+#: The ageing arrays (age, lifetime, size, slot emitter, size ramps) without emitters.
+_NO_AGES = (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0, np.int64), np.zeros((0, 1, 2)))
 
 
-def _collision_arguments(collisions: ParticleCollisions | None) -> tuple[tuple[Any, ...], bool]:
-    """The collision stage for the kernel, and whether some contacts need pass 2.
+def _collision_arguments(
+    collisions: ParticleCollisions | None, count: int
+) -> tuple[tuple[Any, ...], tuple[Any, ...], bool]:
+    """The collision stage for the kernels: what pass 1 takes, what pass 2 takes, and whether
+    some contacts need pass 2.
 
-    First what pass 1 takes: the particles' collider masks (``None`` if every particle meets
-    the same colliders, then given as that one mask: 8 B a particle less to read); the first
-    collider if it is a plane (point, normal, thickness), its mask bit (0 if it is not a
-    plane) and its restitution, friction and resting speed; the other leading planes and
-    those with time of impact, each as point, normal, thickness and mask bit, one after the
-    other in a flat tuple (``None`` if none): the kernel is compiled for their number (a scene
-    with a floor only does no test for other planes). Then what :func:`resolve` takes, for
-    pass 2.
+    Pass 1 takes the particles' collider masks (``None`` if every particle meets the same
+    colliders, then given as that one mask: 8 B a particle less to read); the first collider
+    if it is a plane (point, normal, thickness), its mask bit (0 if it is not a plane) and its
+    restitution, friction and resting speed; the other leading planes and those with time of
+    impact, each as point, normal, thickness and mask bit, one after the other in a flat tuple
+    (``None`` if none): it is compiled for their number (a scene with a floor only does no
+    test for other planes); and the first mask bit of the other colliders (``None`` if none).
+    Pass 2 takes every particle's mask, the responses and the colliders as :func:`resolve`
+    takes them, always as arrays (empty without colliders): it is compiled once for all scenes.
     """
     far = (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, np.inf)
     if collisions is None:
-        no_rows = np.zeros((0, 7))
-        pass_1 = (None, np.uint64(0), far, np.uint64(0), 0.0, 0.0, 0.0, None, None)
-        return (*pass_1, None, None, None, None, 0, no_rows, None, None), False
+        pass_1 = (None, np.uint64(0), far, np.uint64(0), 0.0, 0.0, 0.0, None, None, None)
+        empty = ColliderSet(()).kernel_arrays
+        pass_2 = (np.zeros(count, np.uint64), *(np.zeros(0),) * 3, np.zeros(0, np.bool_))
+        return pass_1, (*pass_2, 0, empty[2], empty[1:]), False
     r = collisions.response
     masks = collisions.masks
     common = bool(masks.shape[0]) and bool((masks == masks[0]).all())
-    rows = collisions.colliders.rows
-    leading = min(collisions.colliders.planes, UNROLLED_PLANES)
+    colliders = collisions.colliders
+    rows = colliders.rows
+    leading = min(colliders.planes, UNROLLED_PLANES)
     planes = [(*(float(v) for v in rows[k, :7]), float(k)) for k in range(leading)]
     near = sum(planes[1:], ()) or None
     impact = sum((plane for plane in planes if r.time_of_impact[int(plane[7])]), ()) or None
-    general = collisions.kernel_arguments()
-    others = general[3]
-    arguments = (
+    others = np.uint64(leading) if len(colliders) > leading else None
+    pass_1 = (
         None if common else masks,
         masks[0] if common else np.uint64(0),
         planes[0][:7] if leading else far,
@@ -372,12 +386,12 @@ def _collision_arguments(collisions: ParticleCollisions | None) -> tuple[tuple[A
         *((r.restitution[0], r.friction[0], r.resting_speed[0]) if leading else (0.0,) * 3),
         near,
         impact,
-        r.restitution,
-        r.friction,
-        r.resting_speed,
-        *general,
+        others,
     )
-    return arguments, near is not None or impact is not None or others is not None
+    pass_2 = (masks, r.restitution, r.friction, r.resting_speed, r.time_of_impact)
+    arrays = colliders.kernel_arrays
+    needed = near is not None or impact is not None or others is not None
+    return pass_1, (*pass_2, colliders.planes, rows, arrays[1:]), needed
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -457,20 +471,22 @@ def _impact_possible(plane, bit, sx, sy, sz, px, py, pz, r):  # pragma: no cover
 # fmt: off
 @njit(cache=True, parallel=True, error_model="numpy")
 def _fused(
-    x, y, z, vx, vy, vz, inverse_mass, h, g, drag, air, damping, kinds, parameters, law_masks,
-    alive, radius, age, lifetime, size, slot_emitter, size_ramps, slot_ramped, end,
-    collider_masks, common_mask, floor, floor_bit, e, mu, rests, near_planes, impact_planes,
-    restitution, friction, resting, toi, planes, rows, others, everything,
-    limit, special, spring_force, lists, point_force, pinned,
+    x, y, z, vx, vy, vz, inverse_mass, h, g, drag, air, damping, law_masks, alive, radius,
+    age, lifetime, slot_ramped, end, collider_masks, common_mask, floor, floor_bit, e, mu,
+    rests, near_planes, impact_planes, others, limit, special, spring_force, lists,
+    point_force, pinned, general,
 ):  # pragma: no cover - compiled
     """The step of the module docstring for every particle, in place (positions ``x, y, z``
-    and velocities ``vx, vy, vz``, one array per component; ``special`` is scratch, ``None``
-    if no particle can need pass 2; the springs' forces come per spring, ``spring_force``
-    summed through ``lists``, and per particle, ``point_force``, each ``None`` if there are
-    none); returns how many particles may be beyond ``limit`` or
-    not finite."""
+    and velocities ``vx, vy, vz``, one array per component); returns how many particles may be
+    beyond ``limit`` or not finite.
+
+    Compiled for the scene's shape: ``None`` stands for what the scene has not (fields by
+    law, ``law_masks``; emitters, ``lifetime, slot_ramped``; other colliders, ``others``,
+    their first mask bit; springs, per spring ``spring_force`` summed through ``lists`` or per
+    particle ``point_force``; pins; ``special``, scratch, if no particle can need pass 2), and
+    the leading planes come as flat tuples (:func:`_collision_arguments`). ``general`` is
+    what only :func:`_general_pass` takes."""
     # fmt: on
-    beyond = np.uint64(min(planes, UNROLLED_PLANES))  # mask bits from here on: other colliders
     one = np.uint64(1)
     # Loop invariants in registers: the compiler cannot tell that the stores miss them.
     gx, gy, gz, wx, wy, wz = g[0], g[1], g[2], air[0], air[1], air[2]
@@ -517,8 +533,8 @@ def _fused(
                 plane = _plane_at(near_planes, k)
                 odd |= _near(plane, (mask >> np.uint64(plane[7])) & one, px, py, pz, r)
         if others is not None:
-            odd |= (mask >> beyond) != 0
-        if kinds is not None:
+            odd |= (mask >> others) != 0
+        if law_masks is not None:
             odd |= law_masks[i] != 0
         # A pinned particle keeps its place (and needs nothing else: pinned particles are
         # not emitted, and colliders skip them).
@@ -528,7 +544,7 @@ def _fused(
             odd &= not held
         # Only emitted particles die: without emitters, every slot is alive.
         live = True
-        if age is not None:
+        if lifetime is not None:
             live = alive[i]
             older = age[i] + h
             # One that dies, or whose size follows a ramp, is special.
@@ -539,7 +555,7 @@ def _fused(
             pending += odd
         # A free slot stays parked; a special particle keeps its start for pass 2.
         keep = live & (not odd) & (not held)
-        if age is not None:
+        if lifetime is not None:
             age[i] = older if keep else age[i]
         x[i] = px if keep else sx
         y[i] = py if keep else sy
@@ -553,30 +569,34 @@ def _fused(
     if special is None or pending == 0:
         return suspects
     return suspects + _general_pass(
-        x, y, z, vx, vy, vz, inverse_mass, h, g, drag, air, damping, kinds, parameters,
-        law_masks, alive, radius, age, lifetime, size, slot_emitter, size_ramps, end,
-        collider_masks, common_mask, restitution, friction, resting, toi, planes, rows, others,
-        everything, limit, special, spring_force, lists, point_force,
+        x, y, z, vx, vy, vz, inverse_mass, h, g, drag, air, damping, alive, radius, age, end,
+        limit, special, general,
     )  # fmt: skip
 
 
-# fmt: off
 @njit(cache=True, parallel=True, error_model="numpy")
 def _general_pass(
-    x, y, z, vx, vy, vz, inverse_mass, h, g, drag, air, damping, kinds, parameters, law_masks,
-    alive, radius, age, lifetime, size, slot_emitter, size_ramps, end,
-    collider_masks, common_mask, restitution, friction, resting, toi, planes, rows, others,
-    everything, limit, special, spring_force, lists, point_force,
+    x, y, z, vx, vy, vz, inverse_mass, h, g, drag, air, damping, alive, radius, age, end,
+    limit, special, general,
 ):  # pragma: no cover - compiled
     """Pass 2 of :func:`_fused`: each ``special`` particle by the general path from its start
-    values (in place); returns how many may be beyond ``limit`` or not finite.
+    values, in place; returns how many may be beyond ``limit`` or not finite.
 
-    A function of its own, not inlined: it holds the collision stage's whole per-particle
-    path, and the pass-1 kernel is compiled once for each scene shape (which planes, springs,
-    pins); this pass depends on fewer of them, so each of its variants is compiled (and
-    cached) once and shared by the pass-1 variants that call it.
+    Everything comes as arrays, empty for what the scene has not, and is tested at run time
+    (this pass visits few particles), so that one compilation serves every scene. The arrays
+    it writes are arguments of their own, ``general`` holds only arrays it reads: with the
+    ages unpacked from it, Numba 0.68's parallel loop here lost their stores (tests/test_fused.py
+    compares the ages with the generic pipeline's).
     """
-    # fmt: on
+    (
+        kinds, parameters, law_masks, lifetime, size, slot_emitter, size_ramps, masks,
+        restitution, friction, resting, toi, planes, rows, everything, spring_force, lists,
+        point_force,
+    ) = general  # fmt: skip
+    ageing = age.shape[0] > 0
+    colliding = restitution.shape[0] > 0
+    per_spring = spring_force.shape[1] > 0
+    per_point = point_force.shape[1] > 0
     one = np.uint64(1)
     gx, gy, gz, wx, wy, wz = g[0], g[1], g[2], air[0], air[1], air[2]
     suspects = 0
@@ -589,35 +609,31 @@ def _general_pass(
         ax = gx - c * svx + wx * w
         ay = gy - c * svy + wy * w
         az = gz - c * svz + wz * w
-        if spring_force is not None:
+        if per_spring:
             fx, fy, fz = _spring_sum(spring_force, lists, i)
             ax += w * fx
             ay += w * fy
             az += w * fz
-        if point_force is not None:
+        if per_point:
             ax += w * point_force[0, i]
             ay += w * point_force[1, i]
             az += w * point_force[2, i]
-        if kinds is not None:
-            bits = law_masks[i]
-            for k in range(kinds.shape[0]):
-                if (bits >> np.uint64(k)) & one:
-                    bx, by, bz = _law_acceleration(
-                        k, kinds, parameters, sx, sy, sz, svx, svy, svz, w
-                    )
-                    ax += bx
-                    ay += by
-                    az += bz
+        bits = law_masks[i]
+        for k in range(kinds.shape[0]):
+            if (bits >> np.uint64(k)) & one:
+                bx, by, bz = _law_acceleration(k, kinds, parameters, sx, sy, sz, svx, svy, svz, w)
+                ax += bx
+                ay += by
+                az += bz
         ux, uy, uz = svx + h * ax, svy + h * ay, svz + h * az
         px, py, pz = sx + h * ux, sy + h * uy, sz + h * uz
         r = radius[i]
-        if restitution is not None:  # the scene has colliders
-            mask = common_mask if collider_masks is None else collider_masks[i]
+        if colliding:
             px, py, pz, ux, uy, uz = resolve(
-                sx, sy, sz, svx, svy, svz, px, py, pz, ux, uy, uz, r, mask, h,
-                restitution, friction, resting, toi, planes, rows, others, everything,
+                sx, sy, sz, svx, svy, svz, px, py, pz, ux, uy, uz, r, masks[i], h,
+                restitution, friction, resting, toi, planes, rows, everything, everything,
             )  # fmt: skip
-        if age is not None:
+        if ageing:
             live, age[i], radius[i] = age_one(
                 True, age[i], lifetime[i], size[i], slot_emitter[i], size_ramps, h
             )
