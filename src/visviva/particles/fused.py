@@ -95,6 +95,8 @@ class FusedParticles:
         for force in forces:
             if isinstance(force, Springs):
                 continue
+            if not isinstance(force, _FIELDS):  # pragma: no cover - `of` admits no other
+                raise TypeError(f"the fused step has no {type(force).__name__}")
             every = force.targets.everything
             if isinstance(force, UniformGravity) and every:
                 self.gravity += force.gravity
@@ -196,6 +198,7 @@ class FusedParticles:
             start = stencil.start
             stencil.forces(self._x, self._v, self._point_force[:, start : start + stencil.points])
         alive, radius = carried["particle_alive"], carried["particle_radius"]
+        ageing: tuple[np.ndarray | None, ...]
         if emission is None:
             age, ageing, ages = _NO_AGES[0], (None, None), _NO_AGES[1:]
         else:

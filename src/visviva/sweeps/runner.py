@@ -24,7 +24,7 @@ import math
 import multiprocessing
 import multiprocessing.context
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import (
     CancelledError,
     Executor,
@@ -251,7 +251,7 @@ def _plan(pending: list[tuple[SweepRun, RunTask]], slots: int) -> list[RunTask |
 
 
 def _execute(
-    tasks: list[RunTask | BatchTask],
+    tasks: Sequence[RunTask | BatchTask],
     executor: Executor | Literal["serial"] | None,
     workers: int | None,
     collect: Callable[[list[dict[str, Any]]], bool],
