@@ -26,8 +26,8 @@ it). Then, in two passes:
    law (:mod:`visviva.forces.laws`), the collision stage's own per-particle function
    (:func:`visviva.collision.response.resolve`), the emission stage's ageing and death
    (:func:`visviva.particles.emission.age_one`). A kernel of its own, called by pass 1's
-   when some particle needs it: pass 1 is compiled once for each scene shape, this pass for
-   fewer, and its compilation (most of the whole, for the collision stage it holds) is shared;
+   when some particle needs it: pass 1 is compiled once for each scene shape, this pass once
+   for every scene (most of the compilation, for the collision stage it holds);
 
 then the step's births (:meth:`~visviva.particles.emission.Emission.give_birth`) and the
 handles' particles put on their paths at the step's end (:class:`~.handles.Handles`; pinned in
