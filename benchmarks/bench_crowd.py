@@ -7,7 +7,7 @@ and 10,000) on a jittered lattice at 1.5 agents/m² in a square yard walled by f
 radii 0.25–0.35 m, 80 kg, velocities drawn with 0.5 m/s per component, walking to a goal far
 off, the parameters of Helbing, Farkas & Vicsek (2000). One step of h = 5 ms:
 
-* visviva: ``Crowd.apply(before, after, h)``, the stage as the pipeline calls it: copy of the
+* visviva: ``Crowd.apply(before, after, h, work)``, the stage as the pipeline calls it: copy of the
   state, exits, grid rebuild on the live agents, the forces on every core, the kick;
 * SciPy + NumPy: ``cKDTree(x).query_pairs(r, output_type="ndarray")`` (one thread), the pair
   forces both ways by ``np.add.at``, the walls by the colliders' own ``signed_distance``, then
@@ -29,6 +29,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 import visviva as vv
+from visviva.ode.workspace import Workspace
 from visviva.particles.crowd import Crowd
 
 DENSITY = 1.5  # agents per m²
@@ -124,9 +125,10 @@ def main() -> int:
         stage = next(s for s in model.stages if isinstance(s, Crowd))
         state = vv.Simulation(model).raw_state
         x, v = np.array(state["particle_position"]), np.array(state["particle_velocity"])
-        ours = median_time(lambda: stage.apply(state, state, H), repeats)  # noqa: B023
+        work = Workspace()  # the run's storage, as a simulation keeps it between steps
+        ours = median_time(lambda: stage.apply(state, state, H, work), repeats)  # noqa: B023
         peer = median_time(lambda: numpy_step(stage, x, v), repeats)  # noqa: B023
-        got = stage.apply(state, state, H)["particle_velocity"]
+        got = stage.apply(state, state, H, work)["particle_velocity"]
         gap = float(np.abs(got - numpy_step(stage, x, v)).max())
         failed |= not gap <= 1e-9
         print(f"{n:>8} {ours * 1e3:>13.3f} {peer * 1e3:>17.3f} {peer / ours:>6.1f}"

@@ -64,6 +64,7 @@ from bench_integrators import (
 )
 from visviva.collision import particle_contacts
 from visviva.collision.particle_contacts import SPECULATIVE, ParticleContacts
+from visviva.ode.workspace import Workspace
 
 SEED = 20261125
 RADIUS = 0.01  # m
@@ -99,10 +100,13 @@ def visviva_step(x: np.ndarray, v: np.ndarray):
         iterations=SWEEPS, gravity=(0.0, 0.0, 0.0),
     )  # fmt: skip
 
+    work = Workspace()  # the run's storage, as a simulation keeps it between steps
+
     def call() -> tuple[np.ndarray, np.ndarray, int]:
         xs, vs = x.copy(), v.copy()
-        stage.resolve(x - H * v, xs, vs, np.full(x.shape[0], RADIUS), ALIVE[x.shape[0]], H)
-        return xs, vs, int(stage.last.first.shape[0])
+        radius = np.full(x.shape[0], RADIUS)
+        stage.resolve(x - H * v, xs, vs, radius, ALIVE[x.shape[0]], H, work=work)
+        return xs, vs, int(stage.solved(work).first.shape[0])
 
     return call
 

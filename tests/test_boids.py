@@ -17,6 +17,7 @@ from visviva.collision import ColliderSet, Sphere
 from visviva.errors import ModelError, SceneError
 from visviva.io.scene_files import parse_scene
 from visviva.ode.state import State
+from visviva.ode.workspace import Workspace
 from visviva.particles.boids import MAX_CROWDING, Boids, polarisation
 
 # ------------------------------------------------------------------------------------------
@@ -287,7 +288,7 @@ def test_no_two_boids_closer_than_the_separation_distance_with_min_distance(plan
     x = state["particle_position"].copy()
     x[1] = x[0] + [0.1, 0.0, 0.0]  # two boids pressed to a quarter of s
     pressed = state.from_parts(state.t, (x.ravel(), state.parts[1]))
-    after = stage.apply(pressed, pressed, 0.05)
+    after = stage.apply(pressed, pressed, 0.05, Workspace())
     moved = after["particle_position"] - x
     gap = np.linalg.norm(after["particle_position"][1] - after["particle_position"][0])
     assert gap >= s * (1.0 - 1e-9)  # SPACING_TOLERANCE
@@ -296,7 +297,7 @@ def test_no_two_boids_closer_than_the_separation_distance_with_min_distance(plan
     free = Boids(stage.targets, **{k: getattr(stage, k) for k in ("radius", "separation",
                  "max_speed", "max_force", "fov", "min_speed", "plane")},
                  **stage.weights, goal=stage.goal)  # fmt: skip
-    steered = free.apply(pressed, pressed, 0.05)["particle_velocity"]
+    steered = free.apply(pressed, pressed, 0.05, Workspace())["particle_velocity"]
     expected = steered + moved / 0.05
     speed = np.linalg.norm(expected, axis=1)
     expected[speed > 2.0] *= (2.0 / speed[speed > 2.0])[:, None]
@@ -347,10 +348,11 @@ def fly_at_sphere(look_ahead):
     state = model.initial_state()
     h = 0.02
     closest = np.inf
+    work = Workspace()
     for _ in range(600):
         q, v = state.parts
         after = State(state.t + h, (q + h * v, v.copy()), state.layout, state.carried)
-        state = stage.apply(state, after, h)
+        state = stage.apply(state, after, h, work)
         closest = min(closest, float(np.linalg.norm(state["particle_position"], axis=1).min()))
     return stage.look_ahead, closest, (state["particle_position"][:, 0] > 1.5).mean()
 
@@ -392,7 +394,7 @@ def test_speed_and_steering_bounds():
     q, vel = state.parts
     vel = vel * 50.0
     after = stage.apply(
-        state, State(0.01, (q + 0.01 * vel, vel), state.layout, state.carried), 0.01
+        state, State(0.01, (q + 0.01 * vel, vel), state.layout, state.carried), 0.01, Workspace()
     )
     speed = np.linalg.norm(after["particle_velocity"], axis=1)
     assert speed.max() <= 2.0 * (1 + 1e-12) and speed.min() >= 1.0 * (1 - 1e-12)

@@ -16,6 +16,7 @@ from visviva.analysis.crowds import exit_flow, exited, mean_flow
 from visviva.cli.main import main
 from visviva.demos.crowd import evacuate, room
 from visviva.errors import SceneError
+from visviva.ode.workspace import Workspace
 from visviva.particles.crowd import REACH, Crowd
 
 H = 0.01  # [s]
@@ -89,7 +90,7 @@ def test_two_agents_pressed_together_push_each_other_equally_and_oppositely():
     stage = _crowd_stage(model)
     start = vv.Simulation(model).raw_state
     state = start.from_parts(0.0, (PRESSED.ravel(), SLIDING.ravel()))
-    after = stage.apply(state, state, H)
+    after = stage.apply(state, state, H, Workspace())
     drive, agents, _ = stage.forces(state["particle_position"], state["particle_velocity"])
     mass = model.particle_mass[:, None]
     change = (mass * (after["particle_velocity"] - state["particle_velocity"])).sum(axis=0)

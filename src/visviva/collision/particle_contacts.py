@@ -65,6 +65,7 @@ from .contacts import CLASSES, COLLIDING, DEFAULT_GAP, RESTING, SEPARATING
 
 if TYPE_CHECKING:
     from ..ode.state import State
+    from ..ode.workspace import Workspace
     from .response import ParticleCollisions
 
 __all__ = [
@@ -191,10 +192,6 @@ class ParticleContacts:
         size = math.hypot(*g)
         self.up = -g / size if size > 0.0 else np.zeros(3)
         self.colliders = colliders
-        self._grid: NeighbourGrid | None = None
-        #: The contacts of the latest :meth:`resolve` (of any simulation of the model), in
-        #: solve order, with their impulses: for inspection.
-        self.last: kernels.ContactArrays | None = None
 
     def carried_start(self) -> dict[str, np.ndarray]:
         """The carried parts this stage keeps, at the start: the impulses of the last step's
@@ -206,7 +203,7 @@ class ParticleContacts:
         return dict(zip(MEMORY, (np.zeros(count + 1, np.int64), np.zeros(0, np.int64),
                                  np.zeros(0), np.zeros((0, 3))), strict=True))  # fmt: skip
 
-    def apply(self, before: State, after: State, h: float) -> State:
+    def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
         """The state with the targeted spheres' collisions resolved (velocities) and their
         overlaps removed (positions)."""
         parts = tuple(np.array(part) for part in after.parts)
@@ -221,6 +218,7 @@ class ParticleContacts:
                 after["particle_alive"],
                 h,
                 memory,
+                work,
             )
         except ModelError as error:  # a sphere flew beyond the grid's reach of the origin
             raise SimulationError(f"particle collisions: {error}", t=after.t, step=None) from None
@@ -235,22 +233,25 @@ class ParticleContacts:
         alive: np.ndarray,
         h: float,
         memory: tuple[np.ndarray, ...] | None = None,
+        work: Workspace | None = None,
     ) -> tuple[np.ndarray, ...]:
         """Resolve the contacts of a step of ``h`` [s] from ``x0`` to ``x`` [m] in place on
         ``x`` and ``v`` [m/s] (``(N, 3)`` each); ``radius`` ``(N,)`` [m], ``alive`` ``(N,)``
         bool; ``memory``: the last step's impulses (:meth:`carried_start`'s parts) for the
-        warm start, or ``None``. Returns this step's. Non-finite positions are left to the
-        divergence watch (and nothing is remembered)."""
+        warm start, or ``None``; ``work``: the run's storage, which keeps the neighbour grid
+        and the contacts solved (``None``: fresh storage). Returns this step's impulses.
+        Non-finite positions are left to the divergence watch (and nothing is remembered)."""
+        scratch = _Scratch() if work is None else work.get(self, _Scratch)
         active = np.asarray(alive, dtype=np.bool_) & self.targets
         x0 = np.ascontiguousarray(x0, dtype=np.float64)
         radius = np.ascontiguousarray(radius, dtype=np.float64)
         largest, move, finite = detection.scan(x0, x, radius, active)
         if not finite or largest == 0.0:
-            self.last = None
+            scratch.solved = None
             return tuple(self.carried_start().values())
         slack = SPECULATIVE * 2.0 * largest + min(2.0 * move, MOTION_CAP * 2.0 * largest)
         reach = 2.0 * largest + slack
-        g = self._grid_over(x, active, reach)
+        g = scratch.grid_over(x, active, reach)
         parallel = g.order.shape[0] >= PARALLEL_MIN_POINTS
         pairs = detection.pair_contacts(g, x0, radius, reach, slack, parallel)
         found, law = self._collider_contacts(x, radius, g.order, slack)
@@ -268,8 +269,15 @@ class ParticleContacts:
             kernels.solve(
                 contacts, x, v, self.inverse_mass, self.iterations, self.iterations, parallel
             )
-        self.last = contacts
+        scratch.solved = contacts
         return tuple(kernels.remember(contacts, x.shape[0]))
+
+    def solved(self, work: Workspace) -> kernels.ContactArrays | None:
+        """The contacts the latest step of the run whose storage is ``work`` solved, in solve
+        order, with their impulses (``None`` before the first step, or if that step had
+        none): for inspection."""
+        scratch = work.peek(self)
+        return None if scratch is None else scratch.solved  # type: ignore[attr-defined]
 
     def pair_contacts(
         self, state: State | Mapping[str, np.ndarray], gap: float = DEFAULT_GAP
@@ -310,14 +318,6 @@ class ParticleContacts:
         kind[vn > self.resting_speed] = SEPARATING
         return PairContacts(first, second, point, normal, depth, vn, kind)
 
-    def _grid_over(self, x: np.ndarray, active: np.ndarray, reach: float) -> Any:
-        """The grid's arrays over the active spheres: the grid is kept while its radius is
-        within [reach, 1.25 reach]."""
-        if self._grid is None or not reach <= self._grid.radius <= 1.25 * reach:
-            self._grid = NeighbourGrid(reach)
-        self._grid.update(x, active)
-        return self._grid.arrays
-
     def _collider_contacts(
         self, x: np.ndarray, radius: np.ndarray, order: np.ndarray, slack: float
     ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
@@ -354,6 +354,25 @@ class ParticleContacts:
             (1.0 / height),
             layers,
         )
+
+
+class _Scratch:
+    """A run's storage for the stage: its neighbour grid (kept while its radius stays within
+    [reach, 1.25 reach], so that a pile at rest does not rebuild it) and the contacts the latest
+    step solved (:meth:`ParticleContacts.solved`)."""
+
+    __slots__ = ("grid", "solved")
+
+    def __init__(self) -> None:
+        self.grid: NeighbourGrid | None = None
+        self.solved: kernels.ContactArrays | None = None
+
+    def grid_over(self, x: np.ndarray, active: np.ndarray, reach: float) -> Any:
+        """The grid's arrays over the active spheres."""
+        if self.grid is None or not reach <= self.grid.radius <= 1.25 * reach:
+            self.grid = NeighbourGrid(reach)
+        self.grid.update(x, active)
+        return self.grid.arrays
 
 
 def _inverse_masses(value: Any) -> np.ndarray:

@@ -37,6 +37,7 @@ from .contacts import DEFAULT_GAP, Contacts, find_contacts
 
 if TYPE_CHECKING:
     from ..ode.state import State
+    from ..ode.workspace import Workspace
 from .tables import ColliderKind
 
 __all__ = ["PenaltyContact"]
@@ -102,7 +103,9 @@ class PenaltyContact:
             gap,
         )
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
         """Add the contact forces [N] to ``out``."""
         _penalty(
             self._touched,

@@ -42,6 +42,7 @@ from .tables import ColliderKind
 
 if TYPE_CHECKING:
     from ..ode.state import State
+    from ..ode.workspace import Workspace
 
 __all__ = ["MAX_IMPACTS", "ColliderResponse", "ParticleCollisions", "resolve"]
 
@@ -121,7 +122,7 @@ class ParticleCollisions:
             gap,
         )
 
-    def apply(self, before: State, after: State, h: float) -> State:
+    def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
         """The state with every particle moved out of the colliders and bounced."""
         parts = tuple(np.array(part) for part in after.parts)
         result = after.from_parts(after.t, parts)

@@ -125,7 +125,7 @@ def pit_measures(simulation: Simulation) -> dict[str, float]:
     contacts = stage.pair_contacts(state)
     pairs = float(contacts.depth.max() / radius.max()) if len(contacts) else 0.0
     floor = float(np.max(radius - state["particle_position"][:, 1]) / radius.max())
-    last = stage.last
+    last = stage.solved(simulation.system.workspace)
     if last is None:
         raise ValueError("the simulation has not taken a step yet")
     box = last.second < 0

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numba import njit, prange
 
+from ..ode.workspace import Workspace
 from .base import Force
 
 __all__ = ["ForceSum"]
@@ -27,6 +28,8 @@ class ForceSum:
     Args:
         forces: The forces.
         count: Number of particles ``N``.
+        work: The run's storage, which the forces keep their scratch in (default: a fresh
+            one). A sum belongs to one run: its Jacobians' block values are scratch too.
 
     Attributes:
         forces: The forces, in order.
@@ -42,9 +45,10 @@ class ForceSum:
         diagonal: ``(N,)`` the index of block ``(i, i)`` among the blocks.
     """
 
-    def __init__(self, forces: Sequence[Force], count: int) -> None:
+    def __init__(self, forces: Sequence[Force], count: int, work: Workspace | None = None) -> None:
         self.forces = tuple(forces)
         self.count = count
+        self.work = work if work is not None else Workspace()
         self.velocity_dependent = any(f.velocity_dependent for f in self.forces)
         self.conservative = all(f.conservative for f in self.forces)
         self.gradient_form = all(
@@ -74,10 +78,12 @@ class ForceSum:
         self._local = np.empty((2, filled.shape[0], 3, 3))
         self.blocks = int(keys.shape[0])
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
         """Add every force [N] into ``out`` ``(N, 3)``."""
         for force in self.forces:
-            force.accumulate(t, x, v, out)
+            force.accumulate(t, x, v, out, self.work)
 
     def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
         """The forces' potential energy [J] (over the particles ``alive``, if given)."""

@@ -4,7 +4,9 @@ Positions and velocities are structure-of-arrays ``(N, 3)`` float64 arrays [m], 
 world frame (Y up), ``N`` the particle capacity of the scene. A force:
 
 * *adds* its contribution [N] to ``out`` (so the model sums every force into one array without
-  temporaries), on the particles it targets;
+  temporaries), on the particles it targets, keeping any scratch arrays in the run's
+  :class:`~visviva.ode.workspace.Workspace` (a force is part of a shared model: it never
+  changes after it is built);
 * reports its potential energy [J] (0 for forces that have none: drag, wind, vortices), so
   every run can monitor the total energy; ``conservative`` says whether the force is ``−∇U``;
 * gives its exact Jacobians ``∂F/∂x`` and ``∂F/∂v`` as 3×3 blocks on a sparsity pattern fixed
@@ -23,9 +25,12 @@ force's ``F = −∇U`` the same way (``tests/test_forces.py``).
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..ode.workspace import Workspace
 
 __all__ = ["Force", "Targets", "diagonal_blocks"]
 
@@ -38,8 +43,14 @@ class Force(Protocol):
     #: True if the force depends on the velocities.
     velocity_dependent: ClassVar[bool]
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        """Add the force [N] on every targeted particle to ``out``, shape ``(N, 3)``."""
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
+        """Add the force [N] on every targeted particle to ``out``, shape ``(N, 3)``.
+
+        ``work`` is the run's storage, where a force that needs scratch arrays keeps them
+        (``None``: a call on its own, which makes fresh ones). A force holds nothing that
+        changes: many runs of one model evaluate it at once."""
         ...
 
     def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:

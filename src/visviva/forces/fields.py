@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from numba import njit
@@ -26,6 +26,9 @@ from .laws import (
     vortex_air_velocity,
     vortex_jacobian,
 )
+
+if TYPE_CHECKING:
+    from ..ode.workspace import Workspace
 
 __all__ = ["Attractor", "Damping", "Drag", "QuadraticDrag", "UniformGravity", "Vortex", "vector"]
 
@@ -84,7 +87,9 @@ class UniformGravity(_Field):
         # m_i g for every target, once: the force does not depend on the state.
         self._weight = self.mass[self.targets.indices, None] * self.gravity[None, :]
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
         """Add ``m_i g`` [N] to ``out`` ``(N, 3)``."""
         if self.targets.everything:
             out += self._weight
@@ -136,7 +141,9 @@ class Drag(_AirDrag):
         """In still air the drag is ``D v`` with ``D = −k I`` (see visviva.forces.ForceSum)."""
         return not np.any(self.air_velocity)
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
         """Add ``−k (v − w)`` [N] to ``out``."""
         k, w = self.coefficient, self.air_velocity
         if self.targets.everything:
@@ -167,7 +174,9 @@ class Damping(_Field):
         self.rate = real_number("rate", rate, nonnegative=True, unit=" 1/s")
         self._factor = (self.rate * self.mass[self.targets.indices])[:, None]
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
         """Add ``−γ m v`` [N] to ``out``."""
         if self.targets.everything:
             out -= self._factor * v
@@ -191,7 +200,9 @@ class QuadraticDrag(_AirDrag):
         air_velocity: The air's velocity ``w`` [m/s].
     """
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
         """Add the drag [N] to ``out``."""
         _quadratic_drag(self.targets.indices, v, *self.air_velocity, self.coefficient, out)
 
@@ -230,7 +241,9 @@ class Attractor(_Field):
     def _parameters(self) -> tuple[float, ...]:
         return (*self.point, self.strength, self.softening**2)
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
         """Add the attraction [N] to ``out``."""
         _attractor(self.targets.indices, x, self.mass, *self._parameters(), out)
 
@@ -279,7 +292,9 @@ class Vortex(_Field):
         factor = self.circulation / (2.0 * math.pi)
         return (*self.point, *self.axis, factor, self.core_radius**2, self.coefficient)
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
         """Add the vortex's drag [N] to ``out``."""
         _vortex(self.targets.indices, x, v, *self._parameters(), out)
 

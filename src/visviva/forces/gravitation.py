@@ -13,7 +13,7 @@ its spectrum from force differences (:mod:`visviva.analysis.advisor`).
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
@@ -26,6 +26,9 @@ from ..mechanics.gravity import (
     potential_energy,
 )
 from .base import Targets
+
+if TYPE_CHECKING:
+    from ..ode.workspace import Workspace
 
 __all__ = ["Gravitation"]
 
@@ -61,20 +64,24 @@ class Gravitation:
         self.G = real_number("G", G, positive=True, unit=" m³/(kg s²)")
         self.softening = real_number("softening", softening, nonnegative=True, unit=" m")
         self.method, self.theta = check_method(method, theta)
-        self._scratch = np.empty((len(self.targets), 3))
 
     def _bodies(self, x: np.ndarray) -> PointMasses:
         return PointMasses(x[self.targets.indices], self.masses, self.softening)
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
         """Add ``m_i a_i`` [N] to ``out`` for every target.
 
         Raises:
             ModelError: If two bodies coincide and there is no softening.
         """
-        accelerations = accelerations_into(
-            self._bodies(x), self.G, self.method, self.theta, self._scratch
-        )
+
+        def scratch() -> np.ndarray:
+            return np.empty((len(self.targets), 3))
+
+        into = scratch() if work is None else work.get(self, scratch)
+        accelerations = accelerations_into(self._bodies(x), self.G, self.method, self.theta, into)
         out[self.targets.indices] += self.masses[:, None] * accelerations
 
     def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:

@@ -26,13 +26,16 @@ force (compressed springs included) and ``f = −∇U`` without damping.
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from numba import njit, prange
 
 from ..errors import ModelError
 from .lattice_springs import SpringStencil
+
+if TYPE_CHECKING:
+    from ..ode.workspace import Workspace
 
 __all__ = ["Springs", "spring_forces", "spring_incidence"]
 
@@ -89,13 +92,9 @@ class Springs:
         # 32-bit indices.
         self._first = np.ascontiguousarray(self.pairs[:, 0], dtype=np.int32)
         self._second = np.ascontiguousarray(self.pairs[:, 1], dtype=np.int32)
-        # Each spring's force on its first particle, one array per component (the compiler
-        # vectorizes the force pass over springs only for contiguous components).
-        self._spring_force = np.empty((3, springs))
         self._touched = np.flatnonzero(
             np.diff(self._as_first[0]) + np.diff(self._as_second[0])
         ).astype(np.int64)
-        self._columns = np.empty((6, count))  # x, y, z, vx, vy, vz of every particle
         # The springs as a stencil, if they are a lattice's (see :mod:`.lattice_springs`),
         # and its force on each of the lattice's points.
         self.stencil = (
@@ -105,7 +104,6 @@ class Springs:
                 self.pairs, self.rest_length, self.stiffness, self.damping, *lattice
             )
         )
-        self._point_force = np.empty((3, 0 if self.stencil is None else self.stencil.points))
         # An undamped set of springs is conservative (instances may differ from the class).
         self.conservative = not np.any(self.damping)  # type: ignore[misc]
         self.velocity_dependent = bool(np.any(self.damping))  # type: ignore[misc]
@@ -113,23 +111,30 @@ class Springs:
     def __len__(self) -> int:
         return int(self.pairs.shape[0])
 
-    def accumulate(self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
         """Add every spring's force [N] on its two particles to ``out``: each spring's force
         in one parallel pass, then each particle's sum in another (no two threads write the
         same particle, and the sums run in a fixed order: the result does not depend on the
         thread count); or, on a lattice, each point's sum by the stencil."""
-        columns = self._columns
+        scratch = self._scratch() if work is None else work.get(self, self._scratch)
+        columns = scratch.columns
         _columns(x, v, columns)
         if self.stencil is not None:
-            self.stencil.forces(columns[:3], columns[3:], self._point_force)
-            _add_rows(self._point_force, self.stencil.start, out)
+            self.stencil.forces(columns[:3], columns[3:], scratch.forces)
+            _add_rows(scratch.forces, self.stencil.start, out)
             return
-        fx, fy, fz = self._spring_force
+        fx, fy, fz = scratch.forces
         spring_forces(
             self._first, self._second, self.rest_length, self.stiffness, self.damping,
             *columns, fx, fy, fz,
         )  # fmt: skip
         _gather(self._touched, *self._as_first, *self._as_second, fx, fy, fz, out)
+
+    def _scratch(self) -> _Scratch:
+        points = None if self.stencil is None else self.stencil.points
+        return _Scratch(self.count, len(self) if points is None else points)
 
     def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
         """``Σ ½ k (l − L)²`` [J] over the springs."""
@@ -186,6 +191,19 @@ class Springs:
             dfdx,
             dfdv,
         )
+
+
+class _Scratch:
+    """A run's arrays for :meth:`Springs.accumulate`: every particle's ``x, y, z, vx, vy, vz``
+    ``(6, N)``, and the forces ``(3, n)`` of each spring on its first particle (or of the
+    stencil on each lattice point), one array per component (the compiler vectorizes the
+    force pass only over contiguous components)."""
+
+    __slots__ = ("columns", "forces")
+
+    def __init__(self, count: int, rows: int) -> None:
+        self.columns = np.empty((6, count))
+        self.forces = np.empty((3, rows))
 
 
 def spring_incidence(ends: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:

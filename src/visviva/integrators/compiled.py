@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._memo import Memo
 from ..ode.batching import PARALLEL_MIN_SYSTEMS
 from .base import CompiledStep
 
@@ -41,13 +42,13 @@ __all__ = [
     "runge_kutta_step",
 ]
 
-_MEMO: dict[tuple[Any, ...], Any] = {}
+#: Compiled adapters, steps and runners by what they are built from, the most recently used
+#: kept (a runner holds the step and adapters it was built from, whatever the memo drops).
+_MEMO: Memo[Any] = Memo(128)
 
 
 def _memoized(key: tuple[Any, ...], build: Callable[[], Any]) -> Any:
-    if key not in _MEMO:
-        _MEMO[key] = build()
-    return _MEMO[key]
+    return _MEMO.get(key, build)
 
 
 def problem_key(problem: Problem) -> tuple[Any, ...] | None:

@@ -31,7 +31,6 @@ References:
 
 from __future__ import annotations
 
-import weakref
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -75,11 +74,6 @@ class FastMassSprings(Integrator):
     def __init__(self, *, iterations: int = 10) -> None:
         self.iterations = whole_number("iterations", iterations, minimum=1)
         self._fallback = BackwardEuler()
-        # Factorizations per system and step size: a memo (the same for every call), dropped
-        # with the system.
-        self._solvers: weakref.WeakKeyDictionary[Any, dict[float, _Global]] = (
-            weakref.WeakKeyDictionary()
-        )
 
     def stability_function(self, z: Any) -> np.ndarray:
         """Backward Euler's, which the iteration converges to."""
@@ -90,9 +84,11 @@ class FastMassSprings(Integrator):
         if springs is None or state.parts[0].ndim != 1:
             return self._fallback.step(system, state, dt)
         network = springs()
-        solver = self._solvers.setdefault(system, {}).get(dt)
+        # The factorizations of the run, per step size (a memo: the same for every call).
+        solvers: dict[float, _Global] = system.workspace.get(self, dict)
+        solver = solvers.get(dt)
         if solver is None:
-            solver = self._solvers[system][dt] = _Global(network, dt)
+            solver = solvers[dt] = _Global(network, dt)
         t = state.t
         q, v = state.parts
         count = network.mass.shape[0]

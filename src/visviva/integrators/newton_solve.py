@@ -55,7 +55,6 @@ class BlockNewtonSolve:
         self.preconditioner = preconditioner
         self.cg_rtol = real_number("cg_rtol", cg_rtol, positive=True)
         self.cg_max_iterations = whole_number("cg_max_iterations", cg_max_iterations, minimum=1)
-        self._hierarchy: Hierarchy | None = None  # the multigrid levels of the last pattern
 
     def _solve(
         self,
@@ -107,21 +106,33 @@ class BlockNewtonSolve:
             self.cg_rtol,
             self.cg_max_iterations,
             normals,
-            self._multigrid(stiffness.indptr, stiffness.indices, data),
+            self._multigrid(system, stiffness.indptr, stiffness.indices, data),
         )
         system.counters.krylov_iterations += iterations
         # Not converged within the iterations, or stopped by negative curvature: the iterate is
         # still a descent direction from CG (Newton's line search and stopping rule judge it).
         return direction.reshape(rhs.shape), positive
 
-    def _multigrid(self, indptr: np.ndarray, indices: np.ndarray, data: np.ndarray) -> Any:
+    def _multigrid(
+        self, system: System, indptr: np.ndarray, indices: np.ndarray, data: np.ndarray
+    ) -> Any:
         """The multigrid cycle of the Newton matrix (``None`` for block Jacobi); the levels
-        are built once per pattern."""
+        are built once per pattern and run, and kept in the run's workspace."""
         if self.preconditioner != "multigrid":
             return None
-        if self._hierarchy is None or not self._hierarchy.matches(indptr, indices):
-            self._hierarchy = Hierarchy(indptr, indices)
-        return self._hierarchy.cycle(data)
+        levels = system.workspace.get(self, _Levels)
+        if levels.hierarchy is None or not levels.hierarchy.matches(indptr, indices):
+            levels.hierarchy = Hierarchy(indptr, indices)
+        return levels.hierarchy.cycle(data)
+
+
+class _Levels:
+    """A run's multigrid hierarchy, for the pattern of its latest Newton matrix."""
+
+    __slots__ = ("hierarchy",)
+
+    def __init__(self) -> None:
+        self.hierarchy: Hierarchy | None = None
 
 
 def same_blocks(stiffness: Any, damping: Any) -> bool:

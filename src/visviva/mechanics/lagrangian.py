@@ -24,6 +24,7 @@ import numpy as np
 import sympy
 from sympy.core.function import AppliedUndef
 
+from .._memo import Memo
 from .._validation import describe, did_you_mean, real_number, state_array
 from ..errors import ModelError
 from ..ode.problems import FirstOrderProblem, SecondOrderProblem
@@ -136,7 +137,8 @@ class LagrangianSystem:
         self.velocity_dependent = self._derived.velocity_dependent
         self._points = self._read_points(points or ())
         self.edges = _read_edges(edges, len(self._points))
-        self._compiled: dict[str, EquationsCode] = {}
+        # Each flavour's code, built once even when many runs ask for it at once.
+        self._compiled: Memo[EquationsCode] = Memo(len(FLAVOURS))
 
     # --- symbols --------------------------------------------------------------------------
 
@@ -428,11 +430,10 @@ class LagrangianSystem:
                 f"unknown `backend` {flavour!r}.{did_you_mean(flavour, FLAVOURS)} "
                 f"Valid: {', '.join(FLAVOURS)}"
             )
-        if flavour not in self._compiled:
-            self._compiled[flavour] = EquationsCode(
-                self._derived, self._constants, flavour, points=self._points
-            )
-        return self._compiled[flavour]
+        return self._compiled.get(
+            flavour,
+            lambda: EquationsCode(self._derived, self._constants, flavour, points=self._points),
+        )
 
 
 # --- reading the user's description ---------------------------------------------------------

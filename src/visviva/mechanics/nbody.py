@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from .._memo import Memo
 from .._validation import real_number
 from ..errors import ModelError
 from ..ode.problems import SecondOrderProblem
@@ -44,7 +45,8 @@ __all__ = ["COMPILED_MAX_BODIES", "Bodies", "nbody_problem"]
 #: acceleration: below it, the cost of a step is Python overhead, not arithmetic.
 COMPILED_MAX_BODIES = 8
 
-_COMPILED: dict[tuple[Any, ...], tuple[Callable[..., None], Callable[..., float]]] = {}
+#: Compiled few-body functions by masses, G and softening, the most recently used kept.
+_COMPILED: Memo[tuple[Callable[..., None], Callable[..., float]]] = Memo(32)
 
 
 @dataclass(frozen=True)
@@ -168,7 +170,8 @@ def _compiled_functions(
     acceleration, which the simulation's divergence watch reports.
     """
     key = (tuple(float(m) for m in masses), G, eps2)
-    if key not in _COMPILED:
+
+    def build() -> tuple[Callable[..., None], Callable[..., float]]:
         import numba
 
         bodies = PointMasses(np.zeros((len(key[0]), 3)), np.array(key[0]), 0.0)
@@ -196,8 +199,9 @@ def _compiled_functions(
                 total += 0.5 * m[i] * speed2 - potential_factor * pairs
             return total
 
-        _COMPILED[key] = (acceleration, energy)
-    return _COMPILED[key]
+        return acceleration, energy
+
+    return _COMPILED.get(key, build)
 
 
 def nbody_problem(

@@ -13,6 +13,7 @@ import numpy as np
 
 from .._validation import did_you_mean
 from ..errors import ModelError, SceneProblem
+from ..geometry.neighbour_grid import NeighbourGrid
 from ..particles.boids import Boids
 from .model import ParticleGroup
 from .parts import Located, _shape
@@ -112,7 +113,8 @@ def boids_stages(
                 plane=entity.plane,
                 name=entity.name or f"boids{index}",
             )
-            stage.grid.update(arrays["position"][rows], arrays["alive"][rows])
+            # The boids must start within the neighbour grid's reach of the origin.
+            NeighbourGrid(stage.radius).update(arrays["position"][rows], arrays["alive"][rows])
         except ModelError as error:
             raise _at_field(where, str(error)) from None
         stages.append(stage)

@@ -12,35 +12,26 @@ systems.
 from __future__ import annotations
 
 import math
-from collections import OrderedDict
 from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
+from .._memo import Memo
 from ..ode.problems import Problem
 from .system_type import Parameter, SystemType
 
 __all__ = ["CLASSIC_SYSTEMS"]
 
-#: Systems built, by name and the values of their equations, most recently used last.
-_BUILT: OrderedDict[tuple[Any, ...], Any] = OrderedDict()
-#: Systems kept: deriving and compiling one costs seconds; a sweep over masses must not keep
-#: every one of them alive.
-MAX_BUILT = 32
+#: Systems built, by name and the values of their equations: deriving and compiling one costs
+#: seconds, and a sweep over masses must not keep every one of them alive.
+_BUILT: Memo[Any] = Memo(32)
 
 
 def _cached(name: str, values: Mapping[str, float], g: float, make: Callable[[], Any]) -> Any:
     """The system of ``name`` for ``values`` (its equations' parameters only: initial
     conditions do not change the equations, so every start shares one compiled system)."""
-    key = (name, tuple(sorted(values.items())), g)
-    if key in _BUILT:
-        _BUILT.move_to_end(key)
-    else:
-        _BUILT[key] = make()
-        if len(_BUILT) > MAX_BUILT:
-            _BUILT.popitem(last=False)
-    return _BUILT[key]
+    return _BUILT.get((name, tuple(sorted(values.items())), g), make)
 
 
 def _lagrangian(

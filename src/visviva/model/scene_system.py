@@ -48,6 +48,7 @@ from ..ode.mass import Mass
 from ..ode.problems import Problem, SecondOrderProblem
 from ..ode.state import Layout, PartView, State
 from ..ode.system import FirstOrderSystem, SecondOrderSystem
+from ..ode.workspace import Workspace
 from ..particles.handles import Handles
 
 if TYPE_CHECKING:
@@ -134,7 +135,8 @@ def scene_system(model: Model) -> System:
         )
     count = model.particle_count
     n = 3 * count
-    forces = ForceSum(model.forces, count)
+    work = Workspace()  # the run's: each system is made for one run
+    forces = ForceSum(model.forces, count, work)
     pieces = [(s.offset + n, s.offset + n + s.size, s.problem.system()) for s in model.systems]
     end = n + model.coordinate_count  # where the bodies start in q and v
     bodies = model.bodies
@@ -240,6 +242,7 @@ def scene_system(model: Model) -> System:
         jacobian=jacobian if analytic else None,
         energy=energy,
         layout=names,
+        workspace=work,
         kinematics=motion,
     )
     particles_only = count and not pieces and not b
@@ -248,7 +251,9 @@ def scene_system(model: Model) -> System:
     system.contact_constraints = _contact_constraints(model)
     springs = [f for f in model.forces if isinstance(f, Springs)]
     if springs and not pieces and not b:
-        network = SpringView(model.particle_mass, model.particle_pinned, tuple(springs), handles)
+        network = SpringView(
+            model.particle_mass, model.particle_pinned, tuple(springs), handles, work
+        )
         system.spring_network = lambda: network
     return system
 
@@ -275,12 +280,14 @@ class SpringView:
         pinned: ``(N,)`` which particles are held (in place, or by a handle).
         forces: The scene's :class:`~visviva.forces.Springs`.
         handles: The scene's handles, if it has any.
+        work: The run's storage (the springs' scratch).
     """
 
     mass: np.ndarray
     pinned: np.ndarray
     forces: tuple[Springs, ...]
     handles: Handles | None = None
+    work: Workspace | None = None
 
     def held_positions(self, t: float, x: np.ndarray) -> np.ndarray:
         """The positions ``x`` ``(N, 3)`` [m] with the particles on handles where their handles
@@ -315,7 +322,7 @@ class SpringView:
         out = np.zeros_like(x)
         still = np.zeros_like(x)
         for force in self.forces:
-            force.accumulate(t, x, still, out)
+            force.accumulate(t, x, still, out, self.work)
         return out
 
 

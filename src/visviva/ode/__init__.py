@@ -8,6 +8,7 @@ from .mass import Mass
 from .problems import FirstOrderProblem, Problem, SecondOrderProblem
 from .state import Layout, PartView, State
 from .system import FirstOrderSystem, SecondOrderSystem, System, WorkCounters
+from .workspace import Workspace
 
 __all__ = [
     "FirstOrderProblem",
@@ -21,4 +22,5 @@ __all__ = [
     "State",
     "System",
     "WorkCounters",
+    "Workspace",
 ]

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from .._memo import Memo
 from .functions import UserFunction
 
 __all__ = ["batched"]
@@ -25,8 +26,9 @@ __all__ = ["batched"]
 PARALLEL_MIN_SYSTEMS = 64
 
 #: Built wrappers by (user function, its form, result kind): every problem made from the same
-#: Numba function reuses one compiled loop instead of compiling its own (~0.5 s each).
-_WRAPPERS: dict[tuple[Any, ...], Callable[..., Any]] = {}
+#: Numba function reuses one compiled loop instead of compiling its own (~0.5 s each); the most
+#: recently used are kept.
+_WRAPPERS: Memo[Callable[..., Any]] = Memo(64)
 
 
 def batched(function: UserFunction, result: str) -> Callable[..., Any]:
@@ -44,9 +46,7 @@ def batched(function: UserFunction, result: str) -> Callable[..., Any]:
         ``(batch,)``.
     """
     key = (function.func, function.state_arguments, function.writes_out, result)
-    if key not in _WRAPPERS:
-        _WRAPPERS[key] = _build(function, result)
-    return _WRAPPERS[key]
+    return _WRAPPERS.get(key, lambda: _build(function, result))
 
 
 class _Split:

@@ -2,8 +2,9 @@
 
 A *system* evaluates a problem's functions on states (whole batches at once), supplies
 Jacobians — the user's or finite differences of the same function — and counts the work. One
-system is made per run, so the counters belong to that run; the problem itself stays immutable
-and reusable.
+system is made per run, so the counters — and the run's :class:`~.workspace.Workspace`, where
+the forces, stages and integrator keep their scratch — belong to that run; the problem itself
+stays immutable and reusable.
 
 Later models (particles, springs, rigid bodies) implement the same two interfaces, which is all
 an integrator ever sees.
@@ -21,6 +22,7 @@ from ..errors import ModelError
 from .batching import batched
 from .functions import UserFunction
 from .state import Layout, State
+from .workspace import Workspace
 
 if TYPE_CHECKING:
     from .mass import Mass
@@ -94,9 +96,12 @@ class FirstOrderSystem:
         energy: ``energy(t, y)``, one value per system, or ``None``.
         layout: The names of the state's parts (default: one part ``y``).
         counters: Work counters to add to (default: fresh ones).
+        workspace: The run's storage (default: a fresh one).
 
     Attributes:
         counters: Work done so far in this run.
+        workspace: The run's mutable storage (:class:`~.workspace.Workspace`), which the
+            forces, stages and integrator stepping this system keep their scratch in.
         layout: The names of the state's parts.
     """
 
@@ -110,12 +115,14 @@ class FirstOrderSystem:
         energy: Callable[..., Any] | None = None,
         layout: Layout | None = None,
         counters: WorkCounters | None = None,
+        workspace: Workspace | None = None,
     ) -> None:
         self._f = f
         self._jacobian = jacobian
         self._energy = energy
         self.layout = layout or Layout.first_order()
         self.counters = counters if counters is not None else WorkCounters()
+        self.workspace = workspace if workspace is not None else Workspace()
 
     @classmethod
     def of(
@@ -195,11 +202,14 @@ class SecondOrderSystem:
         energy: ``energy(t, q, v)``, one value per system, or ``None``.
         layout: The names of the state's parts (default: ``q`` and ``v``).
         counters: Work counters to add to (default: fresh ones).
+        workspace: The run's storage (default: a fresh one).
         kinematics: How the positions move with the velocities where that is not ``q' = v``
             (rigid bodies: orientations, momenta; see :class:`Kinematics`), or ``None``.
 
     Attributes:
         counters: Work done so far in this run.
+        workspace: The run's mutable storage (:class:`~.workspace.Workspace`), which the
+            forces, stages and integrator stepping this system keep their scratch in.
         mass: The mass matrix, or ``None``.
         velocity_dependent: True if the force takes ``v``.
         layout: The names of the state's parts.
@@ -218,6 +228,7 @@ class SecondOrderSystem:
         energy: Callable[..., Any] | None = None,
         layout: Layout | None = None,
         counters: WorkCounters | None = None,
+        workspace: Workspace | None = None,
         kinematics: Kinematics | None = None,
     ) -> None:
         self._force = force
@@ -228,6 +239,7 @@ class SecondOrderSystem:
         self._energy = energy
         self.layout = layout or Layout.positions_and_velocities()
         self.counters = counters if counters is not None else WorkCounters()
+        self.workspace = workspace if workspace is not None else Workspace()
 
     @classmethod
     def of(

@@ -87,6 +87,7 @@ from ..geometry.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid
 
 if TYPE_CHECKING:
     from ..ode.state import State
+    from ..ode.workspace import Workspace
 
 __all__ = ["MAX_LEADERS", "Boids", "polarisation"]
 
@@ -192,8 +193,7 @@ class Boids:
     ) -> None:
         self.name = name
         self.targets = _rows("targets", targets)
-        self.grid = NeighbourGrid(radius)
-        self.radius = self.grid.radius
+        self.radius = NeighbourGrid(radius).radius  # checked as the grid checks it
         self.separation = _bounded("separation", separation, positive=True, unit=" m")
         if self.separation > self.radius:
             raise ModelError(
@@ -248,7 +248,6 @@ class Boids:
             else _bounded("look_ahead", look_ahead, positive=True, unit=" m")
         )
         self.min_distance = None
-        self._spacing = None
         if min_distance is not None:
             self.min_distance = _bounded("min_distance", min_distance, positive=True, unit=" m")
             if self.min_distance > self.separation:
@@ -257,12 +256,9 @@ class Boids:
                     f"({self.separation!r} m): separation steers boids apart before they are "
                     "held apart"
                 )
-            self._spacing = NeighbourGrid(SPACING_REACH * self.min_distance)
         if plane not in (None, "xz"):
             raise ModelError(f'`plane` must be "xz" (a 2-D flock) or None (3-D), not {plane!r}')
         self.plane = plane
-        self._v = np.zeros((0, 3))
-        self._acc = np.zeros((0, 3))
 
     def parameters(self, h: float) -> np.ndarray:
         """The kernel's parameter vector for a step of ``h`` [s]."""
@@ -281,7 +277,11 @@ class Boids:
         p[_LOOK], p[_H], p[_PLANAR] = self.look_ahead, h, self.plane == "xz"
         return p
 
-    def apply(self, before: State, after: State, h: float) -> State:
+    def _scratch(self) -> _Scratch:
+        spacing = None if self.min_distance is None else SPACING_REACH * self.min_distance
+        return _Scratch(self.targets.shape[0], self.radius, spacing)
+
+    def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
         """The state after the boids steered for the step of ``h`` [s] (module docstring)."""
         parts = tuple(np.array(part) for part in after.parts)
         result = after.from_parts(after.t, parts)
@@ -289,15 +289,18 @@ class Boids:
         alive = after["particle_alive"]
         if not np.isfinite(x[self.targets]).all():
             return result  # a blown-up state: the divergence watch reports it
+        scratch = work.get(self, self._scratch)
         try:
-            self._run(x, v, alive, before["particle_position"], x, v, h)
-            if self._spacing is not None:
-                self._space(x, v, alive, h)
+            self._run(scratch, x, v, alive, before["particle_position"], x, v, h)
+            if scratch.spacing is not None:
+                self._space(scratch.spacing, x, v, alive, h)
         except ModelError as error:  # a boid beyond the grid's reach of the origin
             raise SimulationError(f"{self.name}: {error}", t=after.t, step=None) from None
         return result
 
-    def _space(self, x: np.ndarray, v: np.ndarray, alive: np.ndarray, h: float) -> None:
+    def _space(
+        self, grid: NeighbourGrid, x: np.ndarray, v: np.ndarray, alive: np.ndarray, h: float
+    ) -> None:
         """Move the live boids at ``x`` (in place) so that no two are closer than
         ``min_distance``, and add each move over ``h`` to its velocity ``v`` (see the module
         docstring)."""
@@ -306,8 +309,8 @@ class Boids:
         points = start.copy()
         live = np.ascontiguousarray(alive[rows])
         for _ in range(SPACING_ROUNDS):
-            self._spacing.update(points, live)
-            first, second = self._spacing.pairs()
+            grid.update(points, live)
+            first, second = grid.pairs()
             sweeps = _separate(points, first, second, self.min_distance, self.plane == "xz")
             if sweeps <= 1:  # nothing moved, or one sweep did it: no pair is new
                 break
@@ -322,11 +325,17 @@ class Boids:
         v[rows] = u
 
     def steering(
-        self, positions: Any, velocities: Any, alive: Any = None, h: float = 1e-3
+        self,
+        positions: Any,
+        velocities: Any,
+        alive: Any = None,
+        h: float = 1e-3,
+        work: Workspace | None = None,
     ) -> np.ndarray:
         """Each boid's steering acceleration [m/s²], ``(T,)`` rows in the order of
         ``targets`` (zero for dead ones), for particles at ``positions`` ``(N, 3)`` [m] with
-        ``velocities`` ``(N, 3)`` [m/s] (``h`` [s] enters only the obstacle avoidance)."""
+        ``velocities`` ``(N, 3)`` [m/s] (``h`` [s] enters only the obstacle avoidance);
+        ``work``: a run's storage to keep the neighbour grid in (``None``: a fresh one)."""
         x = np.ascontiguousarray(positions, dtype=np.float64)
         v = np.ascontiguousarray(velocities, dtype=np.float64)
         if x.ndim != 2 or x.shape[1] != 3 or v.shape != x.shape:
@@ -344,11 +353,13 @@ class Boids:
                 f"`alive` must be a boolean mask of shape ({x.shape[0]},), one flag per particle "
                 f"(got dtype {mask.dtype}, shape {mask.shape})"
             )
-        self._run(x, v, mask, x, x.copy(), v.copy(), real_number("h", h, positive=True))
-        return self._acc[: self.targets.shape[0]].copy()
+        scratch = self._scratch() if work is None else work.get(self, self._scratch)
+        self._run(scratch, x, v, mask, x, x.copy(), v.copy(), real_number("h", h, positive=True))
+        return scratch.acceleration.copy()
 
     def _run(
         self,
+        scratch: _Scratch,
         x: np.ndarray,
         v: np.ndarray,
         alive: np.ndarray,
@@ -358,22 +369,18 @@ class Boids:
         h: float,
     ) -> None:
         """Steer the flock at ``x``, ``v``: new velocities into ``v_out``, 2-D heights into
-        ``x_out``, accelerations into ``self._acc``."""
+        ``x_out``, accelerations into the scratch's."""
         rows = self.targets
         live = np.ascontiguousarray(alive[rows])
-        self.grid.update(x[rows], live)
-        count = rows.shape[0]
-        if self._v.shape[0] < count:
-            self._v = np.empty((count, 3))
-            self._acc = np.empty((count, 3))
-        acc = self._acc[:count]
+        scratch.grid.update(x[rows], live)
+        acc = scratch.acceleration
         acc[:] = 0.0
         leaders = self.leaders[alive[self.leaders]]
         lead = np.ascontiguousarray(x[leaders])
         p = self.parameters(h)
-        g = self.grid.arrays
+        g = scratch.grid.arrays
         n = g.order.shape[0]
-        vs = self._v[:n]
+        vs = scratch.velocity[:n]
         _, kinds, crows, offsets, nb, nl, tp, tn = self.colliders.kernel_arrays
         args = (g, rows, v, vs, p, lead, kinds, crows, offsets, nb, nl, tp, tn, x_before)
         if n >= PARALLEL_MIN_POINTS:
@@ -381,6 +388,20 @@ class Boids:
         else:
             _gather_velocities(g.order, rows, v, vs, p[_VMAX], 0, n)
             _steer_chunk(*args, acc, x_out, v_out, 0, n)
+
+
+class _Scratch:
+    """A run's storage for a flock of ``count`` boids: the neighbour grid of radius r, the grid
+    of the spacing projection (``None`` without ``min_distance``), the sorted boids'
+    velocities and each boid's steering acceleration, ``(count, 3)`` each."""
+
+    __slots__ = ("acceleration", "grid", "spacing", "velocity")
+
+    def __init__(self, count: int, radius: float, spacing: float | None) -> None:
+        self.grid = NeighbourGrid(radius)
+        self.spacing = None if spacing is None else NeighbourGrid(spacing)
+        self.velocity = np.empty((count, 3))
+        self.acceleration = np.empty((count, 3))
 
 
 def _bounded(name: str, value: Any, *, positive: bool = False, nonnegative: bool = False,

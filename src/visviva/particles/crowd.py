@@ -85,6 +85,7 @@ from .crowd_kernels import exit_agents, social_forces, walk
 
 if TYPE_CHECKING:
     from ..ode.state import State
+    from ..ode.workspace import Workspace
 
 __all__ = ["CUTOFF", "Crowd", "CrowdGroup"]
 
@@ -197,17 +198,17 @@ class Crowd:
         self.interaction_radius = (
             float(2.0 * self.radius.max(initial=0.0) + self.params[:, 6].max(initial=0.0)) or 1.0
         )
-        self._grid = NeighbourGrid(self.interaction_radius)
-        n = self.agents.shape[0]
-        self._points = np.zeros((n, 3))
-        self._drive, self._social, self._wall = np.zeros((n, 2)), np.zeros((n, 2)), np.zeros((n, 2))
+        NeighbourGrid(self.interaction_radius)  # checks the radius as the grid will
 
     def carried_start(self) -> dict[str, np.ndarray]:
         """The carried parts this stage keeps, at the start: ``crowd_exit_time`` [s], one per
         particle, NaN until the particle (an agent) leaves."""
         return {"crowd_exit_time": np.full(self.count, np.nan)}
 
-    def apply(self, before: State, after: State, h: float) -> State:
+    def _scratch(self) -> _Scratch:
+        return _Scratch(self.agents.shape[0], self.interaction_radius)
+
+    def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
         """Exits, then the social forces' kick (see the module docstring)."""
         parts = tuple(np.array(part) for part in after.parts)
         result = after.from_parts(after.t, parts)
@@ -223,31 +224,38 @@ class Crowd:
         exit_agents(
             self.agents, alive, x, v, self.crowd, self.exits, self.exit_start, exit_time, after.t
         )
-        self._evaluate(x, v, alive, height, h)
+        scratch = work.get(self, self._scratch)
+        self._evaluate(scratch, x, v, alive, height, h)
         walk(
-            self.agents, alive, x, v, height, self.mass, self._drive, self._social, self._wall,
-            self.max_speed, self.crowd, h,
+            self.agents, alive, x, v, height, self.mass, scratch.drive, scratch.social,
+            scratch.wall, self.max_speed, self.crowd, h,
         )  # fmt: skip
         return result.with_carried(particle_alive=alive, crowd_exit_time=exit_time)
 
     def _evaluate(
-        self, x: np.ndarray, v: np.ndarray, alive: np.ndarray, height: np.ndarray, h: float
+        self,
+        scratch: _Scratch,
+        x: np.ndarray,
+        v: np.ndarray,
+        alive: np.ndarray,
+        height: np.ndarray,
+        h: float,
     ) -> None:
-        """The three forces on the live agents into the stage's buffers (the sliding friction
-        as a step of ``h`` [s] applies it)."""
+        """The three forces on the live agents into the scratch's buffers (the sliding
+        friction as a step of ``h`` [s] applies it)."""
         agents = self.agents
         live = alive[agents]
-        points = self._points
+        points = scratch.points
         points[:, 0] = x[agents, 0]
         points[:, 2] = x[agents, 2]
-        self._grid.update(points, live)
+        scratch.grid.update(points, live)
         px, pz = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 2])
         vx, vz = np.ascontiguousarray(v[agents, 0]), np.ascontiguousarray(v[agents, 2])
         social_forces(
-            self._grid.arrays, px, np.ascontiguousarray(height), pz, vx, vz, self.radius,
+            scratch.grid.arrays, px, np.ascontiguousarray(height), pz, vx, vz, self.radius,
             self.mass, self.crowd, self.params, self.goal, self.has_goal, self.exits,
-            self.exit_start, self.wall_mask, self._walls, h, self._drive, self._social,
-            self._wall, int(live.sum()) >= PARALLEL_MIN_POINTS,
+            self.exit_start, self.wall_mask, self._walls, h, scratch.drive, scratch.social,
+            scratch.wall, int(live.sum()) >= PARALLEL_MIN_POINTS,
         )  # fmt: skip
 
     def forces(
@@ -260,14 +268,28 @@ class Crowd:
         x = np.asarray(x, dtype=np.float64)
         v = np.asarray(v, dtype=np.float64)
         alive = np.ones(self.count, dtype=bool) if alive is None else np.asarray(alive, bool)
-        for buffer in (self._drive, self._social, self._wall):
-            buffer[:] = 0.0
-        self._evaluate(x, v, alive, np.ascontiguousarray(x[self.agents, 1]), h)
+        scratch = self._scratch()
+        self._evaluate(scratch, x, v, alive, np.ascontiguousarray(x[self.agents, 1]), h)
         live = alive[self.agents]
         results = []
-        for buffer in (self._drive, self._social, self._wall):
+        for buffer in (scratch.drive, scratch.social, scratch.wall):
             out = np.zeros((self.count, 3))
             out[self.agents[live], 0] = buffer[live, 0]
             out[self.agents[live], 2] = buffer[live, 1]
             results.append(out)
         return results[0], results[1], results[2]
+
+
+class _Scratch:
+    """A run's storage for a crowd of ``count`` agents: the neighbour grid of ``radius`` [m],
+    the agents' ``(x, 0, z)`` ``(count, 3)`` [m], and the driving, social and wall forces on
+    each ``(count, 2)`` [N] (x and z)."""
+
+    __slots__ = ("drive", "grid", "points", "social", "wall")
+
+    def __init__(self, count: int, radius: float) -> None:
+        self.grid = NeighbourGrid(radius)
+        self.points = np.zeros((count, 3))
+        self.drive = np.zeros((count, 2))
+        self.social = np.zeros((count, 2))
+        self.wall = np.zeros((count, 2))

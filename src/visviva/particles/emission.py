@@ -34,6 +34,7 @@ from .random import uniform
 
 if TYPE_CHECKING:
     from ..ode.state import State
+    from ..ode.workspace import Workspace
 
 __all__ = ["Emission"]
 
@@ -69,7 +70,7 @@ class Emission:
             ramped = bool((spec.size_ramp[:, 1] != 1.0).any())
             self.slot_ramped[spec.first_slot : spec.first_slot + spec.capacity] = ramped
 
-    def apply(self, before: State, after: State, h: float) -> State:
+    def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
         """Age, kill, give birth and ramp sizes (see the module docstring)."""
         parts = tuple(np.array(part) for part in after.parts)
         result = after.from_parts(after.t, parts)

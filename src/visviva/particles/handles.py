@@ -42,6 +42,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from ..ode.state import State
+    from ..ode.workspace import Workspace
 
 __all__ = ["HandleMotion", "Handles"]
 
@@ -172,7 +173,7 @@ class Handles:
             v[self.indices] = velocity
         return x, v
 
-    def apply(self, before: State, after: State, h: float) -> State:
+    def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
         """``after`` with the handled particles on their paths at its time."""
         parts = tuple(np.array(part) for part in after.parts)
         result = after.from_parts(after.t, parts)

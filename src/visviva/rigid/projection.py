@@ -10,11 +10,14 @@ stage leaves such a state as it is.
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
 from ..ode.state import State
+
+if TYPE_CHECKING:
+    from ..ode.workspace import Workspace
 
 __all__ = ["BodyProjection"]
 
@@ -36,7 +39,7 @@ class BodyProjection:
     def __init__(self, count: int) -> None:
         self.count = count
 
-    def apply(self, before: State, after: State, h: float) -> State:
+    def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
         """``after`` with each orientation divided by its length (``after`` itself if they are
         unit to round-off)."""
         view = after.layout.view("body_orientation")

@@ -30,6 +30,7 @@ from ..ode.state import State
 if TYPE_CHECKING:
     from ..integrators import Integrator
     from ..ode.system import System
+    from ..ode.workspace import Workspace
     from .watch import DivergenceWatch
 
 __all__ = ["JOURNAL_STEPS", "FusedStep", "Stage", "Stepper"]
@@ -44,15 +45,18 @@ class Stage(Protocol):
 
     A stage receives the state before and after the integrator's step (the one before lets
     it find when, within the step, something happened: a time of impact, a birth) and returns
-    the state to keep. It must not modify either state's arrays in place.
+    the state to keep. It must not modify either state's arrays in place, nor itself: a stage
+    is part of a shared model, and keeps what it needs between calls (neighbour grids,
+    scratch arrays) in the run's :class:`~visviva.ode.workspace.Workspace`.
     """
 
     #: True if the stage has a compiled form, so that a run made only of compiled pieces may
     #: still take its whole-run compiled path.
     compiled: ClassVar[bool]
 
-    def apply(self, before: State, after: State, h: float) -> State:
-        """The state to keep after a step of ``h`` [s] from ``before`` to ``after``."""
+    def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
+        """The state to keep after a step of ``h`` [s] from ``before`` to ``after``; ``work``
+        is the run's storage."""
         ...
 
 
@@ -127,7 +131,7 @@ class Stepper:
             failure.step = index
             raise
         for stage in self.stages:
-            after = stage.apply(state, after, h)
+            after = stage.apply(state, after, h, self.system.workspace)
         self.system.counters.accepted_steps += 1
         if not self.watch.healthy(after):
             raise self.watch.diverged(after, index, state)
