@@ -69,9 +69,9 @@ H = 0.01  # s
 RULES = dict(
     radius=RADIUS,
     separation=0.4,
-    fov=270.0,
+    fov_deg=270.0,
     max_speed=2.0,
-    max_force=4.0,
+    max_acceleration=4.0,
     separation_weight=3.0,
     alignment_weight=1.0,
     cohesion_weight=0.7,
@@ -120,7 +120,7 @@ def _truncate(a: np.ndarray, limit: np.ndarray | float) -> np.ndarray:
 def numpy_step(x: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The same step with cKDTree pairs and NumPy arrays: the new velocities ``(N, 3)``."""
     n = x.shape[0]
-    vmax, amax, s = RULES["max_speed"], RULES["max_force"], RULES["separation"]
+    vmax, amax, s = RULES["max_speed"], RULES["max_acceleration"], RULES["separation"]
     v = _truncate(v, vmax)
     pairs = cKDTree(x).query_pairs(RADIUS, output_type="ndarray")
     i = np.concatenate([pairs[:, 0], pairs[:, 1]])
@@ -130,7 +130,7 @@ def numpy_step(x: np.ndarray, v: np.ndarray) -> np.ndarray:
     keep = d2 <= RADIUS * RADIUS  # the grid's test, exactly (query_pairs' differs by ulps)
     speed = _norm(v)
     u = v / np.where(speed > 0.0, speed, 1.0)[:, None]
-    cos_half = math.cos(math.radians(0.5 * RULES["fov"]))
+    cos_half = math.cos(math.radians(0.5 * RULES["fov_deg"]))
     dot = d[:, 0] * u[i, 0] + d[:, 1] * u[i, 1] + d[:, 2] * u[i, 2]
     keep &= ~((speed[i] > 0.0) & (dot < cos_half * np.sqrt(d2)))
     i, j, d, d2 = i[keep], j[keep], d[keep], d2[keep]

@@ -154,10 +154,10 @@ from bench_particles import TRIAD_BYTES, TRIAD_BYTES_STREAM, Runner, cpu_share, 
 # --------------------------------------------------------------------------------------------
 
 GRAVITY = (0.0, -9.81, 0.0)  # m/s²
-DENSITY = 0.1  # kg/m²
-STRETCH = 1000.0  # N/m, structural springs
+AREAL_DENSITY = 0.1  # kg/m²
+STIFFNESS = 1000.0  # N/m, structural springs
 SHEAR = 100.0  # N/m, diagonal springs
-BEND = 1.0  # N/m, springs between points two apart
+BENDING = 1.0  # N/m, springs between points two apart
 DAMPING = 0.01  # N·s/m, along every spring
 HEIGHT = 1.0  # m
 
@@ -241,17 +241,17 @@ def cloth_scene(n: int) -> Cloth:
     # A point's share of the cells around it is the product of its shares along x and z.
     edge = np.ones(n)
     edge[[0, -1]] = 0.5
-    mass = DENSITY * spacing**2 * np.outer(edge, edge)
+    mass = AREAL_DENSITY * spacing**2 * np.outer(edge, edge)
     index = j * n + i
     pairs, stiffness = [], []
     # (Δi, Δj) from the first end to the second, and the family's stiffness.
     families = [
-        (1, 0, STRETCH),
-        (0, 1, STRETCH),
+        (1, 0, STIFFNESS),
+        (0, 1, STIFFNESS),
         (1, 1, SHEAR),
         (-1, 1, SHEAR),
-        (2, 0, BEND),
-        (0, 2, BEND),
+        (2, 0, BENDING),
+        (0, 2, BENDING),
     ]
     for di, dj, k in families:
         inside = (i + di >= 0) & (i + di < n) & (j + dj < n)
@@ -651,11 +651,11 @@ def visviva_runner(n: int) -> Runner:
     builder.set_integration(method="symplectic_euler", dt=STEP_BY_SIZE[n], duration=1.0)
     builder.add_cloth(
         (n, n),
-        stretch=STRETCH,
+        stiffness=STIFFNESS,
         shear=SHEAR,
-        bend=BEND,
+        bending=BENDING,
         damping=DAMPING,
-        density=DENSITY,
+        areal_density=AREAL_DENSITY,
         origin=(0.0, HEIGHT, 0.0),
         along=(1.0, 0.0, 0.0),
         across=(0.0, 0.0, 1.0),

@@ -189,10 +189,10 @@ from visviva.ode.state import State
 
 GRAVITY = (0.0, -9.81, 0.0)  # m/s²
 STEP = 1.0 / 60.0  # s
-DENSITY = 0.1  # kg/m²
-STRETCH = 1000.0  # N/m, structural springs
+AREAL_DENSITY = 0.1  # kg/m²
+STIFFNESS = 1000.0  # N/m, structural springs
 SHEAR = 100.0  # N/m, diagonal springs
-BEND = 1.0  # N/m, springs between points two apart
+BENDING = 1.0  # N/m, springs between points two apart
 DAMPING = 0.01  # N·s/m, along every spring
 HEIGHT = 1.0  # m
 
@@ -243,11 +243,11 @@ def cloth_scene(n: int, damping: float = DAMPING) -> Any:
     builder.set_integration(method="symplectic_euler", dt=STEP, duration=100.0)
     builder.add_cloth(
         (n, n),
-        stretch=STRETCH,
+        stiffness=STIFFNESS,
         shear=SHEAR,
-        bend=BEND,
+        bending=BENDING,
         damping=damping,
-        density=DENSITY,
+        areal_density=AREAL_DENSITY,
         origin=(0.0, HEIGHT, 0.0),
         along=(1.0, 0.0, 0.0),
         across=(0.0, 0.0, 1.0),

@@ -623,7 +623,7 @@ def visviva_fountain_runner(
         stop=capacity / births_per_second,
         position=NOZZLE,
         direction=(0.0, 1.0, 0.0),
-        spread=math.degrees(NOZZLE_HALF_ANGLE),
+        spread_deg=math.degrees(NOZZLE_HALF_ANGLE),
         speed=[NOZZLE_SPEED - NOZZLE_SPEED_SPREAD, NOZZLE_SPEED + NOZZLE_SPEED_SPREAD],
         lifetime=1e6,
         particle_radius=RADIUS,

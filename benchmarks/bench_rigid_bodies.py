@@ -28,9 +28,9 @@ The scene, the same for both runners (float64 throughout):
   L' = τ − γ' L with γ' = 0.2 1/s (P, L the world-frame momenta); no contacts;
 * steps of h = 1/240 s.
 
-visviva: one ``SceneBuilder.add_body("box", ...)`` per box (``linear_damping`` γ,
-``angular_damping`` γ'), then ``vv.Simulation(model)`` with the scene's symplectic Euler: a kick
-P += h (F − γ P), L += h (τ − γ' L), then a drift, x += h P/m and the free rotation by the
+visviva: one ``SceneBuilder.add_body("box", ...)`` per box (``linear_damping_rate`` γ,
+``angular_damping_rate`` γ'), then ``vv.Simulation(model)`` with the scene's symplectic Euler: a
+kick P += h (F − γ P), L += h (τ − γ' L), then a drift, x += h P/m and the free rotation by the
 splitting of Dullweber, Leimkuhler and McLachlan, which keeps L exactly.
 
 MuJoCo: an MJCF string generated here, per box a ``<body>`` with a ``<freejoint/>`` and a
@@ -286,8 +286,8 @@ def visviva_model(boxes: Boxes) -> tuple[vv.Model, dict[str, float]]:
             orientation=orientation,
             velocity=velocity,
             angular_velocity=spin,
-            linear_damping=LINEAR_DAMPING,
-            angular_damping=ANGULAR_DAMPING,
+            linear_damping_rate=LINEAR_DAMPING,
+            angular_damping_rate=ANGULAR_DAMPING,
             name=f"box {i}",
         )
     added = time.perf_counter()

@@ -57,7 +57,7 @@ def reference(b: Boids, x, v, alive, h, sphere=None):
     live = alive[rows]
     planar = b.plane == "xz"
     vmax, s = b.max_speed, b.separation
-    cos_half = -2.0 if b.fov == 360.0 else math.cos(math.radians(0.5 * b.fov))
+    cos_half = -2.0 if b.fov_deg == 360.0 else math.cos(math.radians(0.5 * b.fov_deg))
     w = b.weights
     leaders = x[b.leaders[alive[b.leaders]]]
     out = np.zeros((rows.shape[0], 3))
@@ -102,8 +102,8 @@ def reference(b: Boids, x, v, alive, h, sphere=None):
                     t[1] = 0.0
                 if t.any():
                     n = n + _unit(t)
-                avoid = _truncate(_steer(n, vel[i], vmax, planar) / h, b.max_force)
-        left = b.max_force - np.linalg.norm(avoid)
+                avoid = _truncate(_steer(n, vel[i], vmax, planar) / h, b.max_acceleration)
+        left = b.max_acceleration - np.linalg.norm(avoid)
         out[i] = _truncate(f, left) + avoid
     return out
 
@@ -135,8 +135,8 @@ def test_kernel_equals_brute_force(plane):
             radius=1.0,
             separation=0.4,
             max_speed=2.0,
-            max_force=4.0,
-            fov=250.0,
+            max_acceleration=4.0,
+            fov_deg=250.0,
             min_speed=0.5,
             separation_weight=3.0,
             alignment_weight=1.0,
@@ -163,7 +163,7 @@ def test_dead_slots_are_never_flockmates():
     x = np.array([[0.0, 0, 0], [0.1, 0, 0], [0.0, 0.1, 0], [0.2, 0.1, 0.0]])
     v = np.array([[1.0, 0, 0], [0.0, 1, 0], [0.0, 0, 1], [0.0, 0, 0]])
     alive = np.array([True, False, False, False])
-    stage = Boids(np.arange(4), radius=1.0, separation=0.5, max_speed=1.0, max_force=10.0)
+    stage = Boids(np.arange(4), radius=1.0, separation=0.5, max_speed=1.0, max_acceleration=10.0)
     assert not stage.steering(x, v, alive).any()
     with pytest.raises(ModelError, match=r"`alive` must be a boolean mask of shape \(4,\)"):
         stage.steering(x, v, alive[:3])
@@ -171,31 +171,35 @@ def test_dead_slots_are_never_flockmates():
     dead = np.zeros(500, dtype=bool)
     dead[::7] = True
     big[dead] = 0.0  # parked at the origin, amid the flock, as the emission stage parks them
-    stage = Boids(np.arange(500), radius=1.0, separation=0.4, max_speed=2.0, max_force=4.0)
+    stage = Boids(np.arange(500), radius=1.0, separation=0.4, max_speed=2.0, max_acceleration=4.0)
     with_dead = stage.steering(big, vel, ~dead)
     alone = Boids(
-        np.arange(dead.size - dead.sum()), radius=1.0, separation=0.4, max_speed=2.0, max_force=4.0
+        np.arange(dead.size - dead.sum()),
+        radius=1.0,
+        separation=0.4,
+        max_speed=2.0,
+        max_acceleration=4.0,
     ).steering(big[~dead], vel[~dead])
     np.testing.assert_allclose(with_dead[~dead], alone, rtol=0, atol=1e-12)
 
 
 def test_field_of_view_excludes_boids_behind():
-    """Two boids heading +x, one 0.5 m behind the other: with fov = 180° the leader sees no
+    """Two boids heading +x, one 0.5 m behind the other: with fov_deg = 180° the leader sees no
     one (no steering at all) while the follower sees it ahead; with 360° both see each other.
-    A boid at 100° off the heading is seen with fov = 220° (half-angle 110°), not 180°."""
+    A boid at 100° off the heading is seen with fov_deg = 220° (half-angle 110°), not 180°."""
     x = np.array([[0.0, 0, 0], [-0.5, 0, 0]])
     v = np.array([[0.5, 0, 0], [0.5, 0, 0]])
-    kwargs = dict(radius=1.0, separation=0.2, max_speed=1.0, max_force=10.0)
-    front = Boids([0, 1], fov=180.0, **kwargs).steering(x, v)
+    kwargs = dict(radius=1.0, separation=0.2, max_speed=1.0, max_acceleration=10.0)
+    front = Boids([0, 1], fov_deg=180.0, **kwargs).steering(x, v)
     assert not front[0].any()
     assert front[1, 0] > 0.0  # alignment and cohesion speed the follower up
-    around = Boids([0, 1], fov=360.0, **kwargs).steering(x, v)
+    around = Boids([0, 1], fov_deg=360.0, **kwargs).steering(x, v)
     assert around[0, 0] < 0.0  # cohesion pulls the leader back
     angle = math.radians(100.0)
     side = np.array([[0.0, 0, 0], [0.5 * math.cos(angle), 0.5 * math.sin(angle), 0.0]])
     v = np.array([[1.0, 0, 0], [0.0, 0, 1.0]])
-    assert Boids([0, 1], fov=220.0, **kwargs).steering(side, v)[0].any()
-    assert not Boids([0, 1], fov=180.0, **kwargs).steering(side, v)[0].any()
+    assert Boids([0, 1], fov_deg=220.0, **kwargs).steering(side, v)[0].any()
+    assert not Boids([0, 1], fov_deg=180.0, **kwargs).steering(side, v)[0].any()
 
 
 # ------------------------------------------------------------------------------------------
@@ -210,7 +214,7 @@ def flock_scene(n=400, *, duration=10.0, dt=0.05, plane=None, gravity=0.0, **rul
     builder.add_particle_cloud(
         count=n, center=(0, 0, 0), size=(4.0, 4.0, 4.0), velocity_jitter=1.0, name="birds", seed=1
     )
-    settings = dict(radius=1.5, separation=0.4, max_speed=2.0, max_force=4.0, fov=270.0)
+    settings = dict(radius=1.5, separation=0.4, max_speed=2.0, max_acceleration=4.0, fov_deg=270.0)
     builder.add_boids(["birds"], plane=plane, **(settings | rules))
     return builder
 
@@ -295,7 +299,7 @@ def test_no_two_boids_closer_than_the_separation_distance_with_min_distance(plan
     # The velocities: the steering's (the same stage without the projection) plus move / h,
     # truncated to V = 2 m/s.
     free = Boids(stage.targets, **{k: getattr(stage, k) for k in ("radius", "separation",
-                 "max_speed", "max_force", "fov", "min_speed", "plane")},
+                 "max_speed", "max_acceleration", "fov_deg", "min_speed", "plane")},
                  **stage.weights, goal=stage.goal)  # fmt: skip
     steered = free.apply(pressed, pressed, 0.05, Workspace())["particle_velocity"]
     expected = steered + moved / 0.05
@@ -338,7 +342,7 @@ def fly_at_sphere(look_ahead):
         radius=1.0,
         separation=0.3,
         max_speed=2.0,
-        max_force=4.0,
+        max_acceleration=4.0,
         goal=(8.0, 0.0, 0.0),
         goal_weight=2.0,
         look_ahead=look_ahead,
@@ -379,9 +383,9 @@ def test_speed_and_steering_bounds():
         radius=1.0,
         separation=0.5,
         max_speed=2.0,
-        max_force=4.0,
+        max_acceleration=4.0,
         min_speed=1.0,
-        fov=300.0,
+        fov_deg=300.0,
         separation_weight=20.0,
     )
     a = stage.steering(x, v)
@@ -415,7 +419,7 @@ def test_leaders_lead_and_are_not_steered():
         radius=1.0,
         separation=0.3,
         max_speed=2.0,
-        max_force=4.0,
+        max_acceleration=4.0,
         leader="lead",
         leader_weight=2.0,
     )
@@ -447,7 +451,7 @@ targets = ["birds"]
 radius = 1.0
 separation = 0.3
 max_speed = 2.0
-max_force = 4.0
+max_acceleration = 4.0
 """
 
 
@@ -458,10 +462,10 @@ max_force = 4.0
         ("separation = -1.0", "entities[2].separation", "greater than 0"),
         ("separation = 2.0", "entities[2]", "must not exceed `radius`"),
         ("alignment_weight = -1.0", "entities[2].alignment_weight", "greater than or equal"),
-        ("fov = 0.0", "entities[2].fov", "greater than 0"),
-        ("fov = 361.0", "entities[2].fov", "less than or equal to 360"),
+        ("fov_deg = 0.0", "entities[2].fov_deg", "greater than 0"),
+        ("fov_deg = 361.0", "entities[2].fov_deg", "less than or equal to 360"),
         ("max_speed = 0.0", "entities[2].max_speed", "greater than 0"),
-        ("max_force = -4.0", "entities[2].max_force", "greater than 0"),
+        ("max_acceleration = -4.0", "entities[2].max_acceleration", "greater than 0"),
         ("min_speed = 3.0", "entities[2]", "`min_speed` (3.0 m/s) must not exceed"),
         ("min_distance = 0.5", "entities[2]", "`min_distance` (0.5 m) must not exceed"),
         ("min_distance = 0.0", "entities[2].min_distance", "greater than 0"),
@@ -472,9 +476,9 @@ max_force = 4.0
     ],
 )
 def test_bad_scene_values_are_refused_with_entity_and_field(extra, where, message):
-    text = SCENE.replace("max_force = 4.0\n", "max_force = 4.0\n" + extra + "\n")
-    if extra.startswith("max_force"):
-        text = SCENE.replace("max_force = 4.0", extra)
+    text = SCENE.replace("max_acceleration = 4.0\n", "max_acceleration = 4.0\n" + extra + "\n")
+    if extra.startswith("max_acceleration"):
+        text = SCENE.replace("max_acceleration = 4.0", extra)
     elif extra.startswith(("radius", "separation", "max_speed")):
         key = extra.split(" ")[0]
         text = "\n".join(
@@ -504,8 +508,8 @@ def test_targets_must_exist_and_flocks_not_overlap():
     [
         (dict(radius=-1.0), "`radius` must be positive"),
         (dict(separation=2.0), "`separation` (2.0 m) must not exceed `radius`"),
-        (dict(fov=400.0), "`fov` must lie in (0, 360]"),
-        (dict(fov=float("nan")), "`fov` must be finite"),
+        (dict(fov_deg=400.0), "`fov_deg` must lie in (0, 360]"),
+        (dict(fov_deg=float("nan")), "`fov_deg` must be finite"),
         (dict(min_speed=5.0), "`min_speed` (5.0 m/s) must not exceed `max_speed`"),
         (dict(min_distance=2.0), "`min_distance` (2.0 m) must not exceed `separation`"),
         (dict(min_distance=-1.0), "`min_distance` must be positive"),
@@ -515,29 +519,31 @@ def test_targets_must_exist_and_flocks_not_overlap():
         (dict(leaders=[0]), "`leaders` must not be boids of the flock"),
         (dict(leader_weight=1.0), "`leader_weight` is given without `leaders`"),
         (dict(plane="xy"), '`plane` must be "xz"'),
-        (dict(max_force=0.0), "`max_force` must be positive"),
+        (dict(max_acceleration=0.0), "`max_acceleration` must be positive"),
     ],
 )
 def test_bad_python_values_are_refused(kwargs, message):
-    settings = dict(radius=1.0, separation=0.3, max_speed=2.0, max_force=4.0) | kwargs
+    settings = dict(radius=1.0, separation=0.3, max_speed=2.0, max_acceleration=4.0) | kwargs
     with pytest.raises(ModelError) as caught:
         Boids(np.arange(5), **settings)
     assert message in str(caught.value)
 
 
 def test_the_cli_refuses_a_bad_flock_with_status_2(tmp_path, monkeypatch, capsys):
-    """``visviva validate`` on a flock with fov = 400: exit status 2, one line naming the
+    """``visviva validate`` on a flock with fov_deg = 400: exit status 2, one line naming the
     entity and field, no traceback."""
     from visviva.cli.main import main
 
     path = tmp_path / "bad.toml"
-    path.write_text(SCENE.replace("max_force = 4.0\n", "max_force = 4.0\nfov = 400.0\n"))
+    path.write_text(
+        SCENE.replace("max_acceleration = 4.0\n", "max_acceleration = 4.0\nfov_deg = 400.0\n")
+    )
     monkeypatch.setattr("sys.argv", ["visviva", "validate", str(path)])
     with pytest.raises(SystemExit) as exit_:
         main()
     captured = capsys.readouterr()
     assert exit_.value.code == 2
-    assert "entities[2].fov" in captured.err + captured.out
+    assert "entities[2].fov_deg" in captured.err + captured.out
     assert "Traceback" not in captured.err
 
 
@@ -555,9 +561,9 @@ finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
     points=st.lists(st.tuples(finite, finite, finite), min_size=1, max_size=12),
     speeds=st.lists(st.tuples(finite, finite, finite), min_size=12, max_size=12),
     coincide=st.booleans(),
-    fov=st.floats(min_value=1.0, max_value=360.0),
+    fov_deg=st.floats(min_value=1.0, max_value=360.0),
 )
-def test_hostile_positions_and_velocities(points, speeds, coincide, fov):
+def test_hostile_positions_and_velocities(points, speeds, coincide, fov_deg):
     """Any finite positions and velocities: a clear ModelError (a boid beyond the grid's
     reach) or finite accelerations within A; never NaN, never another exception."""
     x = np.array(points, dtype=np.float64)
@@ -569,8 +575,8 @@ def test_hostile_positions_and_velocities(points, speeds, coincide, fov):
         radius=1.0,
         separation=0.5,
         max_speed=3.0,
-        max_force=2.0,
-        fov=fov,
+        max_acceleration=2.0,
+        fov_deg=fov_deg,
         goal=(0.0, 0.0, 0.0),
         goal_weight=1.0,
     )

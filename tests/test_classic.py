@@ -37,7 +37,7 @@ def test_reduced_and_constrained_pendulums_agree():
     )
     for alpha in (0.0, 20.0):
         problem, multiplier = classic.constrained_pendulum(
-            theta0, length=length, stabilization=alpha
+            theta0, length=length, stabilization_rate=alpha
         )
         particle = vv.solve(problem, method="rk4", dt=1e-3, t_end=5.0)
         x, y = particle.q[:, 0], particle.q[:, 1]
@@ -53,7 +53,7 @@ def test_reduced_and_constrained_pendulums_agree():
 def test_baumgarte_pulls_a_drifted_particle_back_to_the_circle():
     """Started 1 cm off the circle, the unstabilised particle keeps its error; with α = 20/s the
     error decays like (1 + αt) e^{−αt} (critical damping)."""
-    problem, _ = classic.constrained_pendulum(0.5, stabilization=20.0)
+    problem, _ = classic.constrained_pendulum(0.5, stabilization_rate=20.0)
     off = vv.ode.SecondOrderProblem(
         problem.force.func, problem.q0 * 1.01, problem.v0, energy=problem.energy.func
     )

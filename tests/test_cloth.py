@@ -32,7 +32,7 @@ def _stiff_cloth(method: str) -> vv.Simulation:
     builder = vv.SceneBuilder(name="stiff cloth")
     builder.set_integration(method=method, dt=1 / 60, duration=2.0)
     builder.add_cloth(
-        (10, 10), stretch=1e3, bend=10.0, density=0.1, pinned=[0, 9], name="sheet"
+        (10, 10), stiffness=1e3, bending=10.0, areal_density=0.1, pinned=[0, 9], name="sheet"
     )  # 1 m × 1 m, horizontal, held at two corners
     return vv.Simulation(builder.build())
 
@@ -74,7 +74,7 @@ def test_the_advisor_predicts_the_largest_stable_step_from_the_stiffest_springs(
     def cloth(dt: float) -> vv.Simulation:
         builder = vv.SceneBuilder(name="advised")
         builder.set_integration(method="symplectic_euler", dt=dt, duration=100.0)
-        builder.add_cloth((10, 10), stretch=1e3, bend=10.0, density=0.1, pinned=[0, 9])
+        builder.add_cloth((10, 10), stiffness=1e3, bending=10.0, areal_density=0.1, pinned=[0, 9])
         return vv.Simulation(builder.build())
 
     probe = cloth(1 / 60)
@@ -100,12 +100,12 @@ def test_pinned_corners_stay_bit_identical():
         ({"along": (1.0, 0.0, 0.0), "across": (2.0, 0.0, 0.0)}, "the sheet has no area"),
         ({"pinned": [100]}, "pinned index 100 is not a point of this cloth"),
         ({"resolution": (1, 5)}, "resolution"),
-        ({"stretch": -1.0}, "stretch"),
+        ({"stiffness": -1.0}, "stiffness"),
         ({"along": (1e200, 0.0, 0.0), "across": (0.0, 0.0, 1e200)}, "beyond what a float holds"),
     ],
 )
 def test_bad_cloth_is_refused_naming_the_field(cloth, message):
-    arguments = {"resolution": (10, 10), "stretch": 100.0} | cloth
+    arguments = {"resolution": (10, 10), "stiffness": 100.0} | cloth
     builder = vv.SceneBuilder(name="bad")
     with pytest.raises(vv.ModelError, match=message):
         builder.add_cloth(**arguments)
@@ -120,10 +120,10 @@ def test_cloth_drapes_over_a_sphere_with_baraff_witkins_step():
     builder.set_integration(method="linearly_implicit_euler", dt=1 / 60, duration=3.0)
     builder.add_cloth(
         (24, 24),
-        stretch=2e3,
+        stiffness=2e3,
         shear=100.0,
-        bend=0.05,
-        density=0.1,
+        bending=0.05,
+        areal_density=0.1,
         damping=0.05,
         origin=(-0.6, 1.2, -0.6),
         along=(1.2, 0.0, 0.0),
@@ -152,7 +152,7 @@ def test_baraff_witkins_step_by_cg_is_the_direct_solves_step(preconditioner):
         builder = vv.SceneBuilder(name="bw")
         builder.set_integration(method="symplectic_euler", dt=1 / 60, duration=1.0)
         builder.add_cloth(
-            (12, 12), stretch=1e3, shear=100.0, bend=1.0, damping=0.01, density=0.1,
+            (12, 12), stiffness=1e3, shear=100.0, bending=1.0, damping=0.01, areal_density=0.1,
             origin=(0.0, 1.0, 0.0), along=(1.0, 0.0, 0.0), across=(0.0, 0.0, 1.0),
             pinned=[0, 11],
         )  # fmt: skip

@@ -58,7 +58,13 @@ def _hanging(body: str) -> vv.Simulation:
     builder = vv.SceneBuilder(name="hanging")
     builder.set_integration(method="backward_euler", dt=0.05, duration=20.0)
     along, across = np.array([0.6, 0.0, 0.0]), np.array([0.0, -0.6, 0.0])
-    options = {"density": 0.1, "stretch": 200.0, "bend": 0.5, "damping": 0.05, "pinned": range(7)}
+    options = {
+        "areal_density": 0.1,
+        "stiffness": 200.0,
+        "bending": 0.5,
+        "damping": 0.05,
+        "pinned": range(7),
+    }
     if body == "grid":
         builder.add_cloth((7, 7), origin=(0, 1, 0), along=along, across=across, **options)
     else:
@@ -101,9 +107,9 @@ def test_a_cloth_mesh_from_a_scene_file_is_drawn_by_its_triangles(tmp_path):
         name = "flag"
         vertices = [[0, 1, 0], [1, 1, 0], [1, 0, 0], [0, 0, 0]]
         triangles = [[0, 1, 2], [0, 2, 3]]
-        density = 0.2   # kg/m²
-        stretch = 100.0 # N/m
-        bend = 1.0      # N/m
+        areal_density = 0.2  # kg/m²
+        stiffness = 100.0    # N/m
+        bending = 1.0        # N/m
         pinned = [0, 1]
         """
     )
@@ -143,7 +149,7 @@ FIVE = [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1], [0.5, 1, 0]]
         ({"pinned": [9]}, "", "pinned index 9 is not a point of this cloth mesh"),
         ({"triangles": []}, "triangles", "at least 1"),
         ({"vertices": [[0, 0, 0], [1, 0, 0]]}, "vertices", "at least 3"),
-        ({"stretch": 0.0}, "stretch", "greater than 0"),
+        ({"stiffness": 0.0}, "stiffness", "greater than 0"),
         ({"vertices": [[0, 0, 0], [1e300, 0, 0], [1e300, 0, 1e300], [0, 0, 1]]}, "", "a float"),
     ],
 )
@@ -151,8 +157,8 @@ def test_bad_meshes_are_refused_at_the_triangle_at_fault(mesh, path, message):
     arguments = {
         "vertices": SQUARE.tolist(),
         "triangles": [[0, 1, 2], [0, 2, 3]],
-        "density": 0.1,
-        "stretch": 10.0,
+        "areal_density": 0.1,
+        "stiffness": 10.0,
     } | mesh
     builder = vv.SceneBuilder(name="bad")
     with pytest.raises(vv.SceneError, match=message) as refusal:

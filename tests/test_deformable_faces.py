@@ -194,8 +194,8 @@ def test_a_recording_holds_each_surface_shifted_to_its_points_and_edges_only_for
     builder.add_particles([[3.0, 1.0, 0.0], [3.0, 2.0, 0.0]], mass=1.0)
     rope_points = [[2.0, 1.0 - 0.1 * i, 0.0] for i in range(4)]
     builder.add_rope(rope_points, mass=0.01, stiffness=50.0)
-    builder.add_cloth((4, 3), stretch=50.0, density=0.1)
-    builder.add_soft_lattice((2, 3, 2), stretch=50.0, origin=(0, 2, 0), size=(0.2, 0.3, 0.2))
+    builder.add_cloth((4, 3), stiffness=50.0, areal_density=0.1)
+    builder.add_soft_lattice((2, 3, 2), stiffness=50.0, origin=(0, 2, 0), size=(0.2, 0.3, 0.2))
     tetrahedron = [[0, 1, 2], [0.2, 1, 2], [0, 1.2, 2], [0, 1, 2.2]]
     builder.add_soft_mesh(tetrahedron, [[0, 1, 2, 3]], density=100.0, stiffness=50.0)
     recording = vv.Simulation(builder.build()).record(until=0.002)
@@ -222,7 +222,13 @@ def cloth(tmp_path_factory: pytest.TempPathFactory) -> vv.Recording:
     builder = vv.SceneBuilder(name="sheet")
     builder.set_integration(method="backward_euler", dt=0.02, duration=0.4, record_every=1)
     builder.add_cloth(
-        (6, 5), stretch=200.0, bend=0.1, density=0.1, damping=0.02, pinned=[0, 5], name="sheet"
+        (6, 5),
+        stiffness=200.0,
+        bending=0.1,
+        areal_density=0.1,
+        damping=0.02,
+        pinned=[0, 5],
+        name="sheet",
     )
     recorded = vv.Simulation(builder.build()).record(until=0.4)
     path = tmp_path_factory.mktemp("sheet") / "recording.h5"

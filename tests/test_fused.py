@@ -13,7 +13,7 @@ def _scene(**extra) -> vv.Model:
     builder.add_emitter(
         rate=400,
         speed=[3.0, 4.0],
-        spread=20,
+        spread_deg=20,
         lifetime=[0.5, 0.9],
         size_ramp=[[0.0, 1.0], [1.0, 0.3]],
         seed=5,
@@ -118,7 +118,7 @@ def test_fused_cloth_with_pins_and_colliders_agrees_with_the_generic_step(steps)
     builder = vv.SceneBuilder(name="fused cloth")
     builder.set_integration(method="symplectic_euler", dt=1e-4, duration=1.0)
     builder.add_cloth(
-        (12, 12), stretch=500.0, shear=50.0, bend=1.0, damping=0.01, density=0.1,
+        (12, 12), stiffness=500.0, shear=50.0, bending=1.0, damping=0.01, areal_density=0.1,
         origin=(-0.5, 0.4, -0.5), along=(1.0, 0.0, 0.0), across=(0.0, 0.0, 1.0),
         pinned=[0, 11], name="sheet",
     )  # fmt: skip
@@ -188,7 +188,7 @@ def test_fused_blow_up_keeps_the_last_good_state_bit_for_bit(substeps):
         builder = vv.SceneBuilder(name="flung")
         builder.set_integration(method="symplectic_euler", dt=0.01, substeps=substeps)
         builder.add_emitter(
-            rate=200, position=(0, 1, 0), spread=40, speed=[1, 2], lifetime=60, seed=3
+            rate=200, position=(0, 1, 0), spread_deg=40, speed=[1, 2], lifetime=60, seed=3
         )
         builder.add_collider("plane", restitution=0.4, friction=0.2)
         # Damping too stiff for the step: symplectic Euler multiplies the velocity by

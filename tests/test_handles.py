@@ -315,7 +315,7 @@ def test_bad_handles_are_refused_naming_the_field_and_the_fix(handle, where, mes
 def test_a_handle_needs_pins_to_move():
     builder = vv.SceneBuilder()
     with pytest.raises(vv.SceneError, match="list the points it should move in `pinned`"):
-        builder.add_cloth((3, 3), stretch=10.0, handle={"velocity": (1, 0, 0)})
+        builder.add_cloth((3, 3), stiffness=10.0, handle={"velocity": (1, 0, 0)})
 
 
 def test_a_bad_handle_in_a_scene_file_is_found_at_its_line():

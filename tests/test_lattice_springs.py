@@ -127,11 +127,11 @@ def test_scene_bodies_on_lattices_take_the_stencil_and_agree_with_the_general_st
         pinned=[0],
     )  # fmt: skip
     builder.add_cloth(
-        (9, 7), stretch=500.0, shear=50.0, bend=1.0, damping=0.01, density=0.1,
+        (9, 7), stiffness=500.0, shear=50.0, bending=1.0, damping=0.01, areal_density=0.1,
         origin=(-0.5, 0.8, -0.5), along=(1.0, 0.0, 0.0), across=(0.0, 0.0, 1.0), pinned=[0, 8],
     )  # fmt: skip
     builder.add_soft_lattice(
-        (3, 4, 3), origin=(1.0, 0.3, 0.0), size=(0.2, 0.3, 0.2), stretch=800.0, damping=0.05
+        (3, 4, 3), origin=(1.0, 0.3, 0.0), size=(0.2, 0.3, 0.2), stiffness=800.0, damping=0.05
     )
     builder.add_collider("plane", restitution=0.0, friction=0.5)
     model = builder.build()

@@ -58,8 +58,8 @@ def test_python_and_the_scene_file_give_the_same_cloth(monkeypatch):
     monkeypatch.chdir(TABLECLOTH.parent)  # from Python a relative path is the working folder's
     builder = vv.SceneBuilder(name="tablecloth", description=from_file.scene.scene.description)
     builder.set_integration(method="projected_newton", dt=1 / 120, duration=2.0)
-    builder.add_cloth_mesh(path=Path("tablecloth.obj"), density=0.1, stretch=1000.0,
-                           bend=0.05, damping=0.05, radius=0.01, color=(0.9, 0.9, 0.8),
+    builder.add_cloth_mesh(path=Path("tablecloth.obj"), areal_density=0.1, stiffness=1000.0,
+                           bending=0.05, damping=0.05, radius=0.01, color=(0.9, 0.9, 0.8),
                            name="tablecloth")  # fmt: skip
     builder.add_force("damping", rate=1.0, name="air")
     builder.add_collider("sphere", center=(0, 0.6, 0), radius=0.3, restitution=0.0,
@@ -107,11 +107,11 @@ def test_pins_index_the_vertices_as_read(tmp_path):
     vertices, _ = read_triangle_mesh(TABLECLOTH)
     rim = np.flatnonzero(np.hypot(vertices[:, 0], vertices[:, 2]) > 0.499)
     builder = vv.SceneBuilder()
-    builder.add_cloth_mesh(path=TABLECLOTH, density=0.1, stretch=100.0, pinned=rim.tolist())
+    builder.add_cloth_mesh(path=TABLECLOTH, areal_density=0.1, stiffness=100.0, pinned=rim.tolist())
     model = builder.build()
     assert model.particle_pinned.sum() == 48 == rim.shape[0]
     with pytest.raises(vv.SceneError) as error:
-        vv.SceneBuilder().add_cloth_mesh(path=TABLECLOTH, density=0.1, stretch=100.0,
+        vv.SceneBuilder().add_cloth_mesh(path=TABLECLOTH, areal_density=0.1, stiffness=100.0,
                                          pinned=[3, 217])  # fmt: skip
     assert "entities[0].pinned" in str(error.value)
     assert "pinned index 217 is not a vertex of the mesh" in str(error.value)
@@ -158,7 +158,7 @@ def test_files_that_are_not_one_triangle_mesh_are_refused_naming_them(tmp_path, 
     path = tmp_path / name
     path.write_bytes(data)
     with pytest.raises(vv.SceneError) as error:
-        vv.SceneBuilder().add_cloth_mesh(path=path, density=0.1, stretch=10.0)
+        vv.SceneBuilder().add_cloth_mesh(path=path, areal_density=0.1, stiffness=10.0)
     text = str(error.value)
     assert "entities[0].path" in text and repr(str(path)) in text
     assert message in text
@@ -183,14 +183,14 @@ def test_special_files_and_huge_ones_are_refused_without_reading_them(tmp_path):
     ]
     for path, message in cases:
         with pytest.raises(vv.SceneError, match=message):
-            vv.SceneBuilder().add_cloth_mesh(path=path, density=0.1, stretch=10.0)
+            vv.SceneBuilder().add_cloth_mesh(path=path, areal_density=0.1, stiffness=10.0)
 
 
 def test_a_mesh_no_cloth_can_be_made_of_is_refused_at_its_path(tmp_path):
     fan = tmp_path / "fan.obj"  # three triangles on one edge: not manifold
     fan.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 2 5\n")
     with pytest.raises(vv.SceneError) as error:
-        vv.SceneBuilder().add_cloth_mesh(path=fan, density=0.1, stretch=10.0)
+        vv.SceneBuilder().add_cloth_mesh(path=fan, areal_density=0.1, stiffness=10.0)
     assert "entities[0].path" in str(error.value)
     assert f"the mesh in {str(fan)!r} at triangles[2]" in str(error.value)
 
@@ -199,11 +199,13 @@ def test_path_or_arrays_exactly_one(tmp_path):
     builder = vv.SceneBuilder()
     square = [[0, 0, 0], [1, 0, 0], [1, 1, 0]]
     with pytest.raises(vv.SceneError, match="not both"):
-        builder.add_cloth_mesh(square, [[0, 1, 2]], path=TABLECLOTH, density=0.1, stretch=1.0)
+        builder.add_cloth_mesh(
+            square, [[0, 1, 2]], path=TABLECLOTH, areal_density=0.1, stiffness=1.0
+        )
     with pytest.raises(vv.SceneError, match="the mesh is missing: give the mesh as"):
-        builder.add_cloth_mesh(density=0.1, stretch=1.0)
+        builder.add_cloth_mesh(areal_density=0.1, stiffness=1.0)
     with pytest.raises(vv.SceneError, match="`triangles` missing"):
-        builder.add_cloth_mesh(square, density=0.1, stretch=1.0)
+        builder.add_cloth_mesh(square, areal_density=0.1, stiffness=1.0)
     assert not builder.scene.entities  # nothing refused was added
 
 
@@ -212,7 +214,7 @@ def test_a_scene_file_whose_mesh_is_missing_names_the_line_and_the_resolved_path
     scene.parent.mkdir()
     scene.write_text(
         '[[entities]]\ntype = "cloth_mesh"\npath = "meshes/cloth.obj"\n'
-        "density = 0.1\nstretch = 10.0\n"
+        "areal_density = 0.1\nstiffness = 10.0\n"
     )
     with pytest.raises(vv.SceneError) as error:
         vv.load_model(scene)

@@ -201,14 +201,14 @@ def test_each_member_moves_as_it_does_alone(method):
 def test_cloths_batch_to_round_off():
     # A cloth's springs sum by its lattice's stencil alone and spring by spring in the merged
     # model: the same forces, added in another order.
-    def cloth(stretch):
+    def cloth(stiffness):
         data = {
             "integration": {"method": "symplectic_euler", "dt": 0.002, "duration": 0.5},
             "entities": [
                 {
                     "type": "cloth",
                     "resolution": [6, 5],
-                    "stretch": stretch,
+                    "stiffness": stiffness,
                     "pinned": [0, 5],
                     "damping": 0.01,
                 },

@@ -171,7 +171,7 @@ def test_emitter_draws_speeds_directions_and_lifetimes_within_their_ranges():
         shape="sphere",
         radius=0.5,
         direction=(0.0, 1.0, 0.0),
-        spread=30.0,
+        spread_deg=30.0,
         speed=[2.0, 3.0],
         lifetime=[1.0, 2.0],
         particle_radius=[0.01, 0.02],
@@ -201,7 +201,7 @@ def _fountain() -> vv.Model:
     builder.add_emitter(
         rate=300,
         speed=[3.0, 4.0],
-        spread=15,
+        spread_deg=15,
         lifetime=[0.8, 1.2],
         seed=3,
         size_ramp=[[0.0, 1.0], [1.0, 0.2]],

@@ -29,7 +29,7 @@ type = "emitter"
 name = "spray"
 rate = 200.0
 speed = [2.0, 3.0]
-spread = 20.0
+spread_deg = 20.0
 lifetime = 0.4
 color_ramp = [[0.0, 1.0, 0.9, 0.2], [1.0, 0.8, 0.1, 0.0]]
 

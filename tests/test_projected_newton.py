@@ -23,12 +23,12 @@ from visviva.model.scene_system import initial_state, scene_system
 H = 1.0 / 60.0
 
 
-def _cloth(n, *, damping=0.01, bend=1.0, method="symplectic_euler", duration=2.0):
+def _cloth(n, *, damping=0.01, bending=1.0, method="symplectic_euler", duration=2.0):
     builder = vv.SceneBuilder(name=f"cloth {n}")
     builder.set_world(gravity=(0.0, -9.81, 0.0))
     builder.set_integration(method=method, dt=H, duration=duration)
     builder.add_cloth(
-        (n, n), stretch=1000.0, shear=100.0, bend=bend, damping=damping, density=0.1,
+        (n, n), stiffness=1000.0, shear=100.0, bending=bending, damping=damping, areal_density=0.1,
         origin=(0.0, 1.0, 0.0), along=(1.0, 0.0, 0.0), across=(0.0, 0.0, 1.0),
         pinned=[0, n - 1],
     )  # fmt: skip
@@ -297,7 +297,7 @@ def test_cloth_drapes_over_a_sphere_held_inside_the_solve():
     builder = vv.SceneBuilder(name="drape")
     builder.set_integration(method="projected_newton", dt=H, duration=1.5)
     builder.add_cloth(
-        (16, 16), stretch=2e3, shear=100.0, bend=0.05, density=0.1, damping=0.05,
+        (16, 16), stiffness=2e3, shear=100.0, bending=0.05, areal_density=0.1, damping=0.05,
         origin=(-0.6, 1.2, -0.6), along=(1.2, 0.0, 0.0), across=(0.0, 0.0, 1.2), radius=0.01,
     )  # fmt: skip
     builder.add_collider("sphere", name="ball", center=(0, 0.6, 0), radius=0.35, friction=0.5)

@@ -93,7 +93,7 @@ def test_damping_rates_make_the_momenta_decay_exponentially():
     h = 0.01 s matches to 1e-9 relative after 2 s."""
     builder = _scene(
         "rk4", gravity=(0.0, 0.0, 0.0), velocity=(1.0, 2.0, 0.0),
-        angular_velocity=(0.5, 1.0, -2.0), linear_damping=0.7, angular_damping=1.3,
+        angular_velocity=(0.5, 1.0, -2.0), linear_damping_rate=0.7, angular_damping_rate=1.3,
     )  # fmt: skip
     simulation = vv.Simulation(builder.build())
     p0 = simulation.state["body_momentum"].copy()
@@ -291,12 +291,12 @@ def test_the_fused_step_of_free_bodies_is_the_generic_pipelines():
     the same operations differs), and scenes with pushes, anchors or particles do not take
     it."""
     rng = np.random.default_rng(5)
-    builder = _scene(linear_damping=0.3, angular_damping=0.2, angular_velocity=(1, 2, 3))
+    builder = _scene(linear_damping_rate=0.3, angular_damping_rate=0.2, angular_velocity=(1, 2, 3))
     for _ in range(5):
         builder.add_body(
             "capsule", radius=0.05, height=0.2, density=800.0, position=rng.normal(size=3),
             orientation=rng.normal(size=4) / 2.0 + [1, 0, 0, 0], velocity=rng.normal(size=3),
-            angular_velocity=5 * rng.normal(size=3), linear_damping=0.1,
+            angular_velocity=5 * rng.normal(size=3), linear_damping_rate=0.1,
         )  # fmt: skip
     # One spinning fast enough (40 rad/s: ½ h |L|/I_min > 0.05) to leave the short series:
     # the fused step's general path takes it.
@@ -322,7 +322,7 @@ def test_a_fused_blow_up_stops_with_the_last_good_state():
     """Damping γ = 500/s at h = 0.01 s makes the explicit kick multiply P by 1 − hγ = −4 a
     step: the run stops with SimulationDiverged naming the body part, and the simulation
     holds the finite state of the last good step."""
-    model = _scene(linear_damping=500.0, velocity=(1.0, 0.0, 0.0)).build()
+    model = _scene(linear_damping_rate=500.0, velocity=(1.0, 0.0, 0.0)).build()
     simulation = vv.Simulation(model)
     assert simulation.compiled
     with pytest.raises(vv.SimulationDiverged, match="body_"):
@@ -369,7 +369,7 @@ def test_kinematic_and_static_bodies_move_as_given_whatever_acts():
     omega = np.array([0.3, 1.0, -0.5])
     builder = _scene(
         motion="kinematic", velocity=(1.0, 0.0, 0.0), angular_velocity=omega,
-        linear_damping=2.0, angular_damping=2.0,
+        linear_damping_rate=2.0, angular_damping_rate=2.0,
     )  # fmt: skip
     builder.add_body("sphere", radius=0.1, density=100.0, motion="static", position=(0, 5, 0))
     builder.add_body("sphere", radius=0.1, density=100.0, position=(0, 5, 1))

@@ -272,8 +272,8 @@ HAIR = (
 )
 SPRINGS = 'type = "springs"\npoints = [[0, 0, 0], [1, 0, 0]]\nmass = 1.0\nstiffness = 10.0\n'
 CLOTH_MESH = (
-    'type = "cloth_mesh"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 0, 1]]\ndensity = 0.1\n'
-    "stretch = 1.0\n"
+    'type = "cloth_mesh"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 0, 1]]\n'
+    "areal_density = 0.1\nstiffness = 1.0\n"
 )
 SOFT_MESH = (
     'type = "soft_mesh"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]\ndensity = 1.0\n'
@@ -295,7 +295,7 @@ triangles = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 1]]
             entity('type = "emitter"\nrate = 5.0\nlifetime = [2.0, 1.0]'),
             ["entities[2]", "`lifetime`", "low > high"],
         ),
-        (entity('type = "emitter"\nspread = 10.0'), ["entities[2]", "emits nothing", "rate"]),
+        (entity('type = "emitter"\nspread_deg = 10.0'), ["entities[2]", "emits nothing", "rate"]),
         (
             entity('type = "emitter"\nrate = 5.0\ncapacity = 1000000000'),
             ["entities[2].capacity", "1000000000"],

@@ -31,7 +31,7 @@ def test_a_jelly_cube_lands_on_the_floor_and_keeps_its_shape(method, dt):
     builder.set_integration(method=method, dt=dt, duration=2.0)
     builder.add_soft_lattice(
         (6, 6, 6),
-        stretch=2000.0,
+        stiffness=2000.0,
         density=200.0,
         damping=0.5,
         origin=(-0.15, 0.5, -0.15),

@@ -57,12 +57,17 @@ TETRAHEDRON_EDGES = ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))
 
 @_overflow_judged_later
 def cloth_mesh(
-    vertices: np.ndarray, triangles: np.ndarray, density: float, stretch: float, bend: float
+    vertices: np.ndarray,
+    triangles: np.ndarray,
+    areal_density: float,
+    stiffness: float,
+    bending: float,
 ) -> SpringNetwork:
     """Cloth on the triangle mesh ``vertices`` ``(n, 3)`` [m], ``triangles`` ``(T, 3)``
-    (indices into ``vertices``; their orientation only chooses the front drawn), of areal
-    ``density`` [kg/m²]: :data:`STRETCH` springs of ``stretch`` [N/m] on every edge, then
-    :data:`BEND` springs of ``bend`` [N/m] across every edge two triangles share (none if 0);
+    (indices into ``vertices``; their orientation only chooses the front drawn), of
+    ``areal_density`` [kg/m²]: :data:`STRETCH` springs of ``stiffness`` [N/m] on every edge,
+    then :data:`BEND` springs of ``bending`` [N/m] across every edge two triangles share (none
+    if 0);
     drawn by ``triangles``.
 
     Raises:
@@ -101,12 +106,12 @@ def cloth_mesh(
             "triangles",
             int(shared[2]),
         )
-    families = [_springs(edges[:, 0], edges[:, 1], stretch, STRETCH)]
-    if bend > 0.0:
+    families = [_springs(edges[:, 0], edges[:, 1], stiffness, STRETCH)]
+    if bending > 0.0:
         inner = start[count == 2]
-        families.append(_springs(facing[order[inner]], facing[order[inner + 1]], bend, BEND))
+        families.append(_springs(facing[order[inner]], facing[order[inner + 1]], bending, BEND))
     mass = (
-        density
+        areal_density
         / 6.0
         * np.bincount(
             cells.reshape(-1), weights=np.repeat(double_area, 3), minlength=vertices.shape[0]

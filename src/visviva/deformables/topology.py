@@ -263,17 +263,17 @@ def cloth_grid(
     along: np.ndarray,
     across: np.ndarray,
     resolution: tuple[int, int],
-    density: float,
-    stretch: float,
+    areal_density: float,
+    stiffness: float,
     shear: float,
-    bend: float,
+    bending: float,
 ) -> SpringNetwork:
     """A sheet of ``nu × nv`` points (``resolution``) spanning the parallelogram ``origin +
     s·along + t·across``, ``s, t ∈ [0, 1]`` [m]; point ``(i, j)`` (``i`` along, ``j`` across)
-    has index ``j·nu + i``. Areal ``density`` [kg/m²]; ``stretch``, ``shear`` and ``bend``
-    stiffness [N/m] of each family (a family of stiffness 0 is left out). Its surface is two
-    triangles per cell; their front is the side ``across × along`` points to (up for a sheet
-    along +x and across +z, the scene's default)."""
+    has index ``j·nu + i``. ``areal_density`` [kg/m²]; ``stiffness`` (structural), ``shear``
+    and ``bending`` stiffness [N/m] of each family (a family of stiffness 0 is left out). Its
+    surface is two triangles per cell; their front is the side ``across × along`` points to (up
+    for a sheet along +x and across +z, the scene's default)."""
     nu, nv = resolution
     s = np.arange(nu) / (nu - 1)
     t = np.arange(nv) / (nv - 1)
@@ -286,17 +286,17 @@ def cloth_grid(
     for dj in (0, 1):
         for di in (0, 1):
             share[dj : nv - 1 + dj, di : nu - 1 + di] += 0.25
-    mass = density * cell * share.reshape(-1)
+    mass = areal_density * cell * share.reshape(-1)
     families = []
-    if stretch > 0.0:
-        families.append(_springs(index[:, :-1], index[:, 1:], stretch, STRETCH))
-        families.append(_springs(index[:-1, :], index[1:, :], stretch, STRETCH))
+    if stiffness > 0.0:
+        families.append(_springs(index[:, :-1], index[:, 1:], stiffness, STRETCH))
+        families.append(_springs(index[:-1, :], index[1:, :], stiffness, STRETCH))
     if shear > 0.0:
         families.append(_springs(index[:-1, :-1], index[1:, 1:], shear, SHEAR))
         families.append(_springs(index[:-1, 1:], index[1:, :-1], shear, SHEAR))
-    if bend > 0.0:
-        families.append(_springs(index[:, :-2], index[:, 2:], bend, BEND))
-        families.append(_springs(index[:-2, :], index[2:, :], bend, BEND))
+    if bending > 0.0:
+        families.append(_springs(index[:, :-2], index[:, 2:], bending, BEND))
+        families.append(_springs(index[:-2, :], index[2:, :], bending, BEND))
     # Columns across, rows along: the triangles face across × along.
     return _network(points, mass, families, faces=grid_triangles(index.T), lattice=(nu, nv))
 
@@ -307,13 +307,13 @@ def soft_lattice(
     size: np.ndarray,
     resolution: tuple[int, int, int],
     density: float,
-    stretch: float,
+    stiffness: float,
     shear: float,
     diagonal: float,
 ) -> SpringNetwork:
     """A box of ``nx × ny × nz`` points (``resolution``) from the corner ``origin`` with edge
     lengths ``size`` [m]; point ``(i, j, k)`` has index ``(k·ny + j)·nx + i``. ``density``
-    [kg/m³]; ``stretch``, ``shear`` and ``diagonal`` stiffness [N/m] of the structural,
+    [kg/m³]; ``stiffness``, ``shear`` and ``diagonal`` stiffness [N/m] of the structural,
     face-diagonal and body-diagonal springs (a family of stiffness 0 is left out). Its surface
     is the box's six faces, two triangles per cell face, wound outward."""
     nx, ny, nz = resolution
@@ -328,13 +328,13 @@ def soft_lattice(
             for di in (0, 1):
                 share[dk : nz - 1 + dk, dj : ny - 1 + dj, di : nx - 1 + di] += 0.125
     families = []
-    for stiffness, family, offsets in (
-        (stretch, STRETCH, [(1, 0, 0), (0, 1, 0), (0, 0, 1)]),
+    for k, family, offsets in (
+        (stiffness, STRETCH, [(1, 0, 0), (0, 1, 0), (0, 0, 1)]),
         (shear, SHEAR, [(1, 1, 0), (1, -1, 0), (1, 0, 1), (1, 0, -1), (0, 1, 1), (0, 1, -1)]),
         (diagonal, DIAGONAL, [(1, 1, 1), (1, 1, -1), (1, -1, 1), (-1, 1, 1)]),
     ):
-        if stiffness > 0.0:
-            families += [_offset_springs(index, o, stiffness, family) for o in offsets]
+        if k > 0.0:
+            families += [_offset_springs(index, o, k, family) for o in offsets]
     mass = density * cell * share.reshape(-1)
     return _network(points, mass, families, faces=box_triangles(index), lattice=(nx, ny, nz))
 

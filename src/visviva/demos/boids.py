@@ -3,7 +3,7 @@ an obstacle on its way to a goal (Reynolds' boids, :mod:`visviva.particles.boids
 
 The birds start in a box, each with a random velocity (so the flock's polarisation
 ``Φ = |Σ v/|v|| / N`` starts near ``1/√N``); they see flockmates within ``RADIUS`` in a field of
-view of ``FOV`` degrees, keep ``SEPARATION`` apart, align and cohere, and seek a ``GOAL`` behind
+view of ``FOV_DEG`` degrees, keep ``SEPARATION`` apart, align and cohere, and seek a ``GOAL`` behind
 a sphere, which they avoid from their look-ahead distance (2V²/A) on (and which, as an impulse
 collider, would also bounce a bird that touched it). World gravity is off: the birds' lift is
 not modelled. The same scene, with fewer birds, ships as ``examples/scenes/boids.toml``.
@@ -34,10 +34,10 @@ BOX = (24.0, 8.0, 24.0)  # its edges [m]: about 12 flockmates within RADIUS at t
 SPEED_JITTER = 3.0  # standard deviation of each starting velocity component [m/s]
 RADIUS = 2.5  # [m]
 SEPARATION = 1.0  # [m]
-FOV = 270.0  # [degrees]
+FOV_DEG = 270.0  # [degrees]
 MAX_SPEED = 6.0  # [m/s]
 MIN_SPEED = 2.0  # [m/s]
-MAX_FORCE = 12.0  # [m/s²]: look-ahead 2V²/A = 6 m
+MAX_ACCELERATION = 12.0  # [m/s²]: look-ahead 2V²/A = 6 m
 SEPARATION_WEIGHT, ALIGNMENT_WEIGHT, COHESION_WEIGHT = 8.0, 2.0, 1.0  # [1/s]
 GOAL = (45.0, 12.0, 0.0)  # [m]
 GOAL_WEIGHT = 0.6  # [1/s]
@@ -73,10 +73,10 @@ def build_scene(birds: int = BIRDS, duration: float = DURATION) -> SceneBuilder:
         ["birds"],
         radius=RADIUS,
         separation=SEPARATION,
-        fov=FOV,
+        fov_deg=FOV_DEG,
         max_speed=MAX_SPEED,
         min_speed=MIN_SPEED,
-        max_force=MAX_FORCE,
+        max_acceleration=MAX_ACCELERATION,
         goal=GOAL,
         goal_weight=GOAL_WEIGHT,
         separation_weight=SEPARATION_WEIGHT,

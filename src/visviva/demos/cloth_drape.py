@@ -59,10 +59,10 @@ METHOD = "projected_newton"
 POINTS = 16  # per side
 SIZE = 1.2  # [m]
 START_HEIGHT = 1.2  # [m]
-DENSITY = 0.1  # [kg/m²]
-STRETCH = 2000.0  # [N/m]
+AREAL_DENSITY = 0.1  # [kg/m²]
+STIFFNESS = 2000.0  # [N/m]
 SHEAR = 100.0  # [N/m]
-BEND = 0.05  # [N/m]
+BENDING = 0.05  # [N/m]
 DAMPING = 0.05  # [N·s/m] along each spring
 AIR = 1.0  # γ [1/s]
 POINT_RADIUS = 0.01  # [m]
@@ -81,7 +81,7 @@ PRESSED = 0.05
 #: its velocity correction is below 1e-4 m/s (RMS), and a velocity off by δv changes the work of
 #: the cloth's weight M g over the step by up to M g h δv (1.2 µJ here; the largest rise
 #: measured is 0.7 µJ). Round-off on the 1.7 J cloth is 1e-16 J.
-ENERGY_RISE_TOLERANCE = DENSITY * SIZE * SIZE * GRAVITY * DT * 1e-4
+ENERGY_RISE_TOLERANCE = AREAL_DENSITY * SIZE * SIZE * GRAVITY * DT * 1e-4
 DESCRIPTION = "a 1.2 m square of 0.1 kg/m² cloth, 16 × 16 points, falls onto a ball with friction"
 
 
@@ -95,10 +95,10 @@ def build_scene(duration: float = DURATION) -> SceneBuilder:
         origin=(-0.5 * SIZE, START_HEIGHT, -0.5 * SIZE),
         along=(SIZE, 0.0, 0.0),
         across=(0.0, 0.0, SIZE),
-        density=DENSITY,
-        stretch=STRETCH,
+        areal_density=AREAL_DENSITY,
+        stiffness=STIFFNESS,
         shear=SHEAR,
-        bend=BEND,
+        bending=BENDING,
         damping=DAMPING,
         radius=POINT_RADIUS,
         color=(0.2, 0.45, 0.8),

@@ -54,7 +54,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     drifts = {}
     for alpha in (0.0, STABILIZATION):
         problem, multiplier = classic.constrained_pendulum(
-            THETA0, length=LENGTH, stabilization=alpha
+            THETA0, length=LENGTH, stabilization_rate=alpha
         )
         particle = solve(problem, "rk4", dt=DT, t_end=duration)
         label = "particle + λ(r − c)" + (f", Baumgarte α = {alpha:g}/s" if alpha else "")

@@ -32,7 +32,7 @@ RECORD_EVERY = 8  # 50 frames per second
 GRAVITY = 9.81  # [m/s²]
 NOZZLE = (0.0, 0.2, 0.0)  # centre of the nozzle's mouth [m], above the basin floor at y = 0
 NOZZLE_RADIUS = 0.04  # [m]
-SPREAD = 9.0  # half-angle of the jet [degrees]
+SPREAD_DEG = 9.0  # half-angle of the jet [degrees]
 SPEED = (5.6, 6.6)  # [m/s]
 RATE = 2400.0  # drops per second [1/s]
 LIFETIME = (1.5, 2.1)  # [s]: longer than a flight (~1.4 s), so drops run over the floor a while
@@ -66,7 +66,7 @@ def build_scene(duration: float = DURATION) -> SceneBuilder:
         radius=NOZZLE_RADIUS,
         normal=(0.0, 1.0, 0.0),
         direction=(0.0, 1.0, 0.0),
-        spread=SPREAD,
+        spread_deg=SPREAD_DEG,
         speed=SPEED,
         lifetime=LIFETIME,
         particle_radius=DROP_RADIUS,

@@ -55,7 +55,7 @@ METHOD = "projected_newton"
 RESOLUTIONS = (6, 11, 21)  # points per side
 SIZE = 1.0  # [m]
 HEIGHT = 1.5  # [m]: the top edge
-DENSITY = 0.1  # [kg/m²]
+AREAL_DENSITY = 0.1  # [kg/m²]
 STIFFNESS = 100.0  # [N/m]: structural and shear alike
 AIR = 2.0  # γ [1/s]: still air, so the cloth settles
 STRUCTURE_POINTS = 11
@@ -79,8 +79,8 @@ def build_scene(
     pinned: list[int],
     *,
     shear: float = STIFFNESS,
-    bend: float = 0.0,
-    stretch: float = STIFFNESS,
+    bending: float = 0.0,
+    stiffness: float = STIFFNESS,
     across: tuple[float, float, float] = (0.0, -SIZE, 0.0),
     air: float = AIR,
     duration: float = DURATION,
@@ -95,10 +95,10 @@ def build_scene(
         origin=(-0.5 * SIZE, HEIGHT, 0.0),
         along=(SIZE, 0.0, 0.0),
         across=across,
-        density=DENSITY,
-        stretch=stretch,
+        areal_density=AREAL_DENSITY,
+        stiffness=stiffness,
         shear=shear,
-        bend=bend,
+        bending=bending,
         pinned=pinned,
         radius=0.004,
         color=(0.55, 0.3, 0.7),
@@ -117,9 +117,10 @@ def _rest(builder: SceneBuilder, duration: float) -> tuple[Recording, np.ndarray
     return recording, state["particle_position"], float(np.abs(state["particle_velocity"]).max())
 
 
-def membrane_moduli(stretch: float = STIFFNESS, shear: float = STIFFNESS) -> dict[str, float]:
-    """``C₁₁`` and the uniaxial modulus ``E = C₁₁ − C₁₂²/C₁₁`` [N/m] of the grid's membrane."""
-    c11, c12 = stretch + shear, shear
+def membrane_moduli(stiffness: float = STIFFNESS, shear: float = STIFFNESS) -> dict[str, float]:
+    """``C₁₁`` and the uniaxial modulus ``E = C₁₁ − C₁₂²/C₁₁`` [N/m] of the grid's membrane,
+    from its structural ``stiffness`` and ``shear`` stiffness [N/m]."""
+    c11, c12 = stiffness + shear, shear
     return {"C11": c11, "E": c11 - c12**2 / c11}
 
 
@@ -142,7 +143,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     sag = {n: HEIGHT - float(grid[0, n // 2, 1]) for n, grid in corners.items()}
     drop = {n: HEIGHT - SIZE - float(grid[-1, :, 1].mean()) for n, grid in curtain.items()}
     moduli = membrane_moduli()
-    load = 0.5 * DENSITY * SIZE * SIZE * GRAVITY  # on each corner
+    load = 0.5 * AREAL_DENSITY * SIZE * SIZE * GRAVITY  # on each corner
     slope = np.polyfit(np.log2(RESOLUTIONS), list(sag.values()), 1)[0]
     output.figures["refinement_study"] = _figure(corners, curtain, sag, structure)
     return {
@@ -162,8 +163,11 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
             "per_resolution": {str(n): value for n, value in drop.items()},
             "spread_max_minus_min": max(drop.values()) - min(drop.values()),
             "successive_changes": np.diff(list(drop.values())).tolist(),
-            "free_to_contract_rho_g_H2_over_2E": DENSITY * GRAVITY * SIZE**2 / (2 * moduli["E"]),
-            "held_from_contracting_rho_g_H2_over_2C11": DENSITY
+            "free_to_contract_rho_g_H2_over_2E": AREAL_DENSITY
+            * GRAVITY
+            * SIZE**2
+            / (2 * moduli["E"]),
+            "held_from_contracting_rho_g_H2_over_2C11": AREAL_DENSITY
             * GRAVITY
             * SIZE**2
             / (2 * moduli["C11"]),
@@ -180,16 +184,16 @@ def _structure_study(
     rows along one edge: its free edge's mean drop)."""
     n = STRUCTURE_POINTS
     out = {}
-    for label, (shear, bend) in SPRING_SETS.items():
+    for label, (shear, bending) in SPRING_SETS.items():
         side = [j * n for j in range(n)]  # the column i = 0
-        sheared = build_scene(n, side, shear=shear, bend=bend, stretch=STRUCTURE_STIFFNESS,
+        sheared = build_scene(n, side, shear=shear, bending=bending, stiffness=STRUCTURE_STIFFNESS,
                               air=STRUCTURE_AIR, duration=duration)  # fmt: skip
         recording, x, speed = _rest(sheared, duration)
         speeds.append(speed)
         runs[f"in_plane_{label}"] = recording
         corner = HEIGHT - SIZE - float(x[n * n - 1, 1])
-        clamped = build_scene(n, list(range(2 * n)), shear=shear, bend=bend,
-                              stretch=STRUCTURE_STIFFNESS, across=(0.0, 0.0, SIZE),
+        clamped = build_scene(n, list(range(2 * n)), shear=shear, bending=bending,
+                              stiffness=STRUCTURE_STIFFNESS, across=(0.0, 0.0, SIZE),
                               air=STRUCTURE_AIR, duration=duration)  # fmt: skip
         recording, x, speed = _rest(clamped, duration)
         speeds.append(speed)
@@ -222,7 +226,7 @@ def _figure(
                     label=f"{n} × {n}")  # fmt: skip
     moduli = membrane_moduli()
     for key, style in (("E", ":"), ("C11", "--")):
-        level = DENSITY * GRAVITY * SIZE**2 / (2 * moduli[key])
+        level = AREAL_DENSITY * GRAVITY * SIZE**2 / (2 * moduli[key])
         bottom.axhline(-1e3 * level, color="k", linestyle=style, lw=0.8,
                        label=f"ρgH²/(2·{key})")  # fmt: skip
     bottom.set_xlabel("x [m]")

@@ -62,7 +62,7 @@ IMPLICIT = ("projected_newton", "linearly_implicit_euler")
 POINTS = 8  # per side: the advisor takes the eigenvalues of a 384 × 384 matrix
 SIZE = 1.0  # [m]
 HEIGHT = 1.5  # [m]
-DENSITY = 1.0  # [kg/m²]: heavy canvas
+AREAL_DENSITY = 1.0  # [kg/m²]: heavy canvas
 DESCRIPTION = "a 1 m square of 1 kg/m² canvas, 8 × 8 points, held at two corners"
 
 
@@ -76,8 +76,8 @@ def build_scene(stiffness: float, method: str, duration: float = DURATION) -> Sc
         origin=(-0.5 * SIZE, HEIGHT, 0.0),
         along=(SIZE, 0.0, 0.0),
         across=(0.0, 0.0, SIZE),
-        density=DENSITY,
-        stretch=stiffness,
+        areal_density=AREAL_DENSITY,
+        stiffness=stiffness,
         shear=stiffness,
         pinned=[0, POINTS - 1],
         radius=0.01,

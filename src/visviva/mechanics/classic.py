@@ -286,7 +286,7 @@ def constrained_pendulum(
     length: float = 1.0,
     mass: float = 1.0,
     g: float = STANDARD_GRAVITY,
-    stabilization: float = 0.0,
+    stabilization_rate: float = 0.0,
 ) -> tuple[SecondOrderProblem, Any]:
     """The pendulum as a free particle ``r = (x, y)`` held by a constraint force, not by θ.
 
@@ -296,13 +296,13 @@ def constrained_pendulum(
         λ = −m (|ṙ|² + (r − c)·g) / |r − c|²,
 
     so ``m r̈ = m g + λ (r − c)`` is an ordinary second-order problem. Numerically ``C`` drifts;
-    ``stabilization = α > 0`` asks for ``C̈ = −2α Ċ − α² C`` instead (Baumgarte 1972, critically
+    ``stabilization_rate = α > 0`` asks for ``C̈ = −2α Ċ − α² C`` instead (Baumgarte 1972, critically
     damped), pulling the particle back onto the circle at the rate α [1/s].
 
     Args:
         theta0, omega0: Initial angle from straight down [rad] and angular velocity [rad/s].
         length, mass, g: Rod length [m], bob mass [kg], gravity [m/s²].
-        stabilization: Baumgarte rate α [1/s]; 0 for the pure index-reduced equations.
+        stabilization_rate: Baumgarte rate α [1/s]; 0 for the pure index-reduced equations.
 
     Returns:
         The problem on ``q = (x, y)`` (energy ``½ m |ṙ|² + m g y``) and
@@ -311,7 +311,7 @@ def constrained_pendulum(
     length = _positive("length", length, " m")
     mass = _positive("mass", mass, " kg")
     g = _positive("g", g, " m/s²")
-    alpha = real_number("stabilization", stabilization, nonnegative=True, unit=" 1/s")
+    alpha = real_number("stabilization_rate", stabilization_rate, nonnegative=True, unit=" 1/s")
     gravity = np.array([0.0, -g])
 
     def multiplier(q: np.ndarray, v: np.ndarray) -> Any:

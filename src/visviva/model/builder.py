@@ -231,13 +231,13 @@ class SceneBuilder:
         self,
         resolution: Sequence[int],
         *,
-        stretch: float,
+        stiffness: float,
         origin: Vector | None = None,
         along: Vector | None = None,
         across: Vector | None = None,
-        density: float | None = None,
+        areal_density: float | None = None,
         shear: float | None = None,
-        bend: float | None = None,
+        bending: float | None = None,
         damping: float | None = None,
         pinned: Sequence[int] | None = None,
         handle: Handle | Mapping[str, Any] | None = None,
@@ -247,10 +247,11 @@ class SceneBuilder:
         name: str | None = None,
     ) -> int:
         """Add a cloth: ``resolution`` = (nu, nv) points on a grid spanning ``origin + s·along
-        + t·across`` [m], of areal ``density`` [kg/m²], with structural springs of ``stretch``
-        [N/m], shear springs of ``shear`` (default ``stretch``) and bend springs of ``bend``
-        (default none), each with ``damping`` [N·s/m]; point (i, j) has index j·nu + i, and
-        the points ``pinned`` stay where they are, or follow the ``handle``'s motion."""
+        + t·across`` [m], of ``areal_density`` [kg/m²], with structural springs of
+        ``stiffness`` [N/m], shear springs of ``shear`` (default ``stiffness``) and bending
+        springs of ``bending`` [N/m] (default none), each with ``damping`` [N·s/m]; point
+        (i, j) has index j·nu + i, and the points ``pinned`` stay where they are, or follow the
+        ``handle``'s motion."""
         given = _given(locals())
         given["resolution"] = tuple(given["resolution"])
         return self._add(Cloth, "cloth", given)
@@ -259,7 +260,7 @@ class SceneBuilder:
         self,
         resolution: Sequence[int],
         *,
-        stretch: float,
+        stiffness: float,
         origin: Vector | None = None,
         size: Vector | None = None,
         density: float | None = None,
@@ -275,8 +276,8 @@ class SceneBuilder:
     ) -> int:
         """Add a soft body: ``resolution`` = (nx, ny, nz) points on a lattice filling the box
         from the corner ``origin`` with edge lengths ``size`` [m], of ``density`` [kg/m³],
-        with structural springs of ``stretch`` [N/m] and face- and body-diagonal springs of
-        ``shear`` and ``diagonal`` (default ``stretch``), each with ``damping`` [N·s/m];
+        with structural springs of ``stiffness`` [N/m] and face- and body-diagonal springs of
+        ``shear`` and ``diagonal`` (default ``stiffness``), each with ``damping`` [N·s/m];
         point (i, j, k) has index (k·ny + j)·nx + i; the points ``pinned`` stay where they
         are, or follow the ``handle``'s motion."""
         given = _given(locals())
@@ -289,9 +290,9 @@ class SceneBuilder:
         triangles: Any = None,
         *,
         path: str | os.PathLike[str] | None = None,
-        density: float,
-        stretch: float,
-        bend: float | None = None,
+        areal_density: float,
+        stiffness: float,
+        bending: float | None = None,
         damping: float | None = None,
         pinned: Sequence[int] | None = None,
         handle: Handle | Mapping[str, Any] | None = None,
@@ -301,11 +302,11 @@ class SceneBuilder:
         name: str | None = None,
     ) -> int:
         """Add cloth on a triangle mesh: a particle at each of the ``vertices`` [m] ``(n, 3)``
-        (in this order in the state) weighing the areal ``density`` [kg/m²] times a third of
+        (in this order in the state) weighing the ``areal_density`` [kg/m²] times a third of
         the area of each of its ``triangles`` ``(T, 3)`` (vertex indices); stretch springs of
-        ``stretch`` [N/m] on every edge and bend springs of ``bend`` [N/m] (default none)
-        between the vertices facing each other across every edge two triangles share, each
-        with ``damping`` [N·s/m]. A triangle resists shear by itself: there is no shear
+        ``stiffness`` [N/m] on every edge and bending springs of ``bending`` [N/m] (default
+        none) between the vertices facing each other across every edge two triangles share,
+        each with ``damping`` [N·s/m]. A triangle resists shear by itself: there is no shear
         family. The vertices ``pinned`` stay where they are, or follow the ``handle``'s
         motion.
 
@@ -338,8 +339,8 @@ class SceneBuilder:
         vertices: Any = None,
         triangles: Any = None,
         path: str | os.PathLike[str] | None = None,
-        linear_damping: float | None = None,
-        angular_damping: float | None = None,
+        linear_damping_rate: float | None = None,
+        angular_damping_rate: float | None = None,
         push: Sequence[Mapping[str, Any]] | None = None,
         anchor: Mapping[str, Any] | None = None,
         motion: str | None = None,
@@ -353,8 +354,8 @@ class SceneBuilder:
         file at ``path``) of uniform ``density`` [kg/m³] or total ``mass`` [kg], its own
         origin at ``position`` [m], turned by ``orientation`` (a unit quaternion (w, x, y, z),
         body to world), its centre of mass moving at ``velocity`` [m/s] and spinning at
-        ``angular_velocity`` [rad/s] (world frame); ``linear_damping`` and
-        ``angular_damping`` [1/s] damp its momenta; ``push`` is a list of forces at its
+        ``angular_velocity`` [rad/s] (world frame); ``linear_damping_rate`` and
+        ``angular_damping_rate`` [1/s] damp its momenta; ``push`` is a list of forces at its
         points (``{"force": ..., "point": ..., "start": ..., "duration": ...}``) and
         ``anchor`` holds one of its points at a world point by a spring (``{"point": ...,
         "at": ..., "stiffness": ..., "damping": ...}``). ``motion``: ``"dynamic"`` (the
@@ -417,7 +418,7 @@ class SceneBuilder:
         vertices: Any = None,
         triangles: Any = None,
         direction: Vector | None = None,
-        spread: float | None = None,
+        spread_deg: float | None = None,
         speed: float | Sequence[float] | None = None,
         lifetime: float | Sequence[float] | None = None,
         particle_radius: float | Sequence[float] | None = None,
@@ -431,8 +432,8 @@ class SceneBuilder:
     ) -> int:
         """Add an emitter (see :class:`visviva.model.scene.Emitter` for every field): particles
         born at ``rate`` [1/s] and in ``bursts`` (``{"time": s, "count": n}``) from a ``shape``
-        (point, disc, sphere, box, mesh), flying out along ``direction`` within ``spread``
-        degrees at ``speed`` [m/s], living ``lifetime`` [s]; ranges are ``[low, high]``."""
+        (point, disc, sphere, box, mesh), flying out along ``direction`` within ``spread_deg``
+        [degrees] at ``speed`` [m/s], living ``lifetime`` [s]; ranges are ``[low, high]``."""
         return self._add(Emitter, "emitter", _given(locals()))
 
     def add_force(
@@ -517,8 +518,8 @@ class SceneBuilder:
         radius: float,
         separation: float,
         max_speed: float,
-        max_force: float,
-        fov: float | None = None,
+        max_acceleration: float,
+        fov_deg: float | None = None,
         min_speed: float | None = None,
         separation_weight: float | None = None,
         alignment_weight: float | None = None,
@@ -534,9 +535,9 @@ class SceneBuilder:
     ) -> int:
         """Add a flock: Reynolds' boids steering the particles of the entities named in
         ``targets`` (:mod:`visviva.particles.boids`). Boids see flockmates within ``radius``
-        [m] and the field of view ``fov`` [degrees]; separation from those closer than
+        [m] and the field of view ``fov_deg`` [degrees]; separation from those closer than
         ``separation`` [m], alignment and cohesion with weights [1/s]; desired speed
-        ``max_speed`` [m/s], steering bounded by ``max_force`` [m/s²]; an optional ``goal``
+        ``max_speed`` [m/s], steering bounded by ``max_acceleration`` [m/s²]; an optional ``goal``
         point and ``leader`` entity (weights default to 1/s); colliders avoided from
         ``look_ahead`` [m]; no two boids left closer than ``min_distance`` [m] if given;
         ``plane="xz"`` for a 2-D flock."""

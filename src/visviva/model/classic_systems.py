@@ -132,7 +132,7 @@ def _constrained_pendulum(values: Mapping[str, float], gravity: np.ndarray) -> P
         length=values["length"],
         mass=values["mass"],
         g=math.hypot(*gravity),
-        stabilization=values["stabilization"],
+        stabilization_rate=values["stabilization_rate"],
     )
     return problem
 
@@ -262,11 +262,11 @@ CLASSIC_SYSTEMS: tuple[SystemType, ...] = (
             "mass": _MASS,
             "theta0": _angle("initial angle from the downward vertical", 0.5),
             "omega0": _rate("initial angular velocity"),
-            "stabilization": Parameter(0.0, "1/s", "Baumgarte rate (0: none)", minimum=0.0),
+            "stabilization_rate": Parameter(0.0, "1/s", "Baumgarte rate (0: none)", minimum=0.0),
         },
         _constrained_pendulum,
         _draw_constrained,
         ((0, 1),),
-        dissipation="stabilization",  # Baumgarte's correction removes energy too
+        dissipation="stabilization_rate",  # Baumgarte's correction removes energy too
     ),
 )

@@ -118,7 +118,7 @@ def _spec(e: Emitter, index: int, name: str, duration: float, where: str) -> Emi
             surface=e.surface,
             triangles=triangles,
             direction=unit_vector("direction", e.direction),
-            spread=math.radians(e.spread),
+            spread=math.radians(e.spread_deg),
             speed=value_range("speed", e.speed, positive=False),
             lifetime=value_range("lifetime", e.lifetime, positive=True),
             particle_radius=value_range("particle_radius", e.particle_radius, positive=True),
@@ -399,9 +399,9 @@ def spring_network(entity: Body) -> SpringNetwork:
         return cloth_mesh(
             np.array(entity.vertices, dtype=np.float64),
             np.array(entity.triangles, dtype=np.int64).reshape(-1, 3),
-            entity.density,
-            entity.stretch,
-            entity.bend,
+            entity.areal_density,
+            entity.stiffness,
+            entity.bending,
         )
     if isinstance(entity, SoftMesh):
         return soft_mesh(
@@ -426,19 +426,19 @@ def spring_network(entity: Body) -> SpringNetwork:
             np.asarray(entity.size, dtype=np.float64),
             entity.resolution,
             entity.density,
-            entity.stretch,
-            entity.stretch if entity.shear is None else entity.shear,
-            entity.stretch if entity.diagonal is None else entity.diagonal,
+            entity.stiffness,
+            entity.stiffness if entity.shear is None else entity.shear,
+            entity.stiffness if entity.diagonal is None else entity.diagonal,
         )
     return cloth_grid(
         np.asarray(entity.origin, dtype=np.float64),
         np.asarray(entity.along, dtype=np.float64),
         np.asarray(entity.across, dtype=np.float64),
         entity.resolution,
-        entity.density,
-        entity.stretch,
-        entity.stretch if entity.shear is None else entity.shear,
-        entity.bend,
+        entity.areal_density,
+        entity.stiffness,
+        entity.stiffness if entity.shear is None else entity.shear,
+        entity.bending,
     )
 
 

@@ -49,8 +49,8 @@ def rigid_bodies(scene: Scene, names: list[str]) -> tuple[RigidBodies | None, li
         properties,
         starts,
         shapes,
-        [e.linear_damping if e.motion == "dynamic" else 0.0 for _, e in chosen],
-        [e.angular_damping if e.motion == "dynamic" else 0.0 for _, e in chosen],
+        [e.linear_damping_rate if e.motion == "dynamic" else 0.0 for _, e in chosen],
+        [e.angular_damping_rate if e.motion == "dynamic" else 0.0 for _, e in chosen],
         [e.color for _, e in chosen],
     )
     # Forces move dynamic bodies only: the others move as they are given.
@@ -58,8 +58,8 @@ def rigid_bodies(scene: Scene, names: list[str]) -> tuple[RigidBodies | None, li
     forces: list[BodyForce] = []
     if any(scene.world.gravity) and dynamic.any():
         forces.append(BodyGravity(scene.world.gravity, np.where(dynamic, bodies.mass, 0.0)))
-    if bodies.linear_damping.any() or bodies.angular_damping.any():
-        forces.append(BodyDamping(bodies.linear_damping, bodies.angular_damping))
+    if bodies.linear_damping_rate.any() or bodies.angular_damping_rate.any():
+        forces.append(BodyDamping(bodies.linear_damping_rate, bodies.angular_damping_rate))
     pushes = [(b, p) for b, (_, e) in enumerate(chosen) for p in e.push]
     if pushes:
         forces.append(_pushes(pushes, bodies))

@@ -303,7 +303,7 @@ class Emitter(Strict):
     vertices: list[Vector] | None = Field(None, description="mesh vertices [m]")
     triangles: list[tuple[int, int, int]] | None = Field(None, description="mesh triangles")
     direction: Vector = Field((0.0, 1.0, 0.0), description="axis of the emission cone")
-    spread: Annotated[float, Field(strict=True, ge=0, le=180, allow_inf_nan=False)] = Field(
+    spread_deg: Annotated[float, Field(strict=True, ge=0, le=180, allow_inf_nan=False)] = Field(
         0.0, description="half-angle of the emission cone [degrees]"
     )
     speed: NonNegativeRange = Field(1.0, description="initial speed [m/s] or [low, high]")

@@ -205,9 +205,10 @@ class SpringGraph(_Body):
 
 class Cloth(_Body):
     """``type = "cloth"``: a sheet of ``resolution`` = [nu, nv] particles on a grid spanning
-    ``origin + s·along + t·across`` (s, t in [0, 1]), joined by structural (``stretch``), shear
-    (cell diagonals) and bend (two apart) springs (Choi & Ko 2002). Point (i, j) has index
-    j·nu + i. Each point weighs ``density`` times its share of the cells around it."""
+    ``origin + s·along + t·across`` (s, t in [0, 1]), joined by structural (``stiffness``),
+    shear (``shear``, cell diagonals) and bending (``bending``, two apart) springs (Choi & Ko
+    2002), each with ``damping`` c [N·s/m]. Point (i, j) has index j·nu + i. Each point weighs
+    ``areal_density`` [kg/m²] times its share of the cells around it."""
 
     type: Literal["cloth"]
     noun: ClassVar[str] = "cloth"
@@ -219,12 +220,14 @@ class Cloth(_Body):
         Annotated[int, Field(strict=True, ge=2, le=4096)],
         Annotated[int, Field(strict=True, ge=2, le=4096)],
     ] = Field(description="points along and across [nu, nv]")
-    density: Positive = Field(0.2, description="mass per area [kg/m²]")
-    stretch: Positive = Field(description="stiffness of the structural springs [N/m]")
+    areal_density: Positive = Field(0.2, description="mass per area [kg/m²]")
+    stiffness: Positive = Field(description="stiffness k of the structural springs [N/m]")
     shear: NonNegative | None = Field(
-        None, description="stiffness of the shear springs [N/m] (default: stretch; 0: none)"
+        None, description="stiffness of the shear springs [N/m] (default: stiffness; 0: none)"
     )
-    bend: NonNegative = Field(0.0, description="stiffness of the bend springs [N/m] (0: none)")
+    bending: NonNegative = Field(
+        0.0, description="stiffness of the bending springs, two points apart [N/m] (0: none)"
+    )
     damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
     pinned: Pins = Field(
         default_factory=list, description="indices (j·nu + i) of the points held fixed"
@@ -256,14 +259,14 @@ class ClothMesh(_Body):
     """``type = "cloth_mesh"``: cloth from any triangle mesh, given as ``vertices`` and
     ``triangles`` or read from the mesh file at ``path`` (OBJ, STL, PLY, OFF, glTF: see
     :mod:`visviva.deformables.mesh_files`; in a scene file, a relative path is relative to the
-    scene file's folder). A particle at each vertex [m], weighing the areal ``density``
+    scene file's folder). A particle at each vertex [m], weighing the ``areal_density``
     [kg/m²] times a third of the area of each triangle around it (so the cloth weighs
-    density × area); *stretch* springs of ``stretch`` [N/m] on every edge of the mesh and
-    *bend* springs of ``bend`` [N/m] between the two vertices facing each other across every
-    edge two triangles share; every spring with ``damping`` c [N·s/m]. A triangle resists
-    shear by itself, so a mesh has no shear family. The mesh must be manifold (no edge in three
-    triangles) with every vertex in a triangle. A mesh file is read when the scene is built;
-    the built model's scene holds its vertices and triangles instead of the path."""
+    areal_density × area); *stretch* springs of ``stiffness`` [N/m] on every edge of the mesh
+    and *bending* springs of ``bending`` [N/m] between the two vertices facing each other
+    across every edge two triangles share; every spring with ``damping`` c [N·s/m]. A triangle
+    resists shear by itself, so a mesh has no shear family. The mesh must be manifold (no edge
+    in three triangles) with every vertex in a triangle. A mesh file is read when the scene is
+    built; the built model's scene holds its vertices and triangles instead of the path."""
 
     type: Literal["cloth_mesh"]
     noun: ClassVar[str] = "cloth mesh"
@@ -277,9 +280,9 @@ class ClothMesh(_Body):
     triangles: Annotated[list[tuple[Index, Index, Index]], Field(min_length=1)] | None = Field(
         None, description="the triangles: three indices into `vertices` each"
     )
-    density: Positive = Field(description="mass per area [kg/m²]")
-    stretch: Positive = Field(description="stiffness of the springs on the edges [N/m]")
-    bend: NonNegative = Field(
+    areal_density: Positive = Field(description="mass per area [kg/m²]")
+    stiffness: Positive = Field(description="stiffness k of the springs on the edges [N/m]")
+    bending: NonNegative = Field(
         0.0, description="stiffness of the springs across the edges [N/m] (0: none)"
     )
     damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
@@ -316,9 +319,9 @@ class ClothMesh(_Body):
 class SoftLattice(_Body):
     """``type = "soft_lattice"``: a volumetric soft body (seed 004): ``resolution`` = [nx, ny,
     nz] particles on a lattice filling the box from ``origin`` with edge lengths ``size``,
-    joined by structural (``stretch``), face-diagonal (``shear``) and body-diagonal
-    (``diagonal``) springs. Point (i, j, k) has index (k·ny + j)·nx + i; each weighs
-    ``density`` times an eighth of each cell around it."""
+    joined by structural (``stiffness``), face-diagonal (``shear``) and body-diagonal
+    (``diagonal``) springs, each with ``damping`` c [N·s/m]. Point (i, j, k) has index
+    (k·ny + j)·nx + i; each weighs ``density`` [kg/m³] times an eighth of each cell around it."""
 
     type: Literal["soft_lattice"]
     noun: ClassVar[str] = "lattice"
@@ -333,12 +336,12 @@ class SoftLattice(_Body):
         Annotated[int, Field(strict=True, ge=2, le=512)],
     ] = Field(description="points along x, y and z [nx, ny, nz]")
     density: Positive = Field(1000.0, description="mass per volume [kg/m³]")
-    stretch: Positive = Field(description="stiffness of the structural springs [N/m]")
+    stiffness: Positive = Field(description="stiffness k of the structural springs [N/m]")
     shear: NonNegative | None = Field(
-        None, description="stiffness of the face-diagonal springs [N/m] (default: stretch)"
+        None, description="stiffness of the face-diagonal springs [N/m] (default: stiffness)"
     )
     diagonal: NonNegative | None = Field(
-        None, description="stiffness of the body-diagonal springs [N/m] (default: stretch)"
+        None, description="stiffness of the body-diagonal springs [N/m] (default: stiffness)"
     )
     damping: NonNegative = Field(0.0, description="damping c of every spring [N s/m]")
     pinned: Pins = Field(default_factory=list, description="indices of the points held fixed")

@@ -32,10 +32,12 @@ class Boids(Strict):
     targets: Names = Field(description="particle entities whose particles are the boids")
     radius: Positive = Field(description="how far a boid sees its flockmates [m]")
     separation: Positive = Field(description="flockmates closer than this push away [m]")
-    fov: Degrees = Field(360.0, description="field of view, full angle around the heading [deg]")
+    fov_deg: Degrees = Field(
+        360.0, description="field of view, full angle around the heading [degrees]"
+    )
     max_speed: Positive = Field(description="desired and largest speed [m/s]")
     min_speed: NonNegative = Field(0.0, description="least speed of a moving boid [m/s]")
-    max_force: Positive = Field(description="bound of the steering acceleration [m/s^2]")
+    max_acceleration: Positive = Field(description="bound of the steering acceleration [m/s^2]")
     separation_weight: NonNegative = Field(1.5, description="weight of separation [1/s]")
     alignment_weight: NonNegative = Field(1.0, description="weight of alignment [1/s]")
     cohesion_weight: NonNegative = Field(1.0, description="weight of cohesion [1/s]")

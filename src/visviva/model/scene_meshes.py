@@ -58,7 +58,7 @@ def with_mesh_file(entity: ClothMesh | RigidBody, where: str) -> ClothMesh | Rig
     try:
         vertices, triangles = read_triangle_mesh(path)
         if isinstance(entity, ClothMesh):
-            cloth_mesh(vertices, triangles, entity.density, entity.stretch, entity.bend)
+            cloth_mesh(vertices, triangles, entity.areal_density, entity.stiffness, entity.bending)
     except MeshFileError as error:
         raise SceneError([SceneProblem(f"{where}.path", str(error))]) from None
     except DeformableError as error:

@@ -115,8 +115,8 @@ class RigidBody(Strict):
     motion: Literal["dynamic", "kinematic", "static"] = Field(
         "dynamic", description="dynamic (forces move it), kinematic (moves as given), static"
     )
-    linear_damping: NonNegative = Field(0.0, description="P' = F − γ P: γ [1/s]")
-    angular_damping: NonNegative = Field(0.0, description="L' = τ − γ L: γ [1/s]")
+    linear_damping_rate: NonNegative = Field(0.0, description="P' = F − γ P: γ [1/s]")
+    angular_damping_rate: NonNegative = Field(0.0, description="L' = τ − γ L: γ [1/s]")
     push: list[Push] = Field(default_factory=list, description="forces at points, for a while")
     anchor: Anchor | None = Field(None, description="a point held by a spring")
     color: Color = Field((0.8, 0.8, 0.8), description="sRGB colour in [0, 1]")

@@ -2,9 +2,9 @@
 
 Each boid i (a particle at ``x_i`` [m] with velocity ``v_i`` [m/s]) sees its *flockmates*:
 the other live boids j within the ``radius`` r, ``|x_j − x_i|² ≤ r²`` (the grid's test), and
-inside its field of view, a cone of full angle ``fov`` φ around its heading
+inside its field of view, a cone of full angle ``fov_deg`` φ around its heading
 ``u_i = v_i / |v_i|``: ``d · u_i ≥ cos(φ/2) |d|`` with ``d = x_j − x_i`` (a boid at rest, or
-``fov = 360``, sees all around). Three rules (C. W. Reynolds, "Flocks, herds and schools: a
+``fov_deg = 360``, sees all around). Three rules (C. W. Reynolds, "Flocks, herds and schools: a
 distributed behavioral model", SIGGRAPH 1987) give each a *desired direction*:
 
 * separation: the *crowding* ``S = Σ (s/|d| − 1) (x_i − x_j)/|d|`` over the flockmates closer
@@ -25,8 +25,7 @@ a rule relaxes the velocity towards its desired one at the rate w. Separation's 
 of cohesion, which a constant weight could not do (every rule's steering is at most 2V long,
 so a lone nearest flockmate settles near ``s / (1 + 2 Σw / w_s)``, Σw the other weights; a
 boid squeezed between flockmates feels the difference of their pushes and may settle nearer).
-The weighted sum is an acceleration [m/s²], truncated to the length ``max_force`` A (an
-acceleration bound).
+The weighted sum is an acceleration [m/s²], truncated to the length ``max_acceleration`` A.
 
 **Obstacles** come first (Reynolds 1987's prioritised allocation): a boid within the
 ``look_ahead`` distance L of a collider's surface (signed distance ``d < L`` from
@@ -145,8 +144,8 @@ class Boids:
         radius: r, how far a boid sees its flockmates [m].
         separation: s, how close flockmates push it away [m], ``0 < s ≤ r``.
         max_speed: V, the speed every desired velocity has and no boid exceeds [m/s].
-        max_force: A, the bound of the steering acceleration [m/s²].
-        fov: φ, the field of view, full angle around the heading [degrees], ``(0, 360]``.
+        max_acceleration: A, the bound of the steering acceleration [m/s²].
+        fov_deg: φ, the field of view, full angle around the heading [degrees], ``(0, 360]``.
         min_speed: The least speed of a moving boid [m/s], ``≤ V``.
         separation_weight, alignment_weight, cohesion_weight: The rules' weights [1/s], ≥ 0.
         goal: A point the flock seeks [m], ``(3,)``, or ``None``.
@@ -175,8 +174,8 @@ class Boids:
         radius: float,
         separation: float,
         max_speed: float,
-        max_force: float,
-        fov: float = 360.0,
+        max_acceleration: float,
+        fov_deg: float = 360.0,
         min_speed: float = 0.0,
         separation_weight: float = 1.5,
         alignment_weight: float = 1.0,
@@ -201,12 +200,14 @@ class Boids:
                 f"({self.radius!r} m): a boid pushes away only flockmates it sees"
             )
         self.max_speed = _bounded("max_speed", max_speed, positive=True, unit=" m/s")
-        self.max_force = _bounded("max_force", max_force, positive=True, unit=" m/s^2")
-        self.fov = real_number("fov", fov, unit=" degrees")
-        if not 0.0 < self.fov <= 360.0:
+        self.max_acceleration = _bounded(
+            "max_acceleration", max_acceleration, positive=True, unit=" m/s^2"
+        )
+        self.fov_deg = real_number("fov_deg", fov_deg, unit=" degrees")
+        if not 0.0 < self.fov_deg <= 360.0:
             raise ModelError(
-                f"`fov` must lie in (0, 360] degrees, the full angle of the cone a boid sees "
-                f"around its heading (got {self.fov!r})"
+                f"`fov_deg` must lie in (0, 360] degrees, the full angle of the cone a boid sees "
+                f"around its heading (got {self.fov_deg!r})"
             )
         self.min_speed = real_number("min_speed", min_speed, nonnegative=True, unit=" m/s")
         if self.min_speed > self.max_speed:
@@ -241,7 +242,7 @@ class Boids:
         if not self.leaders.shape[0] and self.weights["leader_weight"] > 0.0:
             raise ModelError("`leader_weight` is given without `leaders`: name whom to follow")
         self.colliders = colliders if colliders is not None else ColliderSet([])
-        default = 2.0 * self.max_speed**2 / self.max_force
+        default = 2.0 * self.max_speed**2 / self.max_acceleration
         self.look_ahead = (
             min(default, LIMIT)
             if look_ahead is None
@@ -265,8 +266,8 @@ class Boids:
         p = np.zeros(_PARAMETERS)
         p[_R2] = self.radius * self.radius
         p[_SEP] = self.separation
-        p[_COS] = -2.0 if self.fov == 360.0 else math.cos(math.radians(0.5 * self.fov))
-        p[_VMAX], p[_VMIN], p[_AMAX] = self.max_speed, self.min_speed, self.max_force
+        p[_COS] = -2.0 if self.fov_deg == 360.0 else math.cos(math.radians(0.5 * self.fov_deg))
+        p[_VMAX], p[_VMIN], p[_AMAX] = self.max_speed, self.min_speed, self.max_acceleration
         p[_WSEP] = self.weights["separation_weight"]
         p[_WALI] = self.weights["alignment_weight"]
         p[_WCOH] = self.weights["cohesion_weight"]

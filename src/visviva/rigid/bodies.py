@@ -63,8 +63,8 @@ class RigidBodies:
         axes: ``(B, 4)`` the principal frame's orientation in the body's axes.
         center: ``(B, 3)`` the centre of mass in the body's axes [m].
         inertia: ``(B, 3, 3)`` the inertia about the centre of mass in the body's axes.
-        linear_damping: ``(B,)`` γ of ``P' = F − γ P`` [1/s].
-        angular_damping: ``(B,)`` γ of ``L' = τ − γ L`` [1/s].
+        linear_damping_rate: ``(B,)`` γ of ``P' = F − γ P`` [1/s].
+        angular_damping_rate: ``(B,)`` γ of ``L' = τ − γ L`` [1/s].
         shapes: Each body's shape and dimensions, for drawing (``{"shape": ..., ...}``).
         color: ``(B, 3)`` the colour each body is drawn in, sRGB in [0, 1].
         position: ``(B, 3)`` initial centres of mass [m].
@@ -79,8 +79,8 @@ class RigidBodies:
     axes: np.ndarray
     center: np.ndarray
     inertia: np.ndarray
-    linear_damping: np.ndarray
-    angular_damping: np.ndarray
+    linear_damping_rate: np.ndarray
+    angular_damping_rate: np.ndarray
     shapes: tuple[dict[str, Any], ...]
     color: np.ndarray
     position: np.ndarray
@@ -95,8 +95,8 @@ class RigidBodies:
         properties: Sequence[MassProperties],
         starts: Sequence[BodyStart],
         shapes: Sequence[dict[str, Any]],
-        linear_damping: Sequence[float],
-        angular_damping: Sequence[float],
+        linear_damping_rate: Sequence[float],
+        angular_damping_rate: Sequence[float],
         colors: Sequence[Sequence[float]] | None = None,
     ) -> RigidBodies:
         """The bodies with these mass properties (about the centre of mass, in each body's
@@ -127,8 +127,8 @@ class RigidBodies:
             axes=stacked(axes, 4),
             center=stacked([np.asarray(mp.center_of_mass) for mp in properties], 3),
             inertia=np.array([mp.inertia for mp in properties], dtype=np.float64).reshape(-1, 3, 3),
-            linear_damping=np.array(linear_damping, dtype=np.float64),
-            angular_damping=np.array(angular_damping, dtype=np.float64),
+            linear_damping_rate=np.array(linear_damping_rate, dtype=np.float64),
+            angular_damping_rate=np.array(angular_damping_rate, dtype=np.float64),
             shapes=tuple(shapes),
             color=stacked(
                 [np.asarray(c) for c in colors] if colors is not None else [DEFAULT_COLOR] * count,
