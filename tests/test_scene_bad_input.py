@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import json
 import sys
 import tomllib
 
@@ -14,6 +15,9 @@ import visviva as vv
 from visviva.cli.main import main
 from visviva.io.scene_files import MAX_SCENE_BYTES, dump_scene, parse_scene
 from visviva.model import build_model
+from visviva.model.scene import ENTITY_TYPES
+from visviva.model.scene_renames import RENAMED_FIELDS, RENAMED_PARAMETERS
+from visviva.model.systems import SYSTEMS
 
 VALID = """\
 [scene]
@@ -413,3 +417,117 @@ triangles = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 1]]
 )
 def test_bad_particle_entity_is_refused(monkeypatch, capsys, tmp_path, text, fragments):
     refused(monkeypatch, capsys, tmp_path, text, *fragments)
+
+
+# ------------------------------------------------------------------------------------------
+# Renamed fields (issue 26, "One vocabulary"): an old name is refused at its field, naming the
+# new one, from a scene file and from the builder alike.
+
+#: A valid entity of each kind with renamed fields, every renamed field given its new name.
+RENAMED_ENTITIES: dict[str, dict[str, object]] = {
+    "cloth": {
+        "resolution": [3, 3],
+        "areal_density": 0.2,
+        "stiffness": 100.0,
+        "bending": 1.0,
+    },
+    "cloth_mesh": {
+        "vertices": [[0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [1.0, 1.0, 1.0], [0.0, 1.0, 1.0]],
+        "triangles": [[0, 1, 2], [0, 2, 3]],
+        "areal_density": 0.2,
+        "stiffness": 100.0,
+        "bending": 1.0,
+    },
+    "soft_lattice": {"resolution": [2, 2, 2], "stiffness": 100.0},
+    "body": {
+        "shape": "sphere",
+        "radius": 0.1,
+        "density": 1000.0,
+        "linear_damping_rate": 0.1,
+        "angular_damping_rate": 0.2,
+    },
+    "emitter": {"rate": 10.0, "spread_deg": 15.0},
+    "boids": {
+        "targets": ["cloud"],
+        "radius": 1.0,
+        "separation": 0.5,
+        "max_speed": 2.0,
+        "max_acceleration": 4.0,
+        "fov_deg": 270.0,
+    },
+}
+RENAMES = [(kind, old, new) for kind, table in RENAMED_FIELDS.items() for old, new in table.items()]
+
+
+def test_the_rename_table_names_fields_of_the_schemas():
+    """Every new name is a field of its kind, no old name is, and every kind is tested."""
+    assert set(RENAMED_ENTITIES) == set(RENAMED_FIELDS)
+    for kind, old, new in RENAMES:
+        fields = ENTITY_TYPES[kind].model_fields
+        assert new in fields and old not in fields, (kind, old, new)
+        assert new in RENAMED_ENTITIES[kind], (kind, new)
+    build_model(parse_scene(VALID + "".join(_entity_toml(k, {}, k) for k in RENAMED_ENTITIES)))
+
+
+def _entity_toml(kind: str, renamed: dict[str, str], name: str = "thing") -> str:
+    """The ``[[entities]]`` table of ``RENAMED_ENTITIES[kind]`` called ``name``, its fields
+    under their names in ``renamed`` (new → old)."""
+    lines = ["", "[[entities]]", f'type = "{kind}"', f'name = "{name}"']
+    for key, value in RENAMED_ENTITIES[kind].items():
+        lines.append(f"{renamed.get(key, key)} = {json.dumps(value)}")
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize(("kind", "old", "new"), RENAMES, ids=[f"{k}.{o}" for k, o, _ in RENAMES])
+def test_an_old_field_name_in_a_scene_file_names_the_new_one(
+    monkeypatch, capsys, tmp_path, kind, old, new
+):
+    text = VALID + _entity_toml(kind, {new: old})
+    line = text.splitlines().index(f"{old} = {json.dumps(RENAMED_ENTITIES[kind][new])}") + 1
+    err = refused(
+        monkeypatch,
+        capsys,
+        tmp_path,
+        text,
+        f':{line}: entities[2].{old}: field "{old}" of {kind} "thing" was renamed; '
+        f'did you mean "{new}"?',
+    )
+    assert err.count("entities[2]") == 1, err  # no "missing field" beside it
+
+
+@pytest.mark.parametrize(("kind", "old", "new"), RENAMES, ids=[f"{k}.{o}" for k, o, _ in RENAMES])
+def test_an_old_field_name_in_a_builder_call_names_the_new_one(kind, old, new):
+    builder = vv.SceneBuilder()
+    builder.add_particle_cloud(10, name="cloud")
+    fields = dict(RENAMED_ENTITIES[kind])
+    fields[old] = fields.pop(new)
+    with pytest.raises(vv.SceneError) as refusal:
+        getattr(builder, f"add_{kind}")(**fields)
+    assert [(p.path, p.message) for p in refusal.value.problems] == [
+        (
+            f"entities[1].{old}",
+            f'field "{old}" of the {kind} entity was renamed; did you mean "{new}"?',
+        )
+    ]
+    assert len(builder.scene.entities) == 1  # nothing refused was added
+
+
+def test_an_unnamed_entity_and_a_renamed_system_parameter(monkeypatch, capsys, tmp_path):
+    emitter = '\n[[entities]]\ntype = "emitter"\nrate = 5.0\nspread = 10.0\n'
+    message = 'field "spread" of the emitter entity was renamed; did you mean "spread_deg"?'
+    refused(monkeypatch, capsys, tmp_path, VALID + emitter, f"entities[2].spread: {message}")
+    system = (
+        '\n[[entities]]\ntype = "system"\nsystem = "constrained-pendulum"\n'
+        "parameters = { stabilization = 2.0 }\n"
+    )
+    refused(
+        monkeypatch,
+        capsys,
+        tmp_path,
+        VALID + system,
+        'entities[2].parameters.stabilization: parameter "stabilization" of the '
+        'constrained-pendulum system was renamed; did you mean "stabilization_rate"?',
+    )
+    for system, table in RENAMED_PARAMETERS.items():
+        for old, new in table.items():
+            assert new in SYSTEMS[system].parameters and old not in SYSTEMS[system].parameters

@@ -203,6 +203,21 @@ def test_unknown_path_suggests_the_nearest_valid_one(path, suggestion):
     assert f"s.toml:{line}: " in message  # the line of the path
 
 
+def test_a_renamed_field_in_a_path_names_the_new_one():
+    cloth = (
+        '[[scene.entities]]\ntype = "cloth"\nname = "sheet"\nresolution = [3, 3]\n'
+        "stiffness = 10.0\n"
+    )
+    text = spring_sweep('[[parameters]]\npath = "entities[sheet].stretch"\nvalues = [1.0]\n')
+    text = text.replace("[[parameters]]", cloth + "\n[[parameters]]", 1)
+    with pytest.raises(SweepError) as caught:
+        parse_sweep(text, source="s.toml")
+    assert (
+        'unknown parameter path `entities[sheet].stretch`: field "stretch" of cloth "sheet" was '
+        'renamed; did you mean "stiffness"?'
+    ) in str(caught.value)
+
+
 def test_index_beyond_the_entities_is_refused_with_the_count():
     text = spring_sweep('[[parameters]]\npath = "entities[3].stiffness"\nvalues = [1.0]\n')
     with pytest.raises(SweepError, match=r"`entities` has 1 item, so index 3 does not exist"):

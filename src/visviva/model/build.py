@@ -51,6 +51,7 @@ from .scene_boids import Boids
 from .scene_contacts import ParticleCollisionSettings
 from .scene_crowd import Crowd
 from .scene_meshes import with_mesh_files
+from .scene_renames import RENAMED_PARAMETERS, renamed_message
 from .scene_rigid import RigidBody
 from .systems import SYSTEMS
 
@@ -410,9 +411,18 @@ def _check_lengths(entity: Particles | Rope | Hair | SpringGraph, where: str) ->
 
 def _check_system(entity: System, where: str) -> list[SceneProblem]:
     kind = SYSTEMS[entity.system]
+    renamed = RENAMED_PARAMETERS.get(entity.system)
     problems = []
     for key, value in entity.parameters.items():
         path = f"{where}.parameters.{key}"
+        new = None if renamed is None else renamed.get(key)
+        if new is not None:
+            problems.append(
+                SceneProblem(
+                    path, renamed_message(key, new, f"the {entity.system} system", "parameter")
+                )
+            )
+            continue
         if key not in kind.parameters:
             problems.append(
                 SceneProblem(

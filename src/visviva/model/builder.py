@@ -17,14 +17,15 @@ Every deformable body's ``pinned`` points stay where they are, unless its ``hand
 
 from __future__ import annotations
 
+import functools
 import os
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any, Concatenate, ParamSpec
 
 import numpy as np
 from pydantic import BaseModel, ValidationError
 
-from ..errors import SceneError
+from ..errors import SceneError, SceneProblem
 from .build import build_model
 from .model import Model
 from .scene import (
@@ -46,11 +47,47 @@ from .scene_crowd import Crowd
 from .scene_errors import scene_problems
 from .scene_handles import Handle
 from .scene_meshes import with_mesh_file
+from .scene_renames import RENAMED_FIELDS, entity_owner, renamed_message
 from .scene_rigid import RigidBody
 
 __all__ = ["SceneBuilder"]
 
 Vector = Sequence[float]
+Arguments = ParamSpec("Arguments")
+AddMethod = Callable[Concatenate["SceneBuilder", Arguments], int]
+
+
+def _refusing_old_names(tag: str) -> Callable[[AddMethod[Arguments]], AddMethod[Arguments]]:
+    """The ``add_*`` method of entity type ``tag``, refusing the field names the scene
+    vocabulary gave up (:data:`~visviva.model.scene_renames.RENAMED_FIELDS`) with a
+    :class:`~visviva.errors.SceneError` that names the new one, where Python would only say
+    "unexpected keyword argument". The method keeps its signature (``inspect.signature``,
+    ``help`` and type checkers see the typed keywords)."""
+    renamed = RENAMED_FIELDS[tag]
+
+    def decorate(method: AddMethod[Arguments]) -> AddMethod[Arguments]:
+        @functools.wraps(method)
+        def checked(
+            self: SceneBuilder, /, *args: Arguments.args, **kwargs: Arguments.kwargs
+        ) -> int:
+            old = [key for key in kwargs if key in renamed]
+            if old:
+                where = f"entities[{len(self._scene.entities)}]"
+                name = kwargs.get("name")
+                raise SceneError(
+                    [
+                        SceneProblem(
+                            f"{where}.{key}",
+                            renamed_message(key, renamed[key], entity_owner(tag, name)),
+                        )
+                        for key in old
+                    ]
+                )
+            return method(self, *args, **kwargs)
+
+        return checked
+
+    return decorate
 
 
 class SceneBuilder:
@@ -227,6 +264,7 @@ class SceneBuilder:
         they are, or follow the ``handle``'s motion."""
         return self._add(SpringGraph, "springs", _given(locals()))
 
+    @_refusing_old_names("cloth")
     def add_cloth(
         self,
         resolution: Sequence[int],
@@ -256,6 +294,7 @@ class SceneBuilder:
         given["resolution"] = tuple(given["resolution"])
         return self._add(Cloth, "cloth", given)
 
+    @_refusing_old_names("soft_lattice")
     def add_soft_lattice(
         self,
         resolution: Sequence[int],
@@ -284,6 +323,7 @@ class SceneBuilder:
         given["resolution"] = tuple(given["resolution"])
         return self._add(SoftLattice, "soft_lattice", given)
 
+    @_refusing_old_names("cloth_mesh")
     def add_cloth_mesh(
         self,
         vertices: Any = None,
@@ -323,6 +363,7 @@ class SceneBuilder:
         self._replace(entities=[*self._scene.entities, with_mesh_file(entity, where)])
         return index
 
+    @_refusing_old_names("body")
     def add_body(
         self,
         shape: str,
@@ -402,6 +443,7 @@ class SceneBuilder:
         with parameter values (omitted ones take their defaults)."""
         return self._add(System, "system", _given(locals()))
 
+    @_refusing_old_names("emitter")
     def add_emitter(
         self,
         *,
@@ -511,6 +553,7 @@ class SceneBuilder:
         rest (:mod:`visviva.collision.particle_contacts`)."""
         return self._add(ParticleCollisionSettings, "particle_collisions", _given(locals()))
 
+    @_refusing_old_names("boids")
     def add_boids(
         self,
         targets: Sequence[str],

@@ -3,8 +3,9 @@
 Pydantic reports a problem at a location such as ``("entities", 3, "particles", "mass")`` and
 once per branch of a union; :func:`scene_problems` turns that into one
 :class:`~visviva.errors.SceneProblem` per field at the path the user wrote
-(``entities[3].mass``), names the allowed keys of a misspelt one, and leaves the line number to
-the caller that has the file (``line_of``).
+(``entities[3].mass``), names the allowed keys of a misspelt one, names the new name of a
+renamed one (:mod:`.scene_renames`), and leaves the line number to the caller that has the
+file (``line_of``).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from pydantic import BaseModel, ValidationError
 from .._validation import describe, did_you_mean
 from ..errors import SceneProblem
 from .scene import ENTITY_TYPES, Integration, Output, Scene, SceneInfo, World
+from .scene_renames import entity_owner, new_name, renamed_message
 
 __all__ = ["scene_problems"]
 
@@ -47,8 +49,12 @@ def scene_problems(
             previous["type"].endswith("_type") and not error["type"].endswith("_type")
         ):
             chosen[path] = error
+    renamed = {path: new for path in chosen if (new := _new_name(path, raw, schema)) is not None}
+    replaced = {(*path[:-1], new) for path, new in renamed.items()}
     problems = []
     for path, error in chosen.items():
+        if error["type"] == "missing" and path in replaced:
+            continue  # its old name was given: the rename says it all
         message = error["msg"].replace("Input should be", "must be", 1)
         got: str | None = describe(error["input"])
         if isinstance(error["input"], dict):
@@ -56,7 +62,11 @@ def scene_problems(
             field = error.get("ctx", {}).get("field")
             if error["type"] == "not_a_parameter" and field:
                 path = (*path, field)
-        if error["type"] == "extra_forbidden":
+        if path in renamed:
+            table = _entity_table(path[:-1], raw, schema) or {}
+            owner = entity_owner(str(table.get("type")), table.get("name"))
+            message, got = renamed_message(str(path[-1]), renamed[path], owner), None
+        elif error["type"] == "extra_forbidden":
             key = str(path[-1])
             allowed = _allowed_keys(path[:-1], raw, schema)
             message = f"unknown key.{did_you_mean(key, allowed)} Allowed: {', '.join(allowed)}"
@@ -83,6 +93,32 @@ def _field_path(loc: tuple[Any, ...]) -> tuple[Any, ...]:
             continue  # the discriminator's branch, not a key
         path.append(segment)
     return tuple(path)
+
+
+def _entity_table(
+    path: tuple[Any, ...], raw: dict[str, Any], schema: type[BaseModel] | None
+) -> dict[str, Any] | None:
+    """The entity table at ``path`` of ``raw`` (a scene, or with ``schema`` the entity itself
+    at ``()``), or ``None`` if ``path`` is not an entity's."""
+    if schema is not None:
+        return raw if not path else None
+    if len(path) != 2 or path[0] != "entities" or not isinstance(path[1], int):
+        return None
+    entities = raw.get("entities")
+    entity = entities[path[1]] if isinstance(entities, list) else None
+    return entity if isinstance(entity, dict) else None
+
+
+def _new_name(
+    path: tuple[Any, ...], raw: dict[str, Any], schema: type[BaseModel] | None
+) -> str | None:
+    """The field's new name if ``path`` is a field of an entity given by its old name."""
+    if not path:
+        return None
+    table = _entity_table(path[:-1], raw, schema)
+    if table is None or path[-1] not in table:
+        return None
+    return new_name(str(table.get("type")), str(path[-1]))
 
 
 def _allowed_keys(

@@ -16,6 +16,7 @@ from typing import Any
 from pydantic import BaseModel
 
 from .._validation import describe, did_you_mean
+from ..model.scene_renames import entity_owner, new_name, renamed_message
 
 __all__ = ["display", "replaced", "resolve"]
 
@@ -80,6 +81,13 @@ def resolve(scene: BaseModel, path: str) -> tuple[str | int, ...]:
             fields = list(type(node).model_fields)
             if not isinstance(key, str):
                 raise PathProblem(f"`{where}` is a table, not a list: name one of its fields")
+            kind = str(getattr(node, "type", None))
+            new = new_name(kind, key) if isinstance(key, str) else None
+            if new is not None:
+                owner = entity_owner(kind, getattr(node, "name", None))
+                raise PathProblem(
+                    f"unknown parameter path `{path}`: {renamed_message(key, new, owner)}"
+                )
             if key not in fields:
                 prefix = f"{where}." if where else ""
                 hint = did_you_mean(prefix + key, [prefix + f for f in fields])
