@@ -116,7 +116,8 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
             stages.append(handles)
         with np.errstate(all="ignore"):  # overflowing values are judged by the start check
             forces = force_objects(scene, groups, arrays["mass"])
-            forces += penalty_forces(scene, groups, arrays, h)
+            penalties = penalty_forces(scene, groups, arrays, h)
+            forces += penalties
             forces += spring_forces(scene, groups, count)
         with np.errstate(over="ignore"):  # a weight beyond the float range diverges, named
             bodies, body_forces = rigid_bodies(scene, names)
@@ -127,7 +128,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         if specs:
             from ..particles.emission import Emission
 
-            stages.append(Emission(specs, count))
+            stages.append(Emission(specs, arrays["alive"], arrays["radius"]))
         if bodies is not None:
             stages.append(BodyProjection(bodies.count))
     except Located as located:
@@ -157,7 +158,8 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         body_forces=tuple(body_forces),
         forces=tuple(forces),
         emitters=tuple(specs),
-        stages=tuple(stages),
+        stages=tuple(sorted(stages, key=lambda stage: stage.phase)),
+        contact_sources=(*([] if collisions is None else [collisions]), *penalties),
         output_formats=tuple(scene.output.formats),
         output_fps=scene.output.fps,
         output_speed=scene.output.speed,
