@@ -1,0 +1,43 @@
+"""The package's surface: after ``import visviva as vv`` every subpackage is ``vv.<name>``.
+
+Subpackages load on first use (``visviva/__init__.py``), so a new one is easily left out of that
+list; these tests find the subpackages on disk, so a forgotten one fails here.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+
+import pytest
+
+import visviva as vv
+
+SUBPACKAGES = sorted(info.name for info in pkgutil.iter_modules(vv.__path__) if info.ispkg)
+
+
+def test_the_subpackages_are_found():
+    assert {"cli", "collision", "deformables", "geometry", "simulation", "sweeps"} <= set(
+        SUBPACKAGES
+    )
+
+
+@pytest.mark.parametrize("name", SUBPACKAGES)
+def test_every_subpackage_is_an_attribute_listed_in_dir_and_all(name):
+    # Through the module's __getattr__ itself: once imported (by another test), a subpackage is
+    # an attribute of its parent anyway, and plain getattr would not see a missing entry.
+    assert vv.__getattr__(name) is importlib.import_module(f"visviva.{name}")
+    assert getattr(vv, name) is importlib.import_module(f"visviva.{name}")
+    assert name in dir(vv)
+    assert name in vv.__all__
+
+
+def test_every_public_name_resolves_and_dir_is_all():
+    assert dir(vv) == sorted(vv.__all__)
+    for name in vv.__all__:
+        assert getattr(vv, name) is not None, name
+
+
+def test_an_unknown_name_is_an_attribute_error():
+    with pytest.raises(AttributeError, match="'visviva' has no attribute 'nonesuch'"):
+        vv.nonesuch  # noqa: B018
