@@ -339,11 +339,11 @@ def demo_command(
     force: ForceOption = False,
 ) -> None:
     """Run a demonstration and write its recording, summary and figures (no NAME: list them)."""
-    from ..demos import demos, run_demo
+    from ..demos import demo_summaries, run_demo
 
     if name is None:
-        for demo in sorted(demos().values(), key=lambda d: d.name):
-            typer.echo(f"{demo.name:16s} {demo.summary}")
+        for listed, summary in sorted(demo_summaries().items()):
+            typer.echo(f"{listed:16s} {summary}")
         return
     directory = output if output is not None else Path("out") / name
     report = run_demo(

@@ -2,11 +2,13 @@
 
 Each demo runs real simulations through the public API and writes ``recording.h5`` (one run per
 method), ``summary.json`` and its figures into the output directory. Demos register themselves
-here; later capabilities add theirs to the same list.
+here; the built-in ones are listed in :mod:`~visviva.demos.catalogue`, so that a list of them
+(:func:`demo_summaries`) imports none, and running one imports only its module.
 """
 
 from __future__ import annotations
 
+import importlib
 import time
 import warnings
 from collections.abc import Callable, Iterable
@@ -20,8 +22,9 @@ from ..errors import ModelError
 from ..io.job import JobOutput, JobReport, python_warnings, run_summary
 from ..io.outputs import output_names, write_output
 from ..simulation.interrupt import Interrupted, StopOnSignal
+from .catalogue import BUILTIN_DEMOS
 
-__all__ = ["Demo", "demos", "register_demo", "run_demo"]
+__all__ = ["Demo", "demo_summaries", "demos", "register_demo", "run_demo"]
 
 
 @dataclass(frozen=True)
@@ -70,9 +73,16 @@ def register_demo(demo: Demo, *, replace: bool = False) -> Demo:
 
 
 def demos() -> dict[str, Demo]:
-    """Every registered demo by name."""
-    _load_builtins()
+    """Every registered demo by name (importing every built-in one)."""
+    for name in BUILTIN_DEMOS:
+        _load(name)
     return {name: _DEMOS.get(name) for name in _DEMOS}
+
+
+def demo_summaries() -> dict[str, str]:
+    """Every demo's one-line summary by name, without importing the built-in demos."""
+    summaries = {name: builtin.summary for name, builtin in BUILTIN_DEMOS.items()}
+    return summaries | {name: _DEMOS.get(name).summary for name in _DEMOS}
 
 
 def run_demo(
@@ -103,7 +113,10 @@ def run_demo(
         Interrupted: On SIGINT/SIGTERM: the runs finished so far, the one cut short (marked
             ``-interrupted``) and the summary were written (``error.report``).
     """
-    _load_builtins()
+    if name in BUILTIN_DEMOS:
+        _load(name)
+    else:  # so that an unknown name is answered with every valid one
+        demos()
     demo = _DEMOS.get(name)
     seconds = (
         demo.duration
@@ -201,35 +214,6 @@ def _interrupted_run_name(output: JobOutput, error: Interrupted) -> str:
     return name
 
 
-def _load_builtins() -> None:
-    from . import (  # noqa: F401 - registers the demos
-        ball_pit,
-        boids,
-        bottle_flip,
-        bunny_throw,
-        circular,
-        cloth_drape,
-        cloth_hang,
-        constrained_pendulum,
-        crowd,
-        dahlquist,
-        double_pendulum,
-        dzhanibekov,
-        fireworks,
-        flag,
-        fountain,
-        galaxy,
-        hair,
-        jelly,
-        kepler,
-        oscillator,
-        pendulum,
-        refinement_study,
-        rock,
-        rotation_drift,
-        snow,
-        spring_pendulum,
-        stiffness_study,
-        sun_earth_moon,
-        top,
-    )
+def _load(name: str) -> None:
+    """Import built-in demo ``name``'s module, which registers it (once: imports are cached)."""
+    importlib.import_module(f".{BUILTIN_DEMOS[name].module}", __name__)
