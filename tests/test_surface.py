@@ -41,3 +41,12 @@ def test_every_public_name_resolves_and_dir_is_all():
 def test_an_unknown_name_is_an_attribute_error():
     with pytest.raises(AttributeError, match="'visviva' has no attribute 'nonesuch'"):
         vv.nonesuch  # noqa: B018
+
+
+@pytest.mark.parametrize("name", SUBPACKAGES)
+def test_every_name_a_subpackage_exports_resolves(name):
+    # Packages that load their names on first use (visviva._lazy) list where each one lives;
+    # a wrong entry shows only when the name is looked up.
+    package = importlib.import_module(f"visviva.{name}")
+    for public in vars(package).get("__all__", []):
+        assert getattr(package, public) is not None, f"visviva.{name}.{public}"

@@ -340,12 +340,14 @@ def demo_command(
     force: ForceOption = False,
 ) -> None:
     """Run a demonstration and write its recording, summary and figures (no NAME: list them)."""
-    from ..demos import demo_summaries, run_demo
-
     if name is None:
+        from ..demos import demo_summaries
+
         for listed, summary in sorted(demo_summaries().items()):
             typer.echo(f"{listed:16s} {summary}")
         return
+    from ..demos import run_demo
+
     directory = output if output is not None else Path("out") / name
     report = run_demo(
         name, directory, duration=duration, formats=formats or (), fps=fps, force=force
