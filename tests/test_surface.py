@@ -50,3 +50,18 @@ def test_every_name_a_subpackage_exports_resolves(name):
     package = importlib.import_module(f"visviva.{name}")
     for public in vars(package).get("__all__", []):
         assert getattr(package, public) is not None, f"visviva.{name}.{public}"
+
+
+@pytest.mark.parametrize("name", ["", *SUBPACKAGES])
+def test_no_name_loaded_on_first_use_is_also_a_module_of_its_package(name):
+    # Importing a submodule binds it on its package: a name loaded on first use that is also a
+    # submodule's name (a function `solve` in a module `solve.py`) would turn into the module
+    # once anything imported that module. (Packages that import their names at once rebind
+    # them after their submodules load.)
+    package = importlib.import_module(f"visviva.{name}".rstrip("."))
+    if "__getattr__" not in vars(package):
+        pytest.skip("imports its names at once")
+    modules = {info.name for info in pkgutil.iter_modules(package.__path__)}
+    for public in set(package.__all__) & modules:
+        module = importlib.import_module(f"{package.__name__}.{public}")
+        assert package.__getattr__(public) is module, f"{package.__name__}.{public}"

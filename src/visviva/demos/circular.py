@@ -17,7 +17,7 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..ode.problems import SecondOrderProblem
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 

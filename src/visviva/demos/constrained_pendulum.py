@@ -16,7 +16,7 @@ import numpy as np
 from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.recording import Recording
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 

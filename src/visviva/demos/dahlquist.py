@@ -16,7 +16,7 @@ import numpy as np
 from ..analysis.stability import stability_function
 from ..io.job import JobOutput
 from ..ode.problems import FirstOrderProblem
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from ..viz.plots import plot_stability_regions
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS

@@ -17,7 +17,7 @@ from ..analysis.chaos import lyapunov_exponent
 from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.recording import Recording
-from ..simulation.solve import Solution, solve
+from ..simulation.solution import Solution, solve
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..mechanics import colliding_disks, tree_force_error
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from ._bodies import body_states, drawn_bodies
 from .catalogue import BUILTIN_DEMOS

@@ -16,7 +16,7 @@ import numpy as np
 from ..analysis.invariants import angular_momentum
 from ..io.job import JobOutput
 from ..mechanics import kepler_orbit
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from ._bodies import body_states, drawn_bodies
 from .catalogue import BUILTIN_DEMOS

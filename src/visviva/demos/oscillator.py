@@ -15,7 +15,7 @@ import numpy as np
 from ..integrators import get, names
 from ..io.job import JobOutput
 from ..ode.problems import SecondOrderProblem
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from ..viz.plots import plot_energy, plot_phase
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS

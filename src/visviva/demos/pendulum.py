@@ -16,7 +16,7 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..mechanics import classic
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from ._bodies import drawn_system
 from .catalogue import BUILTIN_DEMOS

@@ -15,7 +15,7 @@ import numpy as np
 from ..analysis.invariants import angular_momentum
 from ..io.job import JobOutput
 from ..mechanics import sun_earth_moon
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from ._bodies import body_states, drawn_bodies
 from .catalogue import BUILTIN_DEMOS

@@ -11,7 +11,7 @@ if TYPE_CHECKING:
     from .loop import Schedule, simulate
     from .recording import Geometry, Recording
     from .simulation import Simulation, SimulationState
-    from .solve import Solution, solve
+    from .solution import Solution, solve
     from .watch import DEFAULT_DIVERGENCE_LIMIT, DivergenceWatch
 
 __all__ = [
@@ -41,8 +41,8 @@ __getattr__, __dir__ = lazy_names(
         "Recording": "recording",
         "Simulation": "simulation",
         "SimulationState": "simulation",
-        "Solution": "solve",
-        "solve": "solve",
+        "Solution": "solution",
+        "solve": "solution",
         "DEFAULT_DIVERGENCE_LIMIT": "watch",
         "DivergenceWatch": "watch",
     },
