@@ -65,3 +65,21 @@ def test_no_name_loaded_on_first_use_is_also_a_module_of_its_package(name):
     for public in set(package.__all__) & modules:
         module = importlib.import_module(f"{package.__name__}.{public}")
         assert package.__getattr__(public) is module, f"{package.__name__}.{public}"
+
+
+@pytest.mark.parametrize("name", ["", *SUBPACKAGES])
+def test_a_package_loading_names_on_first_use_reaches_its_modules_as_attributes(name):
+    # As when the package imported them all: the docs write vv.simulation.interrupt.StopOnSignal.
+    package = importlib.import_module(f"visviva.{name}".rstrip("."))
+    if "__getattr__" not in vars(package):
+        pytest.skip("imports its names at once")
+    for info in pkgutil.iter_modules(package.__path__):
+        if not info.name.startswith("__"):
+            module = importlib.import_module(f"{package.__name__}.{info.name}")
+            assert package.__getattr__(info.name) is module
+
+
+def test_a_dunder_is_never_looked_up_as_a_module():
+    # visviva/__main__.py runs the command line when imported.
+    with pytest.raises(AttributeError):
+        vv.__getattr__("__main__")
