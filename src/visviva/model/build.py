@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import describe, did_you_mean
+from .._registry import did_you_mean
+from .._validation import describe
 from ..errors import ModelError, SceneError, SceneProblem
 from ..rigid.projection import BodyProjection
 from ..simulation.loop import MAX_STEPS
