@@ -543,7 +543,7 @@ def busy(others: float | None) -> str:
 def factorize_seconds(n: int) -> float:
     """Wall time [s] of building FastMassSprings' global matrix ``M + h² L`` and factorizing
     it (``_Global``, as its first step does), once, on a fresh scene at N = n."""
-    network = cloth_scene(n).system().spring_network()
+    network = cloth_scene(n).system().spring_network
     start = time.perf_counter()
     _Global(network, STEP)
     return time.perf_counter() - start

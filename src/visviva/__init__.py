@@ -16,9 +16,9 @@ Subpackages and the main functions load on first use, so that ``import visviva``
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from ._lazy import lazy_names
 from ._version import __version__
 from .errors import (
     ModelError,
@@ -32,8 +32,12 @@ from .errors import (
 if TYPE_CHECKING:
     from . import (
         analysis,
+        cli,
+        collision,
+        deformables,
         demos,
         forces,
+        geometry,
         integrators,
         io,
         mechanics,
@@ -42,6 +46,7 @@ if TYPE_CHECKING:
         particles,
         rigid,
         simulation,
+        sweeps,
         viz,
     )
     from .model import Model, SceneBuilder
@@ -64,8 +69,12 @@ __all__ = [
     "VisvivaError",
     "__version__",
     "analysis",
+    "cli",
+    "collision",
+    "deformables",
     "demos",
     "forces",
+    "geometry",
     "integrators",
     "io",
     "load_model",
@@ -80,23 +89,10 @@ __all__ = [
     "simulation",
     "solve",
     "sweep",
+    "sweeps",
     "viz",
 ]
 
-_SUBPACKAGES = {
-    "analysis",
-    "demos",
-    "forces",
-    "integrators",
-    "io",
-    "mechanics",
-    "model",
-    "ode",
-    "particles",
-    "rigid",
-    "simulation",
-    "viz",
-}
 _FUNCTIONS = {
     "Model": "model",
     "SceneBuilder": "model",
@@ -111,14 +107,5 @@ _FUNCTIONS = {
     "sweep": "sweeps",
 }
 
-
-def __getattr__(name: str) -> Any:
-    if name in _SUBPACKAGES:
-        return importlib.import_module(f".{name}", __name__)
-    if name in _FUNCTIONS:
-        return getattr(importlib.import_module(f".{_FUNCTIONS[name]}", __name__), name)
-    raise AttributeError(f"module 'visviva' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(__all__)
+# Subpackages load on first use too; tests/test_surface.py checks that __all__ lists each one.
+__getattr__, __dir__ = lazy_names(__name__, __all__, _FUNCTIONS)

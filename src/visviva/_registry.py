@@ -1,8 +1,9 @@
 """One way to keep things by name: integrators, named systems and demos.
 
 A :class:`Registry` holds items that carry their own ``name``. Looking up a name that is not
-there raises :class:`~visviva.errors.ModelError` with the closest name and the valid ones, so
-every "unknown method / system / demo" message reads the same::
+there raises :class:`~visviva.errors.ModelError` with the closest name (:func:`did_you_mean`,
+which names checked without a registry use too) and the valid ones, so every "unknown method /
+system / demo" message reads the same::
 
     >>> from dataclasses import dataclass
     >>> @dataclass(frozen=True)
@@ -21,13 +22,13 @@ every "unknown method / system / demo" message reads the same::
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import difflib
+from collections.abc import Iterable, Iterator
 from typing import Generic, Protocol, TypeVar
 
-from ._validation import did_you_mean
 from .errors import ModelError
 
-__all__ = ["Named", "Registry"]
+__all__ = ["Named", "Registry", "did_you_mean"]
 
 
 class Named(Protocol):
@@ -107,3 +108,10 @@ class Registry(Generic[T]):
 
     def __repr__(self) -> str:
         return f"Registry({self.kind!r}: {', '.join(self._items)})"
+
+
+def did_you_mean(word: str, options: Iterable[str]) -> str:
+    """Return ``" Did you mean 'x'?"`` for the closest option, or ``""`` (case ignored)."""
+    by_lower = {option.lower(): option for option in options}
+    close = difflib.get_close_matches(word.lower(), list(by_lower), n=1, cutoff=0.6)
+    return f" Did you mean {by_lower[close[0]]!r}?" if close else ""

@@ -7,16 +7,14 @@ a user can act on.
 
 from __future__ import annotations
 
-import difflib
 import math
-from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
 
 from .errors import ModelError
 
-__all__ = ["describe", "did_you_mean", "real_number", "state_array", "whole_number"]
+__all__ = ["describe", "real_number", "state_array", "whole_number"]
 
 
 def describe(value: Any) -> str:
@@ -112,10 +110,3 @@ def state_array(name: str, value: Any) -> np.ndarray:
         raise ModelError(f"`{name}` must be finite; entry {where} is {describe(array[index])}")
     array.setflags(write=False)
     return array
-
-
-def did_you_mean(word: str, options: Iterable[str]) -> str:
-    """Return ``" Did you mean 'x'?"`` for the closest option, or ``""`` (case ignored)."""
-    by_lower = {option.lower(): option for option in options}
-    close = difflib.get_close_matches(word.lower(), list(by_lower), n=1, cutoff=0.6)
-    return f" Did you mean {by_lower[close[0]]!r}?" if close else ""

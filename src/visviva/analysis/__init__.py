@@ -1,25 +1,32 @@
 """Analysis of integrators and runs: stability, convergence order, invariants, chaos measures."""
 
-from .advisor import largest_stable_step, matrix_free_eigenvalues
-from .chaos import LyapunovEstimate, lyapunov_exponent, separation
-from .compare import Comparison, MethodResult, compare_methods
-from .convergence import ConvergenceStudy, convergence_order
-from .invariants import (
-    angular_momentum,
-    center_of_mass,
-    energy_drift,
-    linear_momentum,
-    max_energy_error,
-    relative_change,
-)
-from .stability import (
-    max_stable_dt,
-    spectrum,
-    stability_function,
-    stability_interval,
-    stability_region,
-    state_jacobian,
-)
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_names
+
+if TYPE_CHECKING:
+    from .advisor import largest_stable_step, matrix_free_eigenvalues
+    from .chaos import LyapunovEstimate, lyapunov_exponent, separation
+    from .compare import Comparison, MethodResult, compare_methods
+    from .convergence import ConvergenceStudy, convergence_order
+    from .invariants import (
+        angular_momentum,
+        center_of_mass,
+        energy_drift,
+        linear_momentum,
+        max_energy_error,
+        relative_change,
+    )
+    from .stability import (
+        max_stable_dt,
+        spectrum,
+        stability_function,
+        stability_interval,
+        stability_region,
+        state_jacobian,
+    )
 
 __all__ = [
     "Comparison",
@@ -45,3 +52,34 @@ __all__ = [
     "stability_region",
     "state_jacobian",
 ]
+
+# Names load on first use (visviva._lazy): a run's summary needs `invariants` without the
+# stability and convergence studies' integrators.
+__getattr__, __dir__ = lazy_names(
+    __name__,
+    __all__,
+    {
+        "largest_stable_step": "advisor",
+        "matrix_free_eigenvalues": "advisor",
+        "LyapunovEstimate": "chaos",
+        "lyapunov_exponent": "chaos",
+        "separation": "chaos",
+        "Comparison": "compare",
+        "MethodResult": "compare",
+        "compare_methods": "compare",
+        "ConvergenceStudy": "convergence",
+        "convergence_order": "convergence",
+        "angular_momentum": "invariants",
+        "center_of_mass": "invariants",
+        "energy_drift": "invariants",
+        "linear_momentum": "invariants",
+        "max_energy_error": "invariants",
+        "relative_change": "invariants",
+        "max_stable_dt": "stability",
+        "spectrum": "stability",
+        "stability_function": "stability",
+        "stability_interval": "stability",
+        "stability_region": "stability",
+        "state_jacobian": "stability",
+    },
+)

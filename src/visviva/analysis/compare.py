@@ -141,7 +141,7 @@ def compare_methods(
     span_end = real_number("convergence_t_end", span_end, unit=" s")
     integrators = [get(name) for name in methods]
     results, runs, studies = [], {}, []
-    from ..simulation.solve import solve
+    from ..simulation.solution import solve
 
     for integrator in integrators:
         started = time.perf_counter()

@@ -104,7 +104,7 @@ def convergence_order(
         >>> round(study.order, 1)
         2.0
     """
-    from ..simulation.solve import solve
+    from ..simulation.solution import solve
 
     integrator = get(method)
     t_end = real_number("t_end", t_end, unit=" s")

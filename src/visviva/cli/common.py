@@ -24,7 +24,7 @@ ForceOption = Annotated[bool, typer.Option("--force", help="Replace existing out
 
 def print_json(data: Any) -> None:
     """Print ``data`` as indented JSON (NumPy values unwrapped)."""
-    from ..io.job import plain_json
+    from ..io.json_values import plain_json
 
     typer.echo(json.dumps(plain_json(data), indent=2, allow_nan=False))
 

@@ -217,7 +217,7 @@ def equations_command(
     latex: Annotated[bool, typer.Option("--latex", help="Print LaTeX instead of text.")] = False,
 ) -> None:
     """Print the equations of motion visviva derives from a classic system's K and U."""
-    from .._validation import did_you_mean
+    from .._registry import did_you_mean
     from ..errors import ModelError
     from ..mechanics.classic import LAGRANGIAN_SYSTEMS
 
@@ -253,7 +253,8 @@ def compare_command(
     force: ForceOption = False,
 ) -> None:
     """Run one system under several integrators: energy plot, convergence plot and a table."""
-    from .._validation import did_you_mean, real_number
+    from .._registry import did_you_mean
+    from .._validation import real_number
     from ..analysis.compare import compare_methods
     from ..errors import ModelError
     from ..io.job import JobOutput
@@ -339,12 +340,14 @@ def demo_command(
     force: ForceOption = False,
 ) -> None:
     """Run a demonstration and write its recording, summary and figures (no NAME: list them)."""
-    from ..demos import demos, run_demo
-
     if name is None:
-        for demo in sorted(demos().values(), key=lambda d: d.name):
-            typer.echo(f"{demo.name:16s} {demo.summary}")
+        from ..demos import demo_summaries
+
+        for listed, summary in sorted(demo_summaries().items()):
+            typer.echo(f"{listed:16s} {summary}")
         return
+    from ..demos import run_demo
+
     directory = output if output is not None else Path("out") / name
     report = run_demo(
         name, directory, duration=duration, formats=formats or (), fps=fps, force=force

@@ -233,7 +233,7 @@ def export_command(
     force: ForceOption = False,
 ) -> None:
     """Export a recording for Blender/Houdini (USD, glTF, OBJ, PC2) or as a video."""
-    from .._validation import did_you_mean
+    from .._registry import did_you_mean
     from ..errors import ModelError
     from ..io.files import check_new_file
     from ..io.outputs import OUTPUT_FILES, playback

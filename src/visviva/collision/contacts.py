@@ -32,13 +32,25 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numba import njit, prange
 
 from .colliders import ColliderSet, collider_distance
 
-__all__ = ["CLASSES", "COLLIDING", "DEFAULT_GAP", "RESTING", "SEPARATING", "Contacts"]
+if TYPE_CHECKING:
+    from ..ode.state import State
+
+__all__ = [
+    "CLASSES",
+    "COLLIDING",
+    "DEFAULT_GAP",
+    "RESTING",
+    "SEPARATING",
+    "ContactSource",
+    "Contacts",
+]
 
 #: Contact classes (the codes of :attr:`Contacts.kind`).
 COLLIDING, RESTING, SEPARATING = 0, 1, 2
@@ -117,6 +129,15 @@ class Contacts:
             np.concatenate([p.kind for p in parts])[order],
             tuple(label for p in parts for label in p.labels),
         )
+
+
+class ContactSource(Protocol):
+    """Colliders that report their contacts with a state's particles: a collision stage's or
+    a penalty force's."""
+
+    def contacts(self, state: State, gap: float = DEFAULT_GAP) -> Contacts:
+        """The contacts of ``state``'s live particles, surfaces within ``gap`` [m]."""
+        ...
 
 
 def find_contacts(

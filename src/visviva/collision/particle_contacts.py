@@ -59,6 +59,7 @@ import numpy as np
 from .._validation import describe, real_number, whole_number
 from ..errors import ModelError, SimulationError
 from ..geometry.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid
+from ..ode.stage import Phase
 from . import contact_detection as detection
 from . import contact_kernels as kernels
 from .contacts import CLASSES, COLLIDING, DEFAULT_GAP, RESTING, SEPARATING
@@ -160,7 +161,10 @@ class ParticleContacts:
     positions and velocities ``particle_position`` / ``particle_velocity``.
     """
 
+    phase: ClassVar[Phase] = Phase.CONTACTS
     compiled: ClassVar[bool] = False
+    changes_energy: ClassVar[bool] = True
+    kills_particles: ClassVar[bool] = False
 
     def __init__(
         self,

@@ -36,6 +36,7 @@ from .colliders import ColliderSet, collider_distance
 from .contacts import DEFAULT_GAP, Contacts, find_contacts
 
 if TYPE_CHECKING:
+    from ..forces.base import JacobianForm
     from ..ode.state import State
     from ..ode.workspace import Workspace
 from .tables import ColliderKind
@@ -61,6 +62,8 @@ class PenaltyContact:
     """
 
     velocity_dependent = True
+    #: Its damper ``c (v·n) n`` changes direction with the positions: not a linear damper.
+    linear_damping = False
 
     def __init__(
         self,
@@ -136,18 +139,21 @@ class PenaltyContact:
         """One 3×3 block per particle that meets a penalty collider."""
         return self._touched, self._touched
 
-    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
-        """The blocks of the module docstring, summed over the colliders in contact."""
-        self._add_jacobian(x, v, dfdx, dfdv, False, False)
-
-    def add_symmetric_jacobian(self, t, x, v, dfdx, dfdv, definite) -> None:  # type: ignore[no-untyped-def]
-        """:meth:`add_jacobian` without the damper's change of direction with position
-        (``−c n vᵀH``); ``definite``: without the curvature term ``f H`` too, which pushes
-        a particle sideways off a sphere (positive in ``∂F/∂x``: it makes the potential's
+    def add_jacobian(
+        self,
+        t: float,
+        x: np.ndarray,
+        v: np.ndarray,
+        dfdx: np.ndarray,
+        dfdv: np.ndarray,
+        form: JacobianForm = "exact",
+    ) -> None:
+        """The blocks of the module docstring, summed over the colliders in contact.
+        ``"symmetric"``: without the damper's change of direction with position
+        (``−c n vᵀH``); ``"definite"``: without the curvature term ``f H`` too, which pushes a
+        particle sideways off a sphere (positive in ``∂F/∂x``: it makes the potential's
         Hessian indefinite)."""
-        self._add_jacobian(x, v, dfdx, dfdv, True, definite)
-
-    def _add_jacobian(self, x, v, dfdx, dfdv, symmetric, definite) -> None:  # type: ignore[no-untyped-def]
+        symmetric, definite = form != "exact", form == "definite"
         _penalty(
             self._touched,
             x,
@@ -189,7 +195,7 @@ def _penalty(
 ):  # pragma: no cover - compiled
     """Forces into ``out`` (if it has rows) and Jacobian blocks into ``dfdx``/``dfdv`` (if they
     have rows), for the particles ``index``; ``symmetric``/``definite`` leave out the terms
-    :meth:`PenaltyContact.add_symmetric_jacobian` names."""
+    :meth:`PenaltyContact.add_jacobian` names."""
     forces = out.shape[0] > 0
     for b in range(index.shape[0]):
         i = index[b]

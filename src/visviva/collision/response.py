@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 from numba import njit, prange
 
+from ..ode.stage import Phase
 from .colliders import UNROLLED_PLANES, ColliderSet, collider_distance, collider_first_hit
 from .contacts import DEFAULT_GAP, Contacts, find_contacts
 from .queries import plane_distance, plane_first_hit
@@ -93,7 +94,10 @@ class ParticleCollisions:
     positions and velocities ``particle_position`` / ``particle_velocity``.
     """
 
+    phase: ClassVar[Phase] = Phase.CONTACTS
     compiled: ClassVar[bool] = True
+    changes_energy: ClassVar[bool] = True
+    kills_particles: ClassVar[bool] = False
 
     def __init__(
         self,
@@ -106,6 +110,10 @@ class ParticleCollisions:
         self.response = response
         self.masks = np.asarray(masks, dtype=np.uint64)
         self.labels = tuple(labels or (f"collider {k}" for k in range(len(colliders))))
+
+    def carried_start(self) -> dict[str, np.ndarray]:
+        """None: it carries nothing in the state."""
+        return {}
 
     def contacts(self, state: State, gap: float = DEFAULT_GAP) -> Contacts:
         """The contacts of ``state``'s live particles with these colliders (classified with

@@ -2,26 +2,26 @@
 
 Each demo runs real simulations through the public API and writes ``recording.h5`` (one run per
 method), ``summary.json`` and its figures into the output directory. Demos register themselves
-here; later capabilities add theirs to the same list.
+here; the built-in ones are listed in :mod:`~visviva.demos.catalogue`, so that a list of them
+(:func:`demo_summaries`) imports none, and running one imports only its module.
 """
 
 from __future__ import annotations
 
-import time
-import warnings
-from collections.abc import Callable, Iterable
+import importlib
+from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from .._lazy import lazy_names
 from .._registry import Registry
-from .._validation import real_number
-from ..errors import ModelError
-from ..io.job import JobOutput, JobReport, python_warnings, run_summary
-from ..io.outputs import output_names, write_output
-from ..simulation.interrupt import Interrupted, StopOnSignal
+from .catalogue import BUILTIN_DEMOS
 
-__all__ = ["Demo", "demos", "register_demo", "run_demo"]
+if TYPE_CHECKING:
+    from ..io.job import JobOutput
+    from .runner import run_demo
+
+__all__ = ["Demo", "demo_summaries", "demos", "find_demo", "register_demo", "run_demo"]
 
 
 @dataclass(frozen=True)
@@ -55,10 +55,6 @@ class Demo:
 
 _DEMOS: Registry[Demo] = Registry("demo")
 
-#: A demo runs at most this many times its default duration: demos pick their steps and frame
-#: counts for their default, and 1000× is already minutes of computing for most of them.
-MAX_DURATION_FACTOR = 1000
-
 
 def register_demo(demo: Demo, *, replace: bool = False) -> Demo:
     """Add a demo to the list shown by ``visviva demo`` and return it.
@@ -70,166 +66,37 @@ def register_demo(demo: Demo, *, replace: bool = False) -> Demo:
 
 
 def demos() -> dict[str, Demo]:
-    """Every registered demo by name."""
-    _load_builtins()
+    """Every registered demo by name (importing every built-in one)."""
+    for name in BUILTIN_DEMOS:
+        _load(name)
     return {name: _DEMOS.get(name) for name in _DEMOS}
 
 
-def run_demo(
-    name: str,
-    directory: str | Path,
-    *,
-    duration: float | None = None,
-    formats: Iterable[str] = (),
-    fps: float = 30.0,
-    force: bool = False,
-) -> JobReport:
-    """Run demo ``name`` and write its outputs into ``directory``.
+def demo_summaries() -> dict[str, str]:
+    """Every demo's one-line summary by name, without importing the built-in demos."""
+    summaries = {name: builtin.summary for name, builtin in BUILTIN_DEMOS.items()}
+    return summaries | {name: _DEMOS.get(name).summary for name in _DEMOS}
 
-    Args:
-        name: Demo name (see :func:`demos`).
-        directory: Output directory, created if missing.
-        duration: Simulated duration [s]; default: the demo's own.
-        formats: Outputs of the demo's first recording (``mp4``, ``gif``, ``html``, ``usd``,
-            ``glb``, ``obj``, ``pc2``), for demos with a picture.
-        fps: Frame rate of those outputs [frames/s].
-        force: Replace outputs that already exist.
 
-    Returns:
-        The files written and the summary (also in ``summary.json``).
+def find_demo(name: str) -> Demo:
+    """The demo called ``name``, importing only its module if it is a built-in one.
 
     Raises:
-        ModelError: Bad arguments or existing outputs, before anything runs.
-        Interrupted: On SIGINT/SIGTERM: the runs finished so far, the one cut short (marked
-            ``-interrupted``) and the summary were written (``error.report``).
+        ModelError: For an unknown name; the message suggests the closest one and lists them
+            all.
     """
-    _load_builtins()
-    demo = _DEMOS.get(name)
-    seconds = (
-        demo.duration
-        if duration is None
-        else real_number("duration", duration, positive=True, unit=" s")
-    )
-    if seconds > MAX_DURATION_FACTOR * demo.duration:
-        raise ModelError(
-            f"`duration` of demo {name!r} must be at most {MAX_DURATION_FACTOR} times its "
-            f"default of {demo.duration:g} s (got {seconds!r} s); for longer runs write a scene "
-            "file and use `visviva run`"
-        )
-    extras = output_names(formats)
-    if extras and not demo.picture:
-        raise ModelError(
-            f"demo {name!r} has no picture, so it cannot be written as "
-            f"{', '.join(dict.fromkeys(formats))}; demos with one: "
-            f"{', '.join(d.name for d in demos().values() if d.picture)}"
-        )
-    fps = real_number("fps", fps, positive=True, unit=" frames/s")
-    with (
-        warnings.catch_warnings(record=True) as caught,
-        StopOnSignal() as stops,
-        JobOutput(directory, force=force) as output,
-    ):
-        warnings.simplefilter("always")
-        output.check_target(["recording.h5", "summary.json", *extras])
-        started = time.perf_counter()
-        interrupted: Interrupted | None = None
-        extra: dict[str, Any] = {}
-        try:
-            with stops.polled():
-                extra = demo.run(output, seconds)
-        except Interrupted as error:
-            interrupted = error
-            if error.recording is not None:
-                output.recordings[_interrupted_run_name(output, error)] = error.recording
-        if interrupted is None and stops.requested:
-            interrupted = Interrupted(stops.requested, seconds)
-        for recording in output.recordings.values():  # later exports play them the same way
-            recording.attrs |= {
-                "playback_speed": demo.speed,
-                "playback_trail": demo.trail,
-                "playback_color_by": demo.color_by,
-            }
-        summary = _summary(demo, output, seconds, interrupted) | extra
-        if extras and interrupted is None:
-            run, primary = next(iter(output.recordings.items()))
-            summary["outputs_show_run"] = run
-            for file_name in extras:
-                try:
-                    with output.writing(file_name) as path:
-                        write_output(primary, path, fps, demo.speed, demo.trail, demo.color_by)
-                except KeyboardInterrupt:
-                    interrupted = Interrupted(stops.requested or "SIGINT", seconds)
-                    summary["interrupted"] = interrupted.signal
-                    summary["message"] = f"{interrupted.signal} while writing {file_name}"
-                    break
-        summary["wall_time_s"] = time.perf_counter() - started
-        summary["warnings"] = python_warnings(caught)
-        report = output.write(summary)
-    if interrupted is not None:
-        interrupted.report = report
-        raise interrupted
-    return report
+    if name in BUILTIN_DEMOS:
+        _load(name)
+    else:  # so that an unknown name is answered with every valid one
+        demos()
+    return _DEMOS.get(name)
 
 
-def _summary(
-    demo: Demo, output: JobOutput, seconds: float, interrupted: Interrupted | None
-) -> dict[str, Any]:
-    runs = {run: run_summary(recording) for run, recording in output.recordings.items()}
-    drifts = [r["energy_drift"] for r in runs.values() if r["energy_drift"] is not None]
-    summary: dict[str, Any] = {
-        "demo": demo.name,
-        "description": demo.summary,
-        "duration_s": seconds,
-        "complete": interrupted is None,
-        "steps": sum(int(r.get("steps", 0)) for r in runs.values()),
-        "energy_drift": max(drifts, key=abs) if drifts else None,
-        "runs": runs,
-    }
-    if interrupted is not None:
-        summary["interrupted"] = interrupted.signal
-        summary["message"] = str(interrupted)
-    return summary
+def _load(name: str) -> None:
+    """Import built-in demo ``name``'s module, which registers it (once: imports are cached)."""
+    importlib.import_module(f".{BUILTIN_DEMOS[name].module}", __name__)
 
 
-def _interrupted_run_name(output: JobOutput, error: Interrupted) -> str:
-    """A name for the run a signal cut short: its method, marked, unique in the job."""
-    base = f"{error.recording.attrs.get('method', 'run')}-interrupted"
-    name, k = base, 1
-    while name in output.recordings:
-        k += 1
-        name = f"{base}-{k}"
-    return name
-
-
-def _load_builtins() -> None:
-    from . import (  # noqa: F401 - registers the demos
-        ball_pit,
-        boids,
-        bottle_flip,
-        bunny_throw,
-        circular,
-        cloth_drape,
-        cloth_hang,
-        constrained_pendulum,
-        crowd,
-        dahlquist,
-        double_pendulum,
-        dzhanibekov,
-        fireworks,
-        flag,
-        fountain,
-        galaxy,
-        hair,
-        jelly,
-        kepler,
-        oscillator,
-        pendulum,
-        refinement_study,
-        rock,
-        rotation_drift,
-        snow,
-        spring_pendulum,
-        stiffness_study,
-        sun_earth_moon,
-        top,
-    )
+# run_demo loads on first use (visviva._lazy): it brings in the job's files and NumPy, which
+# listing the demos does not need.
+__getattr__, __dir__ = lazy_names(__name__, __all__, {"run_demo": "runner"})

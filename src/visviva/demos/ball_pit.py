@@ -32,6 +32,7 @@ from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 DURATION = 1.6  # [s]
 DT = 2e-3  # [s]
@@ -225,8 +226,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "ball-pit",
-        "balls dropped into a box: sphere collisions (restitution, friction), settling; overlaps, "
-        "momentum, the floor's support",
+        BUILTIN_DEMOS["ball-pit"].summary,
         DURATION,
         run,
         picture=True,

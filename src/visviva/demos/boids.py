@@ -24,6 +24,7 @@ from ..model.builder import SceneBuilder
 from ..particles.boids import polarisation
 from ..simulation.simulation import Simulation
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 BIRDS = 10_000
 DURATION = 20.0  # [s]
@@ -158,7 +159,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "boids",
-        "10,000 birds flock around an obstacle to a goal: Reynolds' boids; polarisation, spacing",
+        BUILTIN_DEMOS["boids"].summary,
         DURATION,
         run,
         picture=True,

@@ -22,6 +22,7 @@ from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 MASS = 0.5  # [kg]
 BOTTLES = {  # name: (radius, height) [m]
@@ -128,7 +129,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "bottle-flip",
-        "a flick at a bottle's base gives it spin (τ = r × F); same flick, different I",
+        BUILTIN_DEMOS["bottle-flip"].summary,
         0.7,
         run,
         picture=True,

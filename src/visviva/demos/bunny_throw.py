@@ -22,6 +22,7 @@ from ..rigid import mesh_mass_properties, sampled_mass_properties
 from ..simulation import Simulation
 from . import Demo, register_demo
 from ._meshes import bunny
+from .catalogue import BUILTIN_DEMOS
 
 DENSITY = 1000.0  # [kg/m³]
 START = np.array([0.0, 1.0, 0.0])  # the mesh's origin [m]
@@ -107,7 +108,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "bunny-throw",
-        "a rabbit-shaped mesh thrown with spin: parabola for its centre, tumbling about it",
+        BUILTIN_DEMOS["bunny-throw"].summary,
         1.0,
         run,
         picture=True,

@@ -17,8 +17,9 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..ode.problems import SecondOrderProblem
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 RADIUS = 1.0  # r0 [m]
 DT = 0.1  # step [s]
@@ -83,7 +84,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "circular",
-        "seed 004's circular motion: explicit Euler spirals out, implicit in, symplectic stays",
+        BUILTIN_DEMOS["circular"].summary,
         20.0,
         run,
     )

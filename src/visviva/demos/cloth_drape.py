@@ -47,6 +47,7 @@ from ._deformables import (
     record_alone,
     spring_forces,
 )
+from .catalogue import BUILTIN_DEMOS
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -207,7 +208,7 @@ def _figure(
 register_demo(
     Demo(
         "cloth-drape",
-        "cloth falls onto a ball with friction (projected Newton): no penetration, Coulomb holds",
+        BUILTIN_DEMOS["cloth-drape"].summary,
         DURATION,
         run,
         picture=True,

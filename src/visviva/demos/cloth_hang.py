@@ -47,6 +47,7 @@ from ._deformables import (
     strain,
     stretch_pairs,
 )
+from .catalogue import BUILTIN_DEMOS
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -173,7 +174,7 @@ def _figure(recording: Recording, kinetic: np.ndarray, grid: np.ndarray) -> Figu
 register_demo(
     Demo(
         "cloth-hang",
-        "cloth held at two corners falls and hangs: energy never rises, pins carry its weight",
+        BUILTIN_DEMOS["cloth-hang"].summary,
         DURATION,
         run,
         picture=True,

@@ -16,8 +16,9 @@ import numpy as np
 from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.recording import Recording
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 LENGTH = 1.0  # [m]
 THETA0 = 1.2  # [rad]
@@ -94,7 +95,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "constrained-pendulum",
-        "the pendulum as a particle held by f = λ(r − c), beside the θ description",
+        BUILTIN_DEMOS["constrained-pendulum"].summary,
         10.0,
         run,
         picture=True,

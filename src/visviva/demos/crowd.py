@@ -27,6 +27,7 @@ from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 DURATION = 150.0  # [s]: longer than the evacuation (about 126 s)
 DT = 0.005  # [s]: well below tau = 0.5 s and 2/sqrt(2k/m) = 37 ms
@@ -219,7 +220,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "crowd",
-        "a room of 200 agents evacuating through a door: social forces, flow rate, density",
+        BUILTIN_DEMOS["crowd"].summary,
         DURATION,
         run,
         picture=True,

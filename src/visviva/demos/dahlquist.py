@@ -16,9 +16,10 @@ import numpy as np
 from ..analysis.stability import stability_function
 from ..io.job import JobOutput
 from ..ode.problems import FirstOrderProblem
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from ..viz.plots import plot_stability_regions
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 LAMBDA = -1.0  # eigenvalue λ [1/s]
 STEPS = (0.5, 1.5, 1.9, 2.5, 3.0)  # h [s]
@@ -67,7 +68,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "test-equation",
-        "y' = -y at steps on both sides of h = 2: who decays, who oscillates, who blows up",
+        BUILTIN_DEMOS["test-equation"].summary,
         12.0,
         run,
     )

@@ -17,8 +17,9 @@ from ..analysis.chaos import lyapunov_exponent
 from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.recording import Recording
-from ..simulation.solve import Solution, solve
+from ..simulation.solution import Solution, solve
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 Q0 = np.array([2.0, 1.0])  # released from rest [rad]
 DELTA = 1e-9  # initial difference in theta2 [rad]
@@ -103,7 +104,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "double-pendulum",
-        "chaos: two double pendulums 1e-9 rad apart, Lyapunov exponent, energy",
+        BUILTIN_DEMOS["double-pendulum"].summary,
         20.0,
         run,
         picture=True,

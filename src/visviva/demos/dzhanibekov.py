@@ -22,6 +22,7 @@ from ..model import SceneBuilder
 from ..simulation import Simulation
 from . import Demo, register_demo
 from ._meshes import t_handle
+from .catalogue import BUILTIN_DEMOS
 
 DENSITY = 2700.0  # aluminium [kg/m³]
 SPIN = 8.0  # [rad/s]
@@ -104,7 +105,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "dzhanibekov",
-        "T-handles spun about each principal axis: only the intermediate one flips",
+        BUILTIN_DEMOS["dzhanibekov"].summary,
         20.0,
         run,
         picture=True,

@@ -28,6 +28,7 @@ from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 DURATION = 6.0  # [s]: the last shell's sparks are gone by then
 DT = 1.0 / 200.0  # [s]
@@ -240,7 +241,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "fireworks",
-        "shells burst into spheres of sparks: burst emitters, quadratic drag, colour ramps",
+        BUILTIN_DEMOS["fireworks"].summary,
         DURATION,
         run,
         picture=True,

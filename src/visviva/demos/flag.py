@@ -42,6 +42,7 @@ from ..model.builder import SceneBuilder
 from ..model.model import Model
 from . import Demo, register_demo
 from ._deformables import GRAVITY, kinetic_energy, load_on_pins, record_alone
+from .catalogue import BUILTIN_DEMOS
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -180,7 +181,7 @@ def _figure(
 register_demo(
     Demo(
         "flag",
-        "a flag hung from a staff in the wind: its deflection against drag and weight",
+        BUILTIN_DEMOS["flag"].summary,
         DURATION,
         run,
         picture=True,

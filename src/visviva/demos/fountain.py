@@ -25,6 +25,7 @@ from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 DURATION = 4.0  # [s]
 DT = 0.0025  # [s]: symplectic Euler's apex is low by about v·dt/2 = 8 mm
@@ -159,7 +160,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "fountain",
-        "a water jet into a basin: emitter, gravity, drag, a floor; steady state and apex",
+        BUILTIN_DEMOS["fountain"].summary,
         DURATION,
         run,
         picture=True,

@@ -17,9 +17,10 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..mechanics import colliding_disks, tree_force_error
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from ._bodies import body_states, drawn_bodies
+from .catalogue import BUILTIN_DEMOS
 
 BODIES_PER_DISK = 3000
 DISK_MASS = 0.2  # of each disk, against a central mass of 1
@@ -77,7 +78,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "galaxy",
-        "two disk galaxies collide: tidal bridges and tails, gravity from the Barnes–Hut tree",
+        BUILTIN_DEMOS["galaxy"].summary,
         15.0,
         run,
         picture=True,

@@ -54,6 +54,7 @@ from ..model.model import Model
 from ..simulation.simulation import Simulation
 from . import Demo, register_demo
 from ._deformables import GRAVITY, one_thread, spring_pairs, strain
+from .catalogue import BUILTIN_DEMOS
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -315,8 +316,7 @@ def _figure(model: Model, t: np.ndarray, points: np.ndarray, strands: list[dict]
 register_demo(
     Demo(
         "hair",
-        "hair strands swing after the head turns and stops: roots on the head, stretch "
-        "bounded, chain periods",
+        BUILTIN_DEMOS["hair"].summary,
         DURATION,
         run,
         picture=True,

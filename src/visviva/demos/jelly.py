@@ -41,6 +41,7 @@ from ._deformables import (
     springs_of,
     strain,
 )
+from .catalogue import BUILTIN_DEMOS
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -219,7 +220,7 @@ def _figure(
 register_demo(
     Demo(
         "jelly",
-        "a jelly cube dropped on the floor: free fall, no penetration, squashed by its weight",
+        BUILTIN_DEMOS["jelly"].summary,
         DURATION,
         run,
         picture=True,

@@ -16,9 +16,10 @@ import numpy as np
 from ..analysis.invariants import angular_momentum
 from ..io.job import JobOutput
 from ..mechanics import kepler_orbit
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from ._bodies import body_states, drawn_bodies
+from .catalogue import BUILTIN_DEMOS
 
 ECCENTRICITY = 0.5
 MASSES = (1.0, 0.1)  # [kg], with G = 1 (N-body units)
@@ -89,7 +90,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "kepler",
-        "two-body orbit with e = 0.5 against Kepler's equation; energy and angular momentum",
+        BUILTIN_DEMOS["kepler"].summary,
         60.0,
         run,
         picture=True,

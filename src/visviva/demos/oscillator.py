@@ -15,9 +15,10 @@ import numpy as np
 from ..integrators import get, names
 from ..io.job import JobOutput
 from ..ode.problems import SecondOrderProblem
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from ..viz.plots import plot_energy, plot_phase
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 OMEGA = 2.0 * np.pi  # angular frequency [rad/s]: one oscillation per second
 DT = 0.02  # step [s]: ωh ≈ 0.126
@@ -72,7 +73,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "oscillator",
-        "every integrator on an undamped spring: energy growth, decay or conservation side by side",
+        BUILTIN_DEMOS["oscillator"].summary,
         10.0,
         run,
     )

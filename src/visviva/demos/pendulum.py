@@ -16,9 +16,10 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..mechanics import classic
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from ._bodies import drawn_system
+from .catalogue import BUILTIN_DEMOS
 
 LENGTH = 1.0  # [m]
 THETA0 = 1.0  # released from rest at 1 rad
@@ -79,7 +80,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "pendulum",
-        "seed 001's pendulum from K and U: exact period vs the small-angle solution",
+        BUILTIN_DEMOS["pendulum"].summary,
         10.0,
         run,
         picture=True,

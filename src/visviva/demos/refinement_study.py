@@ -43,6 +43,7 @@ from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
 from . import Demo, register_demo
 from ._deformables import GRAVITY, one_thread
+from .catalogue import BUILTIN_DEMOS
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -256,7 +257,7 @@ def _figure(
 register_demo(
     Demo(
         "refinement-study",
-        "one cloth at 6, 11, 21 points per side: a curtain converges, two pins do not; shear, bend",
+        BUILTIN_DEMOS["refinement-study"].summary,
         DURATION,
         run,
         picture=True,

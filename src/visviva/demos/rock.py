@@ -14,9 +14,10 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..mechanics import classic
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from ._bodies import drawn_system
+from .catalogue import BUILTIN_DEMOS
 
 DT = 0.05  # step [s]
 Q0 = np.array([0.0, 0.0, 0.0])  # thrown from the ground [m]
@@ -63,7 +64,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "rock",
-        "seed 001's thrown rock: integrators against the exact parabola",
+        BUILTIN_DEMOS["rock"].summary,
         1.6,
         run,
         picture=True,

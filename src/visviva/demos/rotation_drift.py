@@ -19,6 +19,7 @@ from ..analysis.rotation_drift import drift_study
 from ..io.job import JobOutput
 from ..rigid.motion import BodyMotion
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 MOMENTS = np.array([1.0, 2.0, 3.0])  # [kg·m²]
 OMEGA = np.array([0.5, 2.0, 1.0])  # body angular velocity at the start [rad/s]
@@ -61,7 +62,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "rotation-drift",
-        "rotation matrices and quaternions under explicit Euler, renormalized or not",
+        BUILTIN_DEMOS["rotation-drift"].summary,
         10.0,
         run,
     )

@@ -30,6 +30,7 @@ from ..model.builder import SceneBuilder
 from ..model.model import Model
 from ..simulation.simulation import Simulation
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -259,7 +260,7 @@ def _figure(
 register_demo(
     Demo(
         "snow",
-        "snowflakes in wind and a gust settle on a ball and the ground (drag, vortex, friction)",
+        BUILTIN_DEMOS["snow"].summary,
         DURATION,
         run,
         picture=True,

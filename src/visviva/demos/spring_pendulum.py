@@ -14,9 +14,10 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..mechanics import classic
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from ._bodies import drawn_system
+from .catalogue import BUILTIN_DEMOS
 
 MASS, REST = 1.0, 1.0  # [kg], [m]
 G = classic.STANDARD_GRAVITY
@@ -76,7 +77,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "spring-pendulum",
-        "a bob on a spring: swing and bounce trade energy (autoparametric resonance)",
+        BUILTIN_DEMOS["spring-pendulum"].summary,
         30.0,
         run,
         picture=True,

@@ -48,6 +48,7 @@ from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
 from . import Demo, register_demo
 from ._deformables import GRAVITY, largest_rise, one_thread, strain, stretch_pairs
+from .catalogue import BUILTIN_DEMOS
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -198,7 +199,7 @@ def _figure(table: list[dict[str, Any]], recordings: dict[str, Recording]) -> Fi
 register_demo(
     Demo(
         "stiffness-study",
-        "explicit vs implicit on one cloth at k = 3 to 1e4 N/m: the advisor predicts blow-ups",
+        BUILTIN_DEMOS["stiffness-study"].summary,
         DURATION,
         run,
         picture=True,

@@ -15,9 +15,10 @@ import numpy as np
 from ..analysis.invariants import angular_momentum
 from ..io.job import JobOutput
 from ..mechanics import sun_earth_moon
-from ..simulation.solve import solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
 from ._bodies import body_states, drawn_bodies
+from .catalogue import BUILTIN_DEMOS
 
 DAY = 86_400.0  # [s]
 YEAR = 365.25 * DAY  # Julian year [s]
@@ -98,7 +99,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "sun-earth-moon",
-        "a year of the Sun, Earth and Moon in SI units from J2000: the year and the month",
+        BUILTIN_DEMOS["sun-earth-moon"].summary,
         YEAR,
         run,
         picture=True,

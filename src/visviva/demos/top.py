@@ -31,6 +31,7 @@ from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
 from . import Demo, register_demo
+from .catalogue import BUILTIN_DEMOS
 
 RADIUS, HEIGHT, DENSITY = 0.05, 0.12, 700.0  # [m], [m], wood [kg/m³]
 TILT, SPIN = 0.3, 500.0  # [rad], [rad/s] (a fast top: I₃²ω² ≫ 4 I₁' M g d)
@@ -122,7 +123,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 register_demo(
     Demo(
         "top",
-        "a spinning top on its tip: gravity's torque makes it precess and nod, not topple",
+        BUILTIN_DEMOS["top"].summary,
         4.0,
         run,
         picture=True,

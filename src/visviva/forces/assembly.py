@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..ode.workspace import Workspace
-from .base import Force
+from .base import Force, JacobianForm
 
 __all__ = ["ForceSum"]
 
@@ -51,9 +51,7 @@ class ForceSum:
         self.work = work if work is not None else Workspace()
         self.velocity_dependent = any(f.velocity_dependent for f in self.forces)
         self.conservative = all(f.conservative for f in self.forces)
-        self.gradient_form = all(
-            f.conservative or getattr(f, "linear_damping", False) for f in self.forces
-        )
+        self.gradient_form = all(f.conservative or f.linear_damping for f in self.forces)
         patterns = [f.jacobian_blocks() for f in self.forces]
         self.has_jacobian = all(p is not None for p in patterns)
         self.blocks = 0
@@ -90,14 +88,11 @@ class ForceSum:
         return sum((f.potential(t, x, alive) for f in self.forces), 0.0)
 
     def jacobian(
-        self, t: float, x: np.ndarray, v: np.ndarray, form: str = "exact"
+        self, t: float, x: np.ndarray, v: np.ndarray, form: JacobianForm = "exact"
     ) -> tuple[Any, Any]:
         """``(∂F/∂x, ∂F/∂v)`` as ``3N × 3N`` block-sparse matrices (BSR, 3×3 blocks, on the
         pattern :attr:`indptr`, :attr:`indices`; ``∂F/∂v`` is ``None`` if no force depends
-        on velocity). ``form``: ``"exact"``; ``"symmetric"``, each force's
-        ``add_symmetric_jacobian`` where it has one (the damped springs' ``∂F/∂x`` without
-        the damper's non-symmetric part: ``−∇²U``); or ``"definite"``, the same made
-        positive semi-definite (see :class:`~visviva.forces.Springs`) for implicit steps.
+        on velocity), each force's in the ``form`` asked for (:data:`~.base.JacobianForm`).
 
         Raises:
             ValueError: If a force has no analytic Jacobian (check :attr:`has_jacobian`).
@@ -110,11 +105,7 @@ class ForceSum:
         local_x.fill(0.0)
         local_v.fill(0.0)
         for force, a, b in zip(self.forces, self._bounds[:-1], self._bounds[1:], strict=True):
-            symmetric = getattr(force, "add_symmetric_jacobian", None)
-            if form == "exact" or symmetric is None:
-                force.add_jacobian(t, x, v, local_x[a:b], local_v[a:b])
-            else:
-                symmetric(t, x, v, local_x[a:b], local_v[a:b], form == "definite")
+            force.add_jacobian(t, x, v, local_x[a:b], local_v[a:b], form)
         shape = (3 * self.count, 3 * self.count)
         matrices = []
         for local in self._local[: 2 if self.velocity_dependent else 1]:

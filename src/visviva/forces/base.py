@@ -25,14 +25,22 @@ force's ``F = −∇U`` the same way (``tests/test_forces.py``).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, ClassVar, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, Protocol
 
 import numpy as np
 
 if TYPE_CHECKING:
     from ..ode.workspace import Workspace
 
-__all__ = ["Force", "Targets", "diagonal_blocks"]
+__all__ = ["Force", "JacobianForm", "Targets", "diagonal_blocks"]
+
+
+#: Which Jacobian a force adds: ``"exact"``; ``"symmetric"``, ``∂F/∂x`` without the parts
+#: that are not ``−∇²U`` (a damper's change of direction with the positions), the Hessian of
+#: backward Euler's incremental potential; ``"definite"``, that made positive semi-definite
+#: too (a compressed spring's negative stiffness across it dropped, Choi & Ko 2002), so that
+#: Newton's matrix ``M − h D − h² K`` is positive definite.
+JacobianForm = Literal["exact", "symmetric", "definite"]
 
 
 class Force(Protocol):
@@ -42,6 +50,13 @@ class Force(Protocol):
     conservative: ClassVar[bool]
     #: True if the force depends on the velocities.
     velocity_dependent: ClassVar[bool]
+
+    @property
+    def linear_damping(self) -> bool:
+        """True if the force is ``−∇U + D v`` with ``D = ∂F/∂v`` symmetric and independent of
+        ``v`` (a linear damper): with such forces only, backward Euler's step minimizes an
+        incremental potential (:class:`~visviva.forces.ForceSum`'s ``gradient_form``)."""
+        ...
 
     def accumulate(
         self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
@@ -64,10 +79,18 @@ class Force(Protocol):
         ...
 
     def add_jacobian(
-        self, t: float, x: np.ndarray, v: np.ndarray, dfdx: np.ndarray, dfdv: np.ndarray
+        self,
+        t: float,
+        x: np.ndarray,
+        v: np.ndarray,
+        dfdx: np.ndarray,
+        dfdv: np.ndarray,
+        form: JacobianForm = "exact",
     ) -> None:
         """Add ``∂F/∂x`` [N/m] and ``∂F/∂v`` [N·s/m] into ``dfdx`` and ``dfdv``, each
-        ``(blocks, 3, 3)`` in the order of :meth:`jacobian_blocks`."""
+        ``(blocks, 3, 3)`` in the order of :meth:`jacobian_blocks`: the exact Jacobians, or
+        the forms implicit steps ask for (:data:`JacobianForm`; a force whose Jacobian has
+        no part to drop adds its exact one for every form)."""
         ...
 
 

@@ -58,6 +58,11 @@ class _Field:
         self.mass = np.asarray(mass, dtype=np.float64)
         self.targets = targets
 
+    @property
+    def linear_damping(self) -> bool:
+        """No linear damper (a damping field says otherwise)."""
+        return False
+
     def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
         """Potential energy [J]: none for a dissipative field."""
         return 0.0
@@ -107,7 +112,7 @@ class UniformGravity(_Field):
         """No blocks: the force does not change with the state."""
         return _NO_BLOCKS
 
-    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+    def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """Nothing to add: ``∂F/∂x = ∂F/∂v = 0``."""
 
 
@@ -152,7 +157,7 @@ class Drag(_AirDrag):
             index = self.targets.indices
             out[index] -= k * (v[index] - w)
 
-    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+    def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """``∂F/∂v = −k I`` [N·s/m] on each block."""
         for axis in range(3):
             dfdv[:, axis, axis] -= self.coefficient
@@ -167,7 +172,10 @@ class Damping(_Field):
         targets: The particles it acts on (default: all).
     """
 
-    linear_damping = True  # F = D v with D = −γ m I (see visviva.forces.ForceSum)
+    @property
+    def linear_damping(self) -> bool:
+        """``F = D v`` with ``D = −γ m I`` (see visviva.forces.ForceSum)."""
+        return True
 
     def __init__(self, rate: float, mass: np.ndarray, targets: Targets | None = None) -> None:
         super().__init__(mass, targets or Targets(len(mass)))
@@ -184,7 +192,7 @@ class Damping(_Field):
             index = self.targets.indices
             out[index] -= self._factor * v[index]
 
-    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+    def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """``∂F/∂v = −γ m I`` [kg/s] on each block."""
         for axis in range(3):
             dfdv[:, axis, axis] -= self._factor[:, 0]
@@ -206,7 +214,7 @@ class QuadraticDrag(_AirDrag):
         """Add the drag [N] to ``out``."""
         _quadratic_drag(self.targets.indices, v, *self.air_velocity, self.coefficient, out)
 
-    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+    def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """``∂F/∂v`` [kg/s] on each block (see :func:`~.laws.quadratic_drag_jacobian`)."""
         _quadratic_drag_blocks(self.targets.indices, v, *self.air_velocity, self.coefficient, dfdv)
 
@@ -251,7 +259,7 @@ class Attractor(_Field):
         """``U = −Σ_i s m_i / ρ_i`` [J] over the targets (alive ones, if given)."""
         return float(_attractor_energy(self.targets.mask(alive), x, self.mass, *self._parameters()))
 
-    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+    def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """``∂F/∂x`` [N/m] on each block (see :func:`~.laws.attractor_jacobian`)."""
         _attractor_blocks(self.targets.indices, x, self.mass, *self._parameters(), dfdx)
 
@@ -298,7 +306,7 @@ class Vortex(_Field):
         """Add the vortex's drag [N] to ``out``."""
         _vortex(self.targets.indices, x, v, *self._parameters(), out)
 
-    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+    def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """``∂F/∂x = k ∂u/∂x`` and ``∂F/∂v = −k I`` on each block."""
         _vortex_blocks(self.targets.indices, x, *self._parameters(), dfdx)
         for axis in range(3):

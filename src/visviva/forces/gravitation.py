@@ -48,6 +48,7 @@ class Gravitation:
 
     conservative: ClassVar[bool] = True
     velocity_dependent: ClassVar[bool] = False
+    linear_damping: ClassVar[bool] = False
 
     def __init__(
         self,
@@ -92,6 +93,6 @@ class Gravitation:
         """None: the Jacobian is dense (see the module docstring)."""
         return None
 
-    def add_jacobian(self, t, x, v, dfdx, dfdv) -> None:  # type: ignore[no-untyped-def]
+    def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """Never called: there is no analytic Jacobian."""
         raise NotImplementedError("gravitation has no analytic Jacobian")

@@ -17,8 +17,8 @@ the projection across the spring,
 fill four 3×3 blocks per spring, ``(i, i) = −K``, ``(i, j) = K``, ``(j, i) = K``,
 ``(j, j) = −K`` (and the same for ``D``), on a pattern fixed when the springs are built. A
 compressed spring (``l < L``) makes ``K`` indefinite across the spring: the buckling that
-implicit steps handle by projecting it (:meth:`Springs.add_symmetric_jacobian` drops the
-negative part, Choi & Ko 2002).
+implicit steps handle by projecting it (:meth:`Springs.add_jacobian`'s ``"definite"`` form drops
+the negative part, Choi & Ko 2002).
 
 ``tests/test_springs.py`` checks every Jacobian against central finite differences of the same
 force (compressed springs included) and ``f = −∇U`` without damping.
@@ -32,6 +32,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..errors import ModelError
+from .base import JacobianForm
 from .lattice_springs import SpringStencil
 
 if TYPE_CHECKING:
@@ -148,37 +149,19 @@ class Springs:
         return rows, cols
 
     def add_jacobian(
-        self, t: float, x: np.ndarray, v: np.ndarray, dfdx: np.ndarray, dfdv: np.ndarray
-    ) -> None:
-        """Add ``∂F/∂x`` [N/m] and ``∂F/∂v`` [N·s/m] into the blocks of
-        :meth:`jacobian_blocks` (``(4S, 3, 3)`` each)."""
-        self._add_jacobian(x, v, dfdx, dfdv)
-
-    def add_symmetric_jacobian(
         self,
         t: float,
         x: np.ndarray,
         v: np.ndarray,
         dfdx: np.ndarray,
         dfdv: np.ndarray,
-        definite: bool,
+        form: JacobianForm = "exact",
     ) -> None:
-        """:meth:`add_jacobian` without the damper's non-symmetric part (the change of its
-        direction with the positions): ``∂F/∂x`` is then ``−∇²U``, the Hessian backward
-        Euler's incremental potential needs. ``definite``: each spring's stiffness made
-        positive semi-definite too, a compressed spring's negative stiffness across it dropped
-        (Choi & Ko 2002), so that ``M − h D − h² K`` is positive definite."""
-        self._add_jacobian(x, v, dfdx, dfdv, True, definite)
-
-    def _add_jacobian(
-        self,
-        x: np.ndarray,
-        v: np.ndarray,
-        dfdx: np.ndarray,
-        dfdv: np.ndarray,
-        symmetric: bool = False,
-        definite: bool = False,
-    ) -> None:
+        """Add ``∂F/∂x`` [N/m] and ``∂F/∂v`` [N·s/m] into the blocks of
+        :meth:`jacobian_blocks` (``(4S, 3, 3)`` each). ``"symmetric"``: without the damper's
+        non-symmetric part (the change of its direction with the positions), so ``∂F/∂x`` is
+        ``−∇²U``; ``"definite"``: each spring's stiffness made positive semi-definite too, a
+        compressed spring's negative stiffness across it dropped (Choi & Ko 2002)."""
         _jacobian(
             self.pairs,
             self.rest_length,
@@ -186,8 +169,8 @@ class Springs:
             self.damping,
             x,
             v,
-            symmetric,
-            definite,
+            form != "exact",
+            form == "definite",
             dfdx,
             dfdv,
         )

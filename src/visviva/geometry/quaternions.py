@@ -4,8 +4,9 @@ A body's orientation is the unit quaternion ``q`` that takes body coordinates to
 ``p_world = R(q) p_body`` (Baraff & Witkin's notes, "Rigid body dynamics", §4). Quaternions are
 easier to keep a rotation than matrices (seed 003): a unit quaternion drifts off the unit
 sphere by round-off only, and one division brings it back, where a matrix needs Gram–Schmidt.
-The functions here are Numba scalars (inlined into the rigid-body kernels) and NumPy forms for
-the model's setup and the tests.
+The functions here are NumPy forms, for the model's setup, the recordings' body surfaces and the
+tests; the scalar forms inlined into the rigid-body kernels are in
+:mod:`~visviva.geometry.quaternion_kernels`, so that reading a recording needs no Numba.
 
 References:
     D. Baraff, A. Witkin, "Physically based modeling: rigid body dynamics", SIGGRAPH course
@@ -15,14 +16,17 @@ References:
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 __all__ = ["matrix_quaternion", "quaternion_matrix", "quaternion_multiply", "quaternion_rotate"]
 
 
-@njit(cache=True, inline="always")
-def multiply(aw, ax, ay, az, bw, bx, by, bz):  # pragma: no cover - compiled
-    """The Hamilton product ``a ⊗ b``: the rotation ``b``, then ``a``."""
+def hamilton_product(aw, ax, ay, az, bw, bx, by, bz):
+    """The Hamilton product ``a ⊗ b``: the rotation ``b``, then ``a``.
+
+    On components that are floats or arrays alike: :func:`quaternion_multiply` calls it on
+    arrays, and :mod:`~visviva.geometry.quaternion_kernels` compiles this same function for the
+    rigid-body kernels.
+    """
     return (
         aw * bw - ax * bx - ay * by - az * bz,
         aw * bx + ax * bw + ay * bz - az * by,
@@ -31,37 +35,10 @@ def multiply(aw, ax, ay, az, bw, bx, by, bz):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True, inline="always")
-def rotate(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
-    """``R(q) v`` for a unit quaternion ``q`` (``v + 2w (u × v) + 2 u × (u × v)``, ``u`` the
-    vector part)."""
-    cx = y * vz - z * vy
-    cy = z * vx - x * vz
-    cz = x * vy - y * vx
-    return (
-        vx + 2.0 * (w * cx + y * cz - z * cy),
-        vy + 2.0 * (w * cy + z * cx - x * cz),
-        vz + 2.0 * (w * cz + x * cy - y * cx),
-    )
-
-
-@njit(cache=True, inline="always")
-def rotate_back(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
-    """``R(q)ᵀ v``: world to body coordinates."""
-    return rotate(w, -x, -y, -z, vx, vy, vz)
-
-
-@njit(cache=True, inline="always")
-def normalized(w, x, y, z):  # pragma: no cover - compiled
-    """``q / |q|``."""
-    inverse = 1.0 / np.sqrt(w * w + x * x + y * y + z * z)
-    return w * inverse, x * inverse, y * inverse, z * inverse
-
-
 def quaternion_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``a ⊗ b`` for ``(..., 4)`` arrays."""
     a, b = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
-    return np.stack(multiply(*np.moveaxis(a, -1, 0), *np.moveaxis(b, -1, 0)), axis=-1)
+    return np.stack(hamilton_product(*np.moveaxis(a, -1, 0), *np.moveaxis(b, -1, 0)), axis=-1)
 
 
 def quaternion_rotate(q: np.ndarray, vectors: np.ndarray) -> np.ndarray:

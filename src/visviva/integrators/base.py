@@ -97,7 +97,7 @@ class Integrator(ABC):
                 "build it with vv.ode.SecondOrderProblem, or pick a method that integrates "
                 "first-order problems (e.g. 'rk4')"
             )
-        if getattr(system, "kinematics", None) is not None and not self.manifold_positions:
+        if system.kinematics is not None and not self.manifold_positions:
             raise ModelError(
                 f"method {self.name!r} cannot step rigid bodies (their orientations do not move "
                 "as q' = v); pick one that does: 'symplectic_euler' (the default), "

@@ -53,7 +53,7 @@ class FastMassSprings(Integrator):
     Args:
         iterations: Local/global iterations per step.
 
-    It steps any system that offers its springs as one network (``system.spring_network()``:
+    It steps any system that offers its springs as one network (``system.spring_network``:
     ``mass`` and ``pinned`` per point, ``first``/``second``/``rest_length``/``stiffness`` per
     spring, ``elastic(t, x)`` and ``held_positions(t, x)``, as a scene of particles does); any
     other system is stepped by
@@ -80,10 +80,9 @@ class FastMassSprings(Integrator):
         return 1.0 / (1.0 - np.asarray(z, dtype=complex))
 
     def step(self, system: System, state: State, dt: float) -> State:
-        springs = getattr(system, "spring_network", None)
-        if springs is None or state.parts[0].ndim != 1:
+        network = system.spring_network
+        if network is None or state.parts[0].ndim != 1:
             return self._fallback.step(system, state, dt)
-        network = springs()
         # The factorizations of the run, per step size (a memo: the same for every call).
         solvers: dict[float, _Global] = system.workspace.get(self, dict)
         solver = solvers.get(dt)

@@ -21,7 +21,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..ode.state import Layout, State
-from ..ode.system import WorkCounters
+from ..ode.system import Structure, WorkCounters
+from ..ode.workspace import Workspace
 
 if TYPE_CHECKING:
     from .base import Integrator
@@ -29,7 +30,7 @@ if TYPE_CHECKING:
 __all__ = ["measured_stability_function"]
 
 
-class _TestEquation:
+class _TestEquation(Structure):
     """``y' = λ y`` for a batch of complex ``λ`` (one per system, ``n = 1``)."""
 
     second_order = False
@@ -38,6 +39,7 @@ class _TestEquation:
     def __init__(self, lam: np.ndarray) -> None:
         self.lam = lam[:, None]
         self.counters = WorkCounters()
+        self.workspace = Workspace()
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         return self.lam * y
@@ -49,7 +51,7 @@ class _TestEquation:
         return self.lam[:, :, None].copy()
 
 
-class _TestOscillator:
+class _TestOscillator(Structure):
     """``q'' = α q + β v`` for a batch of complex ``(α, β)`` (one per system, ``n = 1``)."""
 
     second_order = True
@@ -61,6 +63,7 @@ class _TestOscillator:
         self.alpha = alpha[:, None]
         self.beta = beta[:, None]
         self.counters = WorkCounters()
+        self.workspace = Workspace()
 
     def force(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         return self.alpha * q + self.beta * v

@@ -13,7 +13,7 @@ minimum where ``Φ`` is convex. Newton's method on ``g`` gets what makes optimiz
 
 * **projection**: the Newton matrix ``A = M − h D − h² K`` with each force's stiffness made
   positive semi-definite (a compressed spring's negative stiffness dropped, see
-  :meth:`~visviva.forces.Springs.add_symmetric_jacobian`; Teran et al. 2005) is symmetric
+  :meth:`~visviva.forces.Springs.add_jacobian`; Teran et al. 2005) is symmetric
   positive definite, so every Newton direction ``d = −A⁻¹ g`` goes downhill (``gᵀd < 0``).
   That is the default (``"always"``). The projected matrix may converge only linearly where
   springs are compressed, so ``"adaptive"`` first tries the exact Hessian and falls back to the
@@ -178,7 +178,7 @@ class ProjectedNewton(BlockNewtonSolve, BackwardEuler):
             start = acceleration if acceleration is not None else system.acceleration(t, q, v)
             q_base = q + (h - theta_h) * v
             v_base = v + (h - theta_h) * start
-        constraints = getattr(system, "contact_constraints", None)
+        constraints = system.contact_constraints
         try:
             if constraints is None:
                 v_new, _ = self._minimize(system, t + h, q_base, v_base, guess, theta_h, None)
@@ -220,7 +220,7 @@ class ProjectedNewton(BlockNewtonSolve, BackwardEuler):
         tolerance."""
         mass = np.ones_like(v) if system.mass is None else system.mass.diagonal()
         mass = np.broadcast_to(mass, v.shape)
-        potential = getattr(system, "potential", None)
+        potential = system.potential
         counters = system.counters
         newton = self.tolerance
         iteration, norm = 0, np.inf
@@ -305,7 +305,7 @@ class ProjectedTrapezoidal(ProjectedNewton):
 def _takes(system: System, state: State) -> bool:
     """Whether the minimization road suits the system (see :class:`ProjectedNewton`): a
     scene's, whose Jacobians are 3×3 block-sparse, one at a time, with a diagonal mass."""
-    if not getattr(system, "block_jacobian", False) or state.parts[0].ndim != 1:
+    if not system.block_jacobian or state.parts[0].ndim != 1:
         return False
     mass = system.mass  # type: ignore[union-attr]
     return (mass is None or mass.kind == "diagonal") and system.has_jacobian

@@ -46,13 +46,13 @@ def start_acceleration(system: SecondOrderSystem, state: State):
 
 def _drift(system: SecondOrderSystem, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
     """``q + h v``, or the system's kinematics' drift (rigid bodies' rotations)."""
-    kinematics = getattr(system, "kinematics", None)
+    kinematics = system.kinematics
     return q + h * v if kinematics is None else kinematics.drift(q, v, h)
 
 
 def _derivative(system: SecondOrderSystem, q: np.ndarray, v: np.ndarray, a: np.ndarray):
     """The derivative ``(q', v')`` of a state whose acceleration ``a`` is known."""
-    kinematics = getattr(system, "kinematics", None)
+    kinematics = system.kinematics
     return (v if kinematics is None else kinematics.rate(q, v)), a
 
 

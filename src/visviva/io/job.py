@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 from ..analysis.invariants import energy_drift, max_energy_error
 from ..errors import ModelError
 from .files import check_directory
+from .json_values import plain_json
 from .recording import write_recordings
 
 if TYPE_CHECKING:
@@ -34,7 +35,6 @@ if TYPE_CHECKING:
 __all__ = [
     "JobOutput",
     "JobReport",
-    "plain_json",
     "python_warnings",
     "remove_stale_staging",
     "run_summary",
@@ -233,22 +233,3 @@ def _process_exists(pid: int) -> bool:
     except (PermissionError, OverflowError):
         return True  # another user's process (or a number no process can have: keep it)
     return True
-
-
-def plain_json(value: Any) -> Any:
-    """``value`` as plain JSON: NumPy scalars unwrapped, non-finite floats as strings."""
-    import math
-
-    import numpy as np
-
-    if isinstance(value, Mapping):
-        return {str(k): plain_json(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [plain_json(v) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return str(value)
-    if value is None or isinstance(value, (bool, int, float, str)):
-        return value
-    raise TypeError(f"cannot write {type(value).__name__} to JSON")

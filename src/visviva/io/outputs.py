@@ -10,7 +10,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import NamedTuple
 
-from .._validation import did_you_mean
+from .._registry import did_you_mean
 from ..errors import ModelError
 from ..simulation.recording import Recording
 

@@ -31,7 +31,8 @@ from typing import Any
 import numpy as np
 from numba import njit, prange
 
-from .._validation import describe, did_you_mean, real_number
+from .._registry import did_you_mean
+from .._validation import describe, real_number
 from ..errors import ModelError
 
 __all__ = [

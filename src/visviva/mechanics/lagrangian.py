@@ -25,7 +25,8 @@ import sympy
 from sympy.core.function import AppliedUndef
 
 from .._memo import Memo
-from .._validation import describe, did_you_mean, real_number, state_array
+from .._registry import did_you_mean
+from .._validation import describe, real_number, state_array
 from ..errors import ModelError
 from ..ode.problems import FirstOrderProblem, SecondOrderProblem
 from .codegen import FLAVOURS

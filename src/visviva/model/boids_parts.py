@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .._validation import did_you_mean
+from .._registry import did_you_mean
 from ..errors import ModelError, SceneProblem
 from ..geometry.neighbour_grid import NeighbourGrid
 from ..particles.boids import Boids

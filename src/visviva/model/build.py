@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from .._validation import describe, did_you_mean
+from .._registry import did_you_mean
+from .._validation import describe
 from ..errors import ModelError, SceneError, SceneProblem
 from ..rigid.projection import BodyProjection
 from ..simulation.loop import MAX_STEPS
@@ -117,7 +118,8 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
             stages.append(handles)
         with np.errstate(all="ignore"):  # overflowing values are judged by the start check
             forces = force_objects(scene, groups, arrays["mass"])
-            forces += penalty_forces(scene, groups, arrays, h)
+            penalties = penalty_forces(scene, groups, arrays, h)
+            forces += penalties
             forces += spring_forces(scene, groups, count)
         with np.errstate(over="ignore"):  # a weight beyond the float range diverges, named
             bodies, body_forces = rigid_bodies(scene, names)
@@ -128,7 +130,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         if specs:
             from ..particles.emission import Emission
 
-            stages.append(Emission(specs, count))
+            stages.append(Emission(specs, arrays["alive"], arrays["radius"]))
         if bodies is not None:
             stages.append(BodyProjection(bodies.count))
     except Located as located:
@@ -158,7 +160,8 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         body_forces=tuple(body_forces),
         forces=tuple(forces),
         emitters=tuple(specs),
-        stages=tuple(stages),
+        stages=tuple(sorted(stages, key=lambda stage: stage.phase)),
+        contact_sources=(*([] if collisions is None else [collisions]), *penalties),
         output_formats=tuple(scene.output.formats),
         output_fps=scene.output.fps,
         output_speed=scene.output.speed,

@@ -14,7 +14,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .._validation import describe, did_you_mean
+from .._registry import did_you_mean
+from .._validation import describe
 from ..collision.colliders import MAX_COLLIDERS, ColliderSet
 from ..geometry.neighbour_cells import CELL_MARGIN, MAX_CELLS, MAX_COORDINATE
 from ..particles.crowd import Crowd, CrowdGroup

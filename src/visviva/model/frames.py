@@ -91,7 +91,7 @@ def _bodies(system: SystemInstance) -> bool:
 
 def _kills(model: Model) -> bool:
     """True if a stage may remove particles (a crowd's exits): ``alive`` is then recorded."""
-    return any(getattr(stage, "kills_particles", False) for stage in model.stages)
+    return any(stage.kills_particles for stage in model.stages)
 
 
 def _varying_color(model: Model) -> bool:

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..collision.contacts import DEFAULT_GAP, Contacts
+from ..collision.contacts import DEFAULT_GAP, Contacts, ContactSource
 from ..collision.particle_contacts import PairContacts, ParticleContacts
 from ..errors import ModelError
 from ..ode.problems import Problem
@@ -26,11 +26,11 @@ from .systems import SYSTEMS
 if TYPE_CHECKING:
     from ..forces.base import Force
     from ..forces.body_forces import BodyForce
+    from ..ode.stage import Stage
     from ..ode.state import State
     from ..ode.system import System
     from ..particles.emitters import EmitterSpec
     from ..rigid.bodies import RigidBodies
-    from ..simulation.stepper import Stage
     from .scene import Scene
 
 __all__ = ["Integration", "Model", "ParticleGroup", "SystemInstance"]
@@ -150,7 +150,10 @@ class Model:
         body_forces: The forces on the rigid bodies (world gravity first).
         forces: The forces on particles, world gravity first.
         emitters: The emitters (their slots are among the particles').
-        stages: The post-step stages, in order (handles, collisions, then emission).
+        contact_sources: The colliders whose contacts :meth:`contacts` reports (the collision
+            stage's and the penalty forces').
+        stages: The post-step stages, in the order of their phases
+            (:class:`~visviva.ode.stage.Phase`; of one phase, in the order of the scene).
         output_formats: Extra outputs the scene asks ``visviva run`` for.
         output_fps: Frame rate of videos, viewer and exports [1/s].
         output_speed: Simulated seconds per second of their playback.
@@ -178,6 +181,7 @@ class Model:
     forces: tuple[Force, ...] = field(default=(), repr=False)
     emitters: tuple[EmitterSpec, ...] = field(default=(), repr=False)
     stages: tuple[Stage, ...] = field(default=(), repr=False)
+    contact_sources: tuple[ContactSource, ...] = field(default=(), repr=False)
     output_formats: tuple[str, ...] = ()
     output_fps: float = 30.0
     output_speed: float = 1.0
@@ -205,7 +209,7 @@ class Model:
         """True if the scene's energy is conserved by the exact dynamics (so a change in it
         measures the integrator's error): no dissipative force, no stage that changes the
         state (collisions, births), no damped system."""
-        if any(getattr(s, "changes_energy", True) for s in self.stages):
+        if any(s.changes_energy for s in self.stages):
             return False
         if not all(f.conservative for f in (*self.forces, *self.body_forces)):
             return False
@@ -244,8 +248,7 @@ class Model:
         """The particle–collider contacts of ``state`` (every collider, impulse and penalty:
         where, how deep, and colliding, resting or separating; see
         :mod:`visviva.collision.contacts`)."""
-        sources = [s for s in (*self.stages, *self.forces) if hasattr(s, "contacts")]
-        return Contacts.join([source.contacts(state, gap) for source in sources])
+        return Contacts.join([source.contacts(state, gap) for source in self.contact_sources])
 
     def pair_contacts(self, state: State, gap: float = DEFAULT_GAP) -> PairContacts:
         """The sphere–sphere contacts of ``state`` among the particles of the scene's

@@ -31,7 +31,7 @@ from typing import Annotated, Literal, get_args
 from pydantic import BaseModel, Field, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
-from .._validation import did_you_mean
+from .._registry import did_you_mean
 from .scene_bodies import Cloth, ClothMesh, Hair, Rope, SoftLattice, SoftMesh, SpringGraph
 from .scene_boids import Boids
 from .scene_contacts import ParticleCollisionSettings

@@ -16,7 +16,8 @@ from typing import Any, get_args
 
 from pydantic import BaseModel, ValidationError
 
-from .._validation import describe, did_you_mean
+from .._registry import did_you_mean
+from .._validation import describe
 from ..errors import SceneProblem
 from .scene import ENTITY_TYPES, Integration, Output, Scene, SceneInfo, World
 from .scene_renames import entity_owner, new_name, renamed_message

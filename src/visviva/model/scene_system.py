@@ -33,7 +33,6 @@ integrator's springs pull from the handle's true place at every stage of a step.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 from types import MappingProxyType
@@ -47,7 +46,7 @@ from ..forces.springs import Springs
 from ..ode.mass import Mass
 from ..ode.problems import Problem, SecondOrderProblem
 from ..ode.state import Layout, PartView, State
-from ..ode.system import FirstOrderSystem, SecondOrderSystem
+from ..ode.system import ContactConstraints, FirstOrderSystem, SecondOrderSystem
 from ..ode.workspace import Workspace
 from ..particles.handles import Handles
 
@@ -110,15 +109,8 @@ def initial_state(model: Model) -> State:
     if model.particle_count:
         carried["particle_alive"] = model.particle_alive.copy()
         carried["particle_radius"] = model.particle_radius.copy()
-    if model.emitters:
-        count, emitters = model.particle_count, len(model.emitters)
-        carried["particle_age"] = np.zeros(count)
-        carried["particle_lifetime"] = np.where(model.particle_alive, np.inf, 0.0)
-        carried["particle_size"] = model.particle_radius.copy()
-        carried["emitter_serial"] = np.zeros(emitters, dtype=np.int64)
-        carried["emitter_dropped"] = np.zeros(emitters, dtype=np.int64)
-    for stage in model.stages:  # parts a stage keeps of its own (a crowd's exit times)
-        carried |= getattr(stage, "carried_start", dict)()
+    for stage in model.stages:  # parts a stage keeps (ages, warm starts, exit times)
+        carried |= stage.carried_start()
     return State(0.0, (q, v), layout(model), MappingProxyType(carried))
 
 
@@ -254,7 +246,7 @@ def scene_system(model: Model) -> System:
         network = SpringView(
             model.particle_mass, model.particle_pinned, tuple(springs), handles, work
         )
-        system.spring_network = lambda: network
+        system.spring_network = network
     return system
 
 
@@ -342,17 +334,14 @@ def _damped_handles(model: Model, handles: Handles | None) -> bool:
     )
 
 
-def _contact_constraints(
-    model: Model,
-) -> Callable[[np.ndarray, float], tuple[np.ndarray, ...]] | None:
+def _contact_constraints(model: Model) -> ContactConstraints | None:
     """``(q, reach) ↦ (particles, normals, push, friction)``: the particles inside the impulse
     colliders at positions ``q`` or within ``reach`` [m] of them (one contact per particle, the
-    deepest), their
-    colliders' outward normals, how far [m] each must move along its normal to sit just
-    outside (half the touching gap: the collision stage then finds nothing to undo, and the
-    next step still finds it touching) and the colliders' friction coefficients μ (see
-    :attr:`SceneSystem.contact_constraints`); ``None`` for a scene without impulse colliders or
-    with emitters (whose live particles change between steps)."""
+    deepest), their colliders' outward normals, how far [m] each must move along its normal to
+    sit just outside (half the touching gap: the collision stage then finds nothing to undo,
+    and the next step still finds it touching) and the colliders' friction coefficients μ;
+    ``None`` for a scene without impulse colliders or with emitters (whose live particles
+    change between steps)."""
     from ..collision.contacts import DEFAULT_GAP, Contacts, find_contacts
     from ..collision.response import ParticleCollisions
 
@@ -396,20 +385,8 @@ class SceneSystem(SecondOrderSystem):
     Jacobian (springs without their damper's non-symmetric part, and without a compressed
     spring's negative stiffness) to implicit steps that ask."""
 
-    #: ``U(t, q)`` [J], the potential of a scene whose force is ``−∇U(q) + D(q) v`` with
-    #: ``D = ∂F/∂v`` symmetric (particles whose forces are conservative or linearly damped),
-    #: else ``None``: backward Euler's step is then the minimum of an incremental potential.
-    potential: Callable[[float, np.ndarray], float] | None = None
-    #: Its particles' Jacobians are block-sparse with 3×3 blocks (BSR), on a fixed pattern:
-    #: what solvers for deformables (:mod:`visviva.integrators.projected_newton`) work on.
+    #: Its particles' Jacobians are block-sparse with 3×3 blocks (BSR), on a fixed pattern.
     block_jacobian = True
-    #: ``(q, reach) ↦ (particles, normals, push, friction)`` for the impulse colliders at
-    #: positions ``q`` (see :func:`_contact_constraints`), which implicit steps may hold particles
-    #: against (``None``: no such colliders).
-    contact_constraints: Callable[[np.ndarray, float], tuple[np.ndarray, ...]] | None = None
-    #: The scene's springs as one :class:`SpringView` (``None``: no springs, or generalized
-    #: coordinates beside the particles).
-    spring_network: Callable[[], SpringView] | None = None
 
     def force_jacobian(
         self,

@@ -28,10 +28,88 @@ if TYPE_CHECKING:
     from .mass import Mass
     from .problems import FirstOrderProblem, SecondOrderProblem
 
-__all__ = ["FirstOrderSystem", "Kinematics", "SecondOrderSystem", "System", "WorkCounters"]
+__all__ = [
+    "ContactConstraints",
+    "FirstOrderSystem",
+    "Kinematics",
+    "SecondOrderSystem",
+    "SpringNetwork",
+    "Structure",
+    "System",
+    "WorkCounters",
+]
 
 #: Relative perturbation of forward finite differences: √ε balances truncation and round-off.
 FINITE_DIFFERENCE_STEP = float(np.sqrt(np.finfo(np.float64).eps))
+
+
+class Kinematics(Protocol):
+    """How a second-order system's positions move where ``q' = v`` does not hold.
+
+    A rigid body's configuration is a position and an orientation (a unit quaternion, 4
+    numbers) and its "velocities" are its momenta ``P`` and ``L`` (3 + 3): ``q`` and ``v`` then
+    differ in length (MuJoCo's ``nq`` and ``nv``), ``q' = K(q) v`` is a function of both, and
+    an orientation must not be moved by "vector plus vector". Integrators that support such
+    systems (``Integrator.manifold_positions``) go through these two methods, never ``q + h v``.
+    """
+
+    def rate(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``q'`` at ``(q, v)``, shape of ``q``."""
+        ...
+
+    def drift(self, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
+        """The positions after ``h`` [s] of motion at the velocities (momenta) ``v`` held, as
+        a new array: on the configuration manifold (unit quaternions stay unit)."""
+        ...
+
+
+class SpringNetwork(Protocol):
+    """A system's springs as one network, for solvers made for springs
+    (:mod:`visviva.integrators.fast_springs`): ``N`` points, ``S`` springs."""
+
+    #: ``(N,)`` point masses [kg].
+    mass: np.ndarray
+    #: ``(N,)`` which points are held (in place, or on a handle's path).
+    pinned: np.ndarray
+    #: ``(S, 2)``, ``(S,)``, ``(S,)`` each spring's points (both ends, the first, the second).
+    pairs: np.ndarray
+    first: np.ndarray
+    second: np.ndarray
+    #: ``(S,)`` rest lengths [m] and stiffnesses [N/m].
+    rest_length: np.ndarray
+    stiffness: np.ndarray
+
+    def elastic(self, t: float, x: np.ndarray) -> np.ndarray:
+        """``(N, 3)`` the springs' elastic forces [N] at positions ``x`` (no dampers)."""
+        ...
+
+    def held_positions(self, t: float, x: np.ndarray) -> np.ndarray:
+        """The positions ``x`` ``(N, 3)`` with the held points where they are held at ``t``."""
+        ...
+
+
+#: ``(q, reach) ↦ (particles, normals, push, friction)``: the particles against colliders at
+#: positions ``q`` or within ``reach`` [m] of them, the colliders' outward normals, how far [m]
+#: each must move along its normal to sit outside, and the friction coefficients.
+ContactConstraints = Callable[[np.ndarray, float], tuple[np.ndarray, ...]]
+
+
+class Structure:
+    """What a system offers integrators beyond its equations. Each is ``None`` (or False)
+    unless the system has it; an integrator that can use one reads it here, never probes."""
+
+    #: How positions move where ``q' = v`` does not hold (rigid bodies' orientations).
+    kinematics: Kinematics | None = None
+    #: ``U(t, q)`` [J] if the force is ``−∇U(q) + D(q) v`` with ``D = ∂F/∂v`` symmetric:
+    #: backward Euler's step is then the minimum of an incremental potential.
+    potential: Callable[[float, np.ndarray], float] | None = None
+    #: True if the Jacobians are block-sparse with 3×3 blocks (BSR) on a fixed pattern: what
+    #: solvers for deformables (:mod:`visviva.integrators.projected_newton`) work on.
+    block_jacobian: bool = False
+    #: The colliders implicit steps may hold particles against.
+    contact_constraints: ContactConstraints | None = None
+    #: The springs as one network (a system of particles and springs only).
+    spring_network: SpringNetwork | None = None
 
 
 @dataclass
@@ -86,7 +164,7 @@ def evaluator(function: UserFunction, batch: bool, result: str = "array") -> Cal
     return func
 
 
-class FirstOrderSystem:
+class FirstOrderSystem(Structure):
     """Evaluates ``y' = f(t, y)`` for integrators.
 
     Args:
@@ -184,7 +262,7 @@ class FirstOrderSystem:
         return np.asarray(self._energy(state.t, state.parts[0]), dtype=np.float64)
 
 
-class SecondOrderSystem:
+class SecondOrderSystem(Structure):
     """Evaluates ``M q'' = F(t, q, v)`` for integrators.
 
     For a problem given by its acceleration, ``mass`` is ``None`` and ``force`` *is* the
@@ -369,26 +447,6 @@ class SecondOrderSystem:
 
 
 System = FirstOrderSystem | SecondOrderSystem
-
-
-class Kinematics(Protocol):
-    """How a second-order system's positions move where ``q' = v`` does not hold.
-
-    A rigid body's configuration is a position and an orientation (a unit quaternion, 4
-    numbers) and its "velocities" are its momenta ``P`` and ``L`` (3 + 3): ``q`` and ``v`` then
-    differ in length (MuJoCo's ``nq`` and ``nv``), ``q' = K(q) v`` is a function of both, and
-    an orientation must not be moved by "vector plus vector". Integrators that support such
-    systems (``Integrator.manifold_positions``) go through these two methods, never ``q + h v``.
-    """
-
-    def rate(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """``q'`` at ``(q, v)``, shape of ``q``."""
-        ...
-
-    def drift(self, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
-        """The positions after ``h`` [s] of motion at the velocities (momenta) ``v`` held, as
-        a new array: on the configuration manifold (unit quaternions stay unit)."""
-        ...
 
 
 def _optional_evaluator(

@@ -83,6 +83,7 @@ from ..collision.colliders import ColliderSet, collider_distance
 from ..errors import ModelError, SimulationError
 from ..geometry.neighbour_cells import MAX_COORDINATE, cell_of, neighbour_runs
 from ..geometry.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid
+from ..ode.stage import Phase
 
 if TYPE_CHECKING:
     from ..ode.state import State
@@ -164,8 +165,11 @@ class Boids:
         ModelError: A value out of its range, naming the argument (backquoted) and the fix.
     """
 
+    phase: ClassVar[Phase] = Phase.BEHAVIOURS
     #: Not a part of the fused particle step (which knows only its own stages).
     compiled: ClassVar[bool] = False
+    changes_energy: ClassVar[bool] = True
+    kills_particles: ClassVar[bool] = False
 
     def __init__(
         self,
@@ -277,6 +281,10 @@ class Boids:
         p[_WLEAD] = self.weights["leader_weight"]
         p[_LOOK], p[_H], p[_PLANAR] = self.look_ahead, h, self.plane == "xz"
         return p
+
+    def carried_start(self) -> dict[str, np.ndarray]:
+        """None: it carries nothing in the state."""
+        return {}
 
     def _scratch(self) -> _Scratch:
         spacing = None if self.min_distance is None else SPACING_REACH * self.min_distance

@@ -81,6 +81,7 @@ import numpy as np
 
 from ..collision.colliders import ColliderSet
 from ..geometry.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid
+from ..ode.stage import Phase
 from .crowd_kernels import exit_agents, social_forces, walk
 
 if TYPE_CHECKING:
@@ -139,7 +140,9 @@ class Crowd:
         walls: The colliders the crowds' ``walls`` index (``None``: none).
     """
 
+    phase: ClassVar[Phase] = Phase.BEHAVIOURS
     compiled: ClassVar[bool] = False
+    changes_energy: ClassVar[bool] = True
     #: Agents leave through exits: recordings keep ``alive`` per frame.
     kills_particles: ClassVar[bool] = True
 

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 from numba import njit, prange
 
+from ..ode.stage import Phase
 from .emitters import EmitterSpec, ramp_values
 from .random import uniform
 
@@ -44,13 +45,23 @@ class Emission:
 
     Args:
         emitters: The emitters, in scene order (their slot ranges do not overlap).
-        count: Number of particle slots of the scene.
+        alive: ``(N,)`` which of the scene's particle slots hold a particle at the start.
+        radius: ``(N,)`` the slots' radii at the start [m].
     """
 
+    phase: ClassVar[Phase] = Phase.EMISSION
     compiled: ClassVar[bool] = True
+    changes_energy: ClassVar[bool] = True
+    #: Particles die at the end of their lifetimes.
+    kills_particles: ClassVar[bool] = True
 
-    def __init__(self, emitters: Sequence[EmitterSpec], count: int) -> None:
+    def __init__(
+        self, emitters: Sequence[EmitterSpec], alive: np.ndarray, radius: np.ndarray
+    ) -> None:
+        count = alive.shape[0]
         self.emitters = tuple(emitters)
+        self._alive = np.array(alive, dtype=np.bool_)
+        self._radius = np.array(radius, dtype=np.float64)
         #: The emitter owning each slot (−1: a particle that lives for the whole run).
         self.slot_emitter = np.full(count, -1, dtype=np.int64)
         longest = max(e.size_ramp.shape[0] for e in self.emitters)
@@ -69,6 +80,21 @@ class Emission:
         for spec in self.emitters:
             ramped = bool((spec.size_ramp[:, 1] != 1.0).any())
             self.slot_ramped[spec.first_slot : spec.first_slot + spec.capacity] = ramped
+
+    def carried_start(self) -> dict[str, np.ndarray]:
+        """Per slot ``particle_age`` [s] (0), ``particle_lifetime`` [s] (∞ for the particles
+        alive at the start, which live for the whole run; 0 for the empty slots) and
+        ``particle_size`` [m], the radius before its ramp; per emitter ``emitter_serial`` (the
+        births so far, which number the random draws) and ``emitter_dropped`` (births that
+        found no free slot)."""
+        count, emitters = self._alive.shape[0], len(self.emitters)
+        return {
+            "particle_age": np.zeros(count),
+            "particle_lifetime": np.where(self._alive, np.inf, 0.0),
+            "particle_size": self._radius.copy(),
+            "emitter_serial": np.zeros(emitters, dtype=np.int64),
+            "emitter_dropped": np.zeros(emitters, dtype=np.int64),
+        }
 
     def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
         """Age, kill, give birth and ramp sizes (see the module docstring)."""

@@ -200,11 +200,10 @@ class FusedParticles:
         alive, radius = carried["particle_alive"], carried["particle_radius"]
         ageing: tuple[np.ndarray | None, ...]
         if emission is None:
-            age, ageing, ages = _NO_AGES[0], (None, None), _NO_AGES[1:]
+            age, ageing = _NO_AGES[0], (None, None)
         else:
             age, lifetime = carried["particle_age"], carried["particle_lifetime"]
             ageing = (lifetime, emission.slot_ramped)
-            ages = (lifetime, carried["particle_size"], emission.slot_emitter, emission.size_ramps)
         has_laws = self.kinds.shape[0] > 0
         suspects = _fused(
             *self._x,
@@ -228,16 +227,7 @@ class FusedParticles:
             self._lists if self._springs is not None else None,
             self._point_force if self._stencils else None,
             self.pinned,
-            (
-                self.kinds,
-                self.parameters,
-                self.law_masks,
-                *ages,
-                *self._colliders,
-                self._spring_force,
-                self._lists,
-                self._point_force,
-            ),
+            self.general_arguments(carried),
         )
         if emission is not None:
             born = emission.give_birth(state.t, t_after, self._x.T, self._v.T, carried)
@@ -249,6 +239,30 @@ class FusedParticles:
         self._current = state.from_parts(t_after, state.parts)
         self._settled = False
         return self._current, suspects != 0
+
+    def general_arguments(self, carried: dict[str, np.ndarray]) -> tuple[Any, ...]:
+        """What only pass 2 (:func:`_general_pass`) takes, from the state's ``carried`` parts:
+        arrays of one type in every scene, so that it is compiled once."""
+        if self.emission is None:
+            ages = _NO_AGES[1:]
+        else:
+            emission = self.emission
+            ages = (
+                carried["particle_lifetime"],
+                carried["particle_size"],
+                emission.slot_emitter,
+                emission.size_ramps,
+            )
+        return (
+            self.kinds,
+            self.parameters,
+            self.law_masks,
+            *ages,
+            *self._colliders,
+            self._spring_force,
+            self._lists,
+            self._point_force,
+        )
 
     def settled(self, state: State) -> State:
         """``state`` with its particle positions and velocities up to date (it is, unless it

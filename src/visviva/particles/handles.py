@@ -40,6 +40,8 @@ from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from ..ode.stage import Phase
+
 if TYPE_CHECKING:
     from ..ode.state import State
     from ..ode.workspace import Workspace
@@ -122,8 +124,12 @@ class Handles:
         positions: Each handle's particles' positions at t = 0 [m], ``(k, 3)``.
     """
 
+    phase: ClassVar[Phase] = Phase.CONSTRAINTS
     #: The fused particle step applies it (:mod:`visviva.particles.fused`).
     compiled: ClassVar[bool] = True
+    #: A moving handle does work on what it holds.
+    changes_energy: ClassVar[bool] = True
+    kills_particles: ClassVar[bool] = False
 
     def __init__(
         self,
@@ -143,6 +149,10 @@ class Handles:
         self._across = np.concatenate(across)
         self._inward = np.concatenate(inward)
         self._slices = np.cumsum([0, *(len(p) for p in particles)])
+
+    def carried_start(self) -> dict[str, np.ndarray]:
+        """None: it carries nothing in the state."""
+        return {}
 
     def place(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """Where the handles hold their particles at time ``t`` [s]: positions [m] and

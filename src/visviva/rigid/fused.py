@@ -36,7 +36,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..forces.body_forces import BodyDamping, BodyGravity
-from ..geometry.quaternions import multiply, normalized, rotate_back
+from ..geometry.quaternion_kernels import multiply, normalized, rotate_back
 from .motion import SMALL_LIMIT, _free_turns, _small_half_angle, drift_body
 from .projection import BodyProjection
 

@@ -43,7 +43,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..geometry.quaternions import multiply, normalized, rotate, rotate_back
+from ..geometry.quaternion_kernels import multiply, normalized, rotate, rotate_back
 
 __all__ = ["BodyMotion"]
 

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
+from ..ode.stage import Phase
 from ..ode.state import State
 
 if TYPE_CHECKING:
@@ -32,12 +33,18 @@ class BodyProjection:
         count: Number of bodies.
     """
 
+    phase: ClassVar[Phase] = Phase.CONSTRAINTS
     compiled: ClassVar[bool] = False
     #: Renormalizing keeps the rotation a quaternion stands for: it does not change the energy.
     changes_energy: ClassVar[bool] = False
+    kills_particles: ClassVar[bool] = False
 
     def __init__(self, count: int) -> None:
         self.count = count
+
+    def carried_start(self) -> dict[str, np.ndarray]:
+        """None: it carries nothing in the state."""
+        return {}
 
     def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
         """``after`` with each orientation divided by its length (``after`` itself if they are

@@ -12,7 +12,8 @@ import os
 from dataclasses import dataclass
 from typing import Any
 
-from .._validation import describe, did_you_mean, with_article
+from .._registry import did_you_mean
+from .._validation import describe, with_article
 from ..errors import ModelError
 from .mass_properties import MassProperties
 from .mesh_integrals import mesh_file_mass_properties, mesh_mass_properties

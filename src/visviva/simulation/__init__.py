@@ -1,11 +1,18 @@
 """The simulation loop, the adaptive driver and ``solve``."""
 
-from .adaptive import DenseOutput
-from .loop import Schedule, simulate
-from .recording import Geometry, Recording
-from .simulation import Simulation, SimulationState
-from .solve import Solution, solve
-from .watch import DEFAULT_DIVERGENCE_LIMIT, DivergenceWatch
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_names
+
+if TYPE_CHECKING:
+    from .adaptive import DenseOutput
+    from .loop import Schedule, simulate
+    from .recording import Geometry, Recording
+    from .simulation import Simulation, SimulationState
+    from .solution import Solution, solve
+    from .watch import DEFAULT_DIVERGENCE_LIMIT, DivergenceWatch
 
 __all__ = [
     "DEFAULT_DIVERGENCE_LIMIT",
@@ -20,3 +27,23 @@ __all__ = [
     "simulate",
     "solve",
 ]
+
+# Names load on first use (visviva._lazy): the CLI and io need `interrupt` and `recording`
+# without the loop's integrators and their Numba kernels.
+__getattr__, __dir__ = lazy_names(
+    __name__,
+    __all__,
+    {
+        "DenseOutput": "adaptive",
+        "Schedule": "loop",
+        "simulate": "loop",
+        "Geometry": "recording",
+        "Recording": "recording",
+        "Simulation": "simulation",
+        "SimulationState": "simulation",
+        "Solution": "solution",
+        "solve": "solution",
+        "DEFAULT_DIVERGENCE_LIMIT": "watch",
+        "DivergenceWatch": "watch",
+    },
+)

@@ -48,8 +48,9 @@ from .watch import DivergenceWatch
 
 if TYPE_CHECKING:
     from ..model import Model
+    from ..ode.stage import Stage
     from ..ode.system import System
-    from .stepper import FusedStep, Stage
+    from .stepper import FusedStep
 
 __all__ = [
     "MAX_MEMBER_PARTICLES",

@@ -5,8 +5,8 @@ Every run — ``vv.solve`` on a problem, ``visviva run`` on a scene, a user's
 :meth:`Stepper.step`:
 
 1. the integrator advances the integrated parts by ``h`` (:meth:`Integrator.step`);
-2. the post-step stages, in order, may change the state discontinuously (collisions with
-   colliders, births and deaths of particles; later constraint projection and pins);
+2. the post-step stages (:class:`~visviva.ode.stage.Stage`), in the order of their phases, may
+   change the state discontinuously (behaviours, constraints, contacts, births and deaths);
 3. the divergence watch checks the result and stops a blown-up run with an explanation.
 
 A :class:`FusedStep` may take the place of 1 and 2 (the particle scenes' one-pass step). It
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, ClassVar, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -29,35 +29,15 @@ from ..ode.state import State
 
 if TYPE_CHECKING:
     from ..integrators import Integrator
+    from ..ode.stage import Stage
     from ..ode.system import System
-    from ..ode.workspace import Workspace
     from .watch import DivergenceWatch
 
-__all__ = ["JOURNAL_STEPS", "FusedStep", "Stage", "Stepper"]
+__all__ = ["JOURNAL_STEPS", "FusedStep", "Stepper"]
 
 #: Steps between the copies of the state a fused step's journal keeps (copying costs about a
 #: step; a failure replays at most this many steps).
 JOURNAL_STEPS = 256
-
-
-class Stage(Protocol):
-    """What the loop needs from a post-step stage.
-
-    A stage receives the state before and after the integrator's step (the one before lets
-    it find when, within the step, something happened: a time of impact, a birth) and returns
-    the state to keep. It must not modify either state's arrays in place, nor itself: a stage
-    is part of a shared model, and keeps what it needs between calls (neighbour grids,
-    scratch arrays) in the run's :class:`~visviva.ode.workspace.Workspace`.
-    """
-
-    #: True if the stage has a compiled form, so that a run made only of compiled pieces may
-    #: still take its whole-run compiled path.
-    compiled: ClassVar[bool]
-
-    def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
-        """The state to keep after a step of ``h`` [s] from ``before`` to ``after``; ``work``
-        is the run's storage."""
-        ...
 
 
 class FusedStep(Protocol):

@@ -15,7 +15,8 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from .._validation import describe, did_you_mean
+from .._registry import did_you_mean
+from .._validation import describe
 from ..model.scene_renames import entity_owner, new_name, renamed_message
 
 __all__ = ["display", "replaced", "resolve"]

@@ -24,7 +24,7 @@ from typing import Any
 from pydantic import BaseModel
 
 from ..io.files import atomic_path
-from ..io.job import plain_json
+from ..io.json_values import plain_json
 from ..model.scene import Scene, System
 from ..model.systems import SYSTEMS
 from .description import Sweep

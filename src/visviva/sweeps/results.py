@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from ..io.files import atomic_path
-from ..io.job import plain_json
+from ..io.json_values import plain_json
 
 __all__ = ["flatten_summary", "results_columns", "write_results"]
 

@@ -29,7 +29,7 @@ import h5py
 import numpy as np
 
 from ..io.files import atomic_path
-from ..io.job import plain_json
+from ..io.json_values import plain_json
 from .reductions import numeric
 
 __all__ = ["read_results_h5", "write_results_h5"]

@@ -28,7 +28,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..._validation import describe, did_you_mean
+from ..._registry import did_you_mean
+from ..._validation import describe
 from ...errors import ModelError
 from ...simulation.recording import Recording
 from ._frames import FALLBACK_FPS, MAX_OUTPUT_FRAMES, default_fps, prepare
