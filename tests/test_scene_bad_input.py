@@ -13,11 +13,11 @@ from hypothesis import strategies as st
 
 import visviva as vv
 from visviva.cli.main import main
+from visviva.entities import ENTITY_KINDS
+from visviva.entities.system.schema import RENAMED_PARAMETERS
+from visviva.entities.system.systems import SYSTEMS
 from visviva.io.scene_files import MAX_SCENE_BYTES, dump_scene, parse_scene
 from visviva.model import build_model
-from visviva.model.scene import ENTITY_TYPES
-from visviva.model.scene_renames import RENAMED_FIELDS, RENAMED_PARAMETERS
-from visviva.model.systems import SYSTEMS
 
 VALID = """\
 [scene]
@@ -456,6 +456,7 @@ RENAMED_ENTITIES: dict[str, dict[str, object]] = {
         "fov_deg": 270.0,
     },
 }
+RENAMED_FIELDS = {kind.name: kind.renamed for kind in ENTITY_KINDS.values() if kind.renamed}
 RENAMES = [(kind, old, new) for kind, table in RENAMED_FIELDS.items() for old, new in table.items()]
 
 
@@ -463,7 +464,7 @@ def test_the_rename_table_names_fields_of_the_schemas():
     """Every new name is a field of its kind, no old name is, and every kind is tested."""
     assert set(RENAMED_ENTITIES) == set(RENAMED_FIELDS)
     for kind, old, new in RENAMES:
-        fields = ENTITY_TYPES[kind].model_fields
+        fields = ENTITY_KINDS.get(kind).schema.model_fields
         assert new in fields and old not in fields, (kind, old, new)
         assert new in RENAMED_ENTITIES[kind], (kind, new)
     build_model(parse_scene(VALID + "".join(_entity_toml(k, {}, k) for k in RENAMED_ENTITIES)))

@@ -91,6 +91,10 @@ class Registry(Generic[T]):
         """The registered names, in registration order."""
         return list(self._items)
 
+    def values(self) -> list[T]:
+        """The registered items, in registration order."""
+        return list(self._items.values())
+
     def __getitem__(self, name: str) -> T:
         return self.get(name)
 

@@ -256,10 +256,10 @@ def compare_command(
     from .._registry import did_you_mean
     from .._validation import real_number
     from ..analysis.compare import compare_methods
+    from ..entities.system.systems import SYSTEMS
     from ..errors import ModelError
     from ..io.job import JobOutput
     from ..model.builder import SceneBuilder
-    from ..model.systems import SYSTEMS
     from ..scenes import load_model
     from ..viz.plots import comparison_figures
 
@@ -309,7 +309,7 @@ def compare_command(
 def _check_steps(span: float, step: float) -> None:
     """Refuse a comparison whose runs would take more steps than any run may."""
     from ..errors import ModelError
-    from ..simulation.loop import MAX_STEPS
+    from ..model.model import MAX_STEPS
 
     if span / step > MAX_STEPS:
         raise ModelError(

@@ -162,6 +162,9 @@ class ParticleContacts:
     """
 
     phase: ClassVar[Phase] = Phase.CONTACTS
+    #: Before the collision stage: the sphere–sphere solve holds the impulse colliders too,
+    #: and their own stage then finds the times of impact of what is left.
+    order: ClassVar[int] = 0
     compiled: ClassVar[bool] = False
     changes_energy: ClassVar[bool] = True
     kills_particles: ClassVar[bool] = False

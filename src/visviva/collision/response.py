@@ -95,6 +95,7 @@ class ParticleCollisions:
     """
 
     phase: ClassVar[Phase] = Phase.CONTACTS
+    order: ClassVar[int] = 1
     compiled: ClassVar[bool] = True
     changes_energy: ClassVar[bool] = True
     kills_particles: ClassVar[bool] = False

@@ -1,4 +1,5 @@
-"""Scenes as data: the scene description, the builder, the frozen Model and the named systems."""
+"""Scenes as data: the scene description, the builder, the frozen Model and its build, generic
+over the entity kinds (:mod:`visviva.entities`)."""
 
 from __future__ import annotations
 
@@ -9,22 +10,10 @@ from .._lazy import lazy_names
 if TYPE_CHECKING:
     from .build import build_model
     from .builder import SceneBuilder
-    from .model import Integration, Model, ParticleGroup, SystemInstance
+    from .model import Integration, Model
     from .scene import Scene
-    from .scene_handles import Handle
-    from .systems import SYSTEMS
 
-__all__ = [
-    "SYSTEMS",
-    "Handle",
-    "Integration",
-    "Model",
-    "ParticleGroup",
-    "Scene",
-    "SceneBuilder",
-    "SystemInstance",
-    "build_model",
-]
+__all__ = ["Integration", "Model", "Scene", "SceneBuilder", "build_model"]
 
 # Names load on first use (visviva._lazy): the scene description (`scene`) is plain data, and
 # `visviva schema` reads it without the builder and the physics packages it assembles.
@@ -36,10 +25,6 @@ __getattr__, __dir__ = lazy_names(
         "SceneBuilder": "builder",
         "Integration": "model",
         "Model": "model",
-        "ParticleGroup": "model",
-        "SystemInstance": "model",
         "Scene": "scene",
-        "Handle": "scene_handles",
-        "SYSTEMS": "systems",
     },
 )

@@ -25,7 +25,8 @@ what to draw between points (point indices, the systems' shifted past the partic
     edges   (E, 2) int64  the stretch springs of the bodies without a surface (ropes, hair,
                           spring graphs), then the systems' links
 
-the static colliders' surfaces (``scenery_*``, :mod:`visviva.model.scenery`), and the rigid
+the static colliders' surfaces (``scenery_*``, :mod:`visviva.entities.collider.outputs`: what
+the kinds record of their own, :attr:`Model.recorded_once`), and the rigid
 bodies' surfaces in their own axes (:func:`visviva.rigid.surfaces.body_surface`),
 body after body, with their colours and centres of mass (see
 :mod:`visviva.simulation.body_geometry`; their names go in the attributes,
@@ -51,18 +52,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..deformables.topology import STRETCH
 from ..geometry.quaternions import quaternion_rotate
 from ..particles.emitters import ramp_values
 from ..rigid.surfaces import body_surface
-from .parts import body_networks
-from .scenery import scenery_attrs, scenery_fields
-from .systems import SYSTEMS
 
 if TYPE_CHECKING:
     from ..ode.state import State
     from ..rigid.bodies import RigidBodies
-    from .model import Model, SystemInstance
+    from .model import Model
 
 __all__ = ["frame_fields", "recording_attrs", "static_fields"]
 
@@ -82,11 +79,6 @@ def _system_points(model: Model, state: State) -> list[np.ndarray]:
         if points is not None:
             pictures.append(points[0])
     return pictures
-
-
-def _bodies(system: SystemInstance) -> bool:
-    """True for a system of gravitating bodies: its coordinates are its picture."""
-    return SYSTEMS[system.system].bodies
 
 
 def _kills(model: Model) -> bool:
@@ -110,9 +102,9 @@ def frame_fields(model: Model, state: State) -> dict[str, np.ndarray]:
     if model.systems and "y" not in state.names():
         v = state["generalized_velocity"]
         velocities += [
-            v[s.offset : s.offset + s.size].reshape(-1, 3) for s in model.systems if _bodies(s)
+            v[s.offset : s.offset + s.size].reshape(-1, 3) for s in model.systems if s.gravitating
         ]
-        if not all(_bodies(s) for s in model.systems):
+        if not all(s.gravitating for s in model.systems):
             fields["generalized_position"] = state["generalized_position"]
             fields["generalized_velocity"] = v
     if velocities:
@@ -171,14 +163,14 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
             )
         if not _varying_color(model) and (model.emitters or np.any(model.particle_color != 1.0)):
             static["color"] = np.concatenate([_colors(model, start), np.ones((extra, 3))])
-    edges, faces = _body_topology(model)
+    edges, faces = list(model.edges), list(model.faces)
     first = count
     for system, points in zip(
-        [s for s in model.systems if SYSTEMS[s.system].draw is not None],
+        [s for s in model.systems if s.drawn],
         _system_points(model, start),
         strict=True,
     ):
-        own = SYSTEMS[system.system].edges
+        own = system.edges
         if own is not None:
             edges.append(np.array(own, dtype=np.int64) + first)
         first += points.shape[0]
@@ -188,7 +180,7 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
         static["faces"] = np.concatenate(faces)
     if model.bodies is not None:
         static |= _body_surfaces(model.bodies)
-    return static | scenery_fields(model.scene)
+    return static | dict(model.recorded_once)
 
 
 def _body_surfaces(bodies: RigidBodies) -> dict[str, np.ndarray]:
@@ -212,22 +204,4 @@ def recording_attrs(model: Model) -> dict[str, list[str]]:
     """Attributes a recording keeps of the scene besides its arrays: the bodies' names, the
     drawn colliders' names."""
     bodies = {} if model.bodies is None else {"body_names": list(model.bodies.names)}
-    return bodies | scenery_attrs(model.scene)
-
-
-def _body_topology(model: Model) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Each deformable body's drawing, in the scene's point indices: its surface triangles
-    (:attr:`~visviva.deformables.SpringNetwork.faces`) if it has a surface (cloth, soft
-    bodies), else its stretch springs as edges (a rope's or hair's segments, every spring of a
-    ``springs`` entity; bend and torsion springs are not drawn: they skip points).
-
-    Returns:
-        The edge arrays ``(E_b, 2)`` and the triangle arrays ``(F_b, 3)`` of the bodies.
-    """
-    edges, faces = [], []
-    for network, first in body_networks(model.scene, model.particle_groups):
-        if network.faces.shape[0]:
-            faces.append(network.faces + first)
-        else:
-            edges.append(network.pairs[network.family == STRETCH] + first)
-    return edges, faces
+    return bodies | dict(model.recorded_attrs)

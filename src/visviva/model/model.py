@@ -19,9 +19,10 @@ import numpy as np
 
 from ..collision.contacts import DEFAULT_GAP, Contacts, ContactSource
 from ..collision.particle_contacts import PairContacts, ParticleContacts
+from ..entities.context import ParticleGroup
+from ..entities.system.block import SystemInstance
 from ..errors import ModelError
 from ..ode.problems import Problem
-from .systems import SYSTEMS
 
 if TYPE_CHECKING:
     from ..forces.base import Force
@@ -33,12 +34,16 @@ if TYPE_CHECKING:
     from ..rigid.bodies import RigidBodies
     from .scene import Scene
 
-__all__ = ["Integration", "Model", "ParticleGroup", "SystemInstance"]
+__all__ = ["MAX_STEPS", "Integration", "Model"]
 
 #: Default recording rate when a scene does not set ``record_every`` [frames/s].
 DEFAULT_FRAME_RATE = 60.0
-#: Largest default ``record_every``: the most steps a run may take (simulation.loop.MAX_STEPS).
-MAX_DEFAULT_RECORD_EVERY = 10**9
+#: A fixed-step run may take at most this many integrator steps (substeps included): a billion
+#: steps is minutes compiled and hours in NumPy; more is a mistake in dt, not a plan. A scene
+#: asking for more is refused when built, a run when it starts.
+MAX_STEPS = 10**9
+#: Largest default ``record_every``: the most steps a run may take.
+MAX_DEFAULT_RECORD_EVERY = MAX_STEPS
 
 
 def frozen_array(values: Any, dtype: Any = np.float64) -> np.ndarray:
@@ -77,56 +82,6 @@ class Integration:
         return max(1, min(MAX_DEFAULT_RECORD_EVERY, round(1.0 / (DEFAULT_FRAME_RATE * dt))))
 
 
-@dataclass(frozen=True)
-class ParticleGroup:
-    """A named range of particle slots that came from one scene entity.
-
-    Attributes:
-        name: Entity name.
-        entity: The entity's index in the scene.
-        start: First particle index.
-        count: Number of particles (an emitter's capacity).
-        emitted: True for an emitter's slots, whose particles are born and die.
-    """
-
-    name: str
-    entity: int
-    start: int
-    count: int
-    emitted: bool = False
-
-
-@dataclass(frozen=True, eq=False)
-class SystemInstance:
-    """A named system of the scene with its parameter values (defaults filled in).
-
-    Attributes:
-        name: Entity name.
-        system: The system's type name (``"pendulum"``, ...).
-        parameters: Parameter values.
-        entity: The entity's index in the scene.
-        offset: Index of its first coordinate among the scene's generalized coordinates.
-        problem: Its problem (initial state, equations of motion).
-    """
-
-    name: str
-    system: str
-    parameters: Mapping[str, float]
-    entity: int
-    offset: int
-    problem: Problem = field(repr=False)
-
-    @property
-    def size(self) -> int:
-        """Number of its coordinates."""
-        return self.problem.size
-
-    def points(self, gravity: np.ndarray, parts: tuple[np.ndarray, ...]) -> np.ndarray | None:
-        """Its picture for frames of its parts (``(frames, n)`` each): ``(frames, P, 3)`` [m]."""
-        draw = SYSTEMS[self.system].draw
-        return None if draw is None else draw(self.parameters, gravity, parts)
-
-
 @dataclass(frozen=True, eq=False)
 class Model:
     """A built scene.
@@ -152,8 +107,15 @@ class Model:
         emitters: The emitters (their slots are among the particles').
         contact_sources: The colliders whose contacts :meth:`contacts` reports (the collision
             stage's and the penalty forces').
-        stages: The post-step stages, in the order of their phases
-            (:class:`~visviva.ode.stage.Phase`; of one phase, in the order of the scene).
+        stages: The post-step stages, in the order of their phases and orders
+            (:class:`~visviva.ode.stage.Phase`; then in the order they were built).
+        edges: Lines drawn between particles, ``(E, 2)`` particle indices each (a rope's
+            segments).
+        faces: Triangles drawn between particles, ``(F, 3)`` particle indices each (a cloth's
+            surface).
+        recorded_once: Arrays the recordings keep once, by name, from the kinds that draw
+            something of their own (the colliders' ``scenery_*``).
+        recorded_attrs: Attributes the recordings keep, by name (``scenery_names``).
         output_formats: Extra outputs the scene asks ``visviva run`` for.
         output_fps: Frame rate of videos, viewer and exports [1/s].
         output_speed: Simulated seconds per second of their playback.
@@ -182,6 +144,10 @@ class Model:
     emitters: tuple[EmitterSpec, ...] = field(default=(), repr=False)
     stages: tuple[Stage, ...] = field(default=(), repr=False)
     contact_sources: tuple[ContactSource, ...] = field(default=(), repr=False)
+    edges: tuple[np.ndarray, ...] = field(default=(), repr=False)
+    faces: tuple[np.ndarray, ...] = field(default=(), repr=False)
+    recorded_once: Mapping[str, np.ndarray] = field(default_factory=dict, repr=False)
+    recorded_attrs: Mapping[str, Any] = field(default_factory=dict, repr=False)
     output_formats: tuple[str, ...] = ()
     output_fps: float = 30.0
     output_speed: float = 1.0
@@ -213,16 +179,12 @@ class Model:
             return False
         if not all(f.conservative for f in (*self.forces, *self.body_forces)):
             return False
-        return all(SYSTEMS[s.system].conservative(s.parameters) for s in self.systems)
+        return all(s.conservative for s in self.systems)
 
     @property
     def has_geometry(self) -> bool:
         """True if runs of this model record something to draw: ``points`` or rigid bodies."""
-        return (
-            self.particle_count > 0
-            or self.body_count > 0
-            or any(SYSTEMS[s.system].draw is not None for s in self.systems)
-        )
+        return self.particle_count > 0 or self.body_count > 0 or any(s.drawn for s in self.systems)
 
     def system(self) -> System:
         """A fresh run-time system (with zeroed work counters): the view an integrator steps."""

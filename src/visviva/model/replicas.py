@@ -21,6 +21,8 @@ field folded into the compiled step alone but evaluated by its law here, a cloth
 its lattice's stencil alone), the last bits may differ. Scenes with anything that couples
 particles (gravitation, particle collisions, flocks, crowds) or that is not particles
 (emitters, named systems, rigid bodies) have no replicas: :func:`replica_key` is ``None``.
+Which entities are copied, and the room their copies take, each kind says
+(:class:`~visviva.entities.kind.Replica`).
 """
 
 from __future__ import annotations
@@ -33,38 +35,37 @@ from typing import Any
 import numpy as np
 
 from ..collision.colliders import MAX_COLLIDERS
+from ..entities import entity_kinds
+from ..entities.kind import Replica
 from ..errors import ModelError
 from ..forces.springs import Springs
 from ..ode.state import Layout, State
 from ..particles.fused import MAX_LAW_FIELDS
 from .build import build_model, entity_names
 from .model import Model
-from .scene import Collider, ForceField, ParticleCloud, Particles, Scene
-from .scene_bodies import BODIES
+from .scene import Scene
 from .scene_system import layout
 
 __all__ = ["Replicas", "replica_capacity", "replica_key"]
 
-#: The entities whose particles are copied for each member.
-HOLDERS = (Particles, ParticleCloud, *BODIES)
-#: Fields folded into the compiled particle step when they act on every particle.
-_FOLDED_KINDS = ("drag", "wind", "damping")
+
+def _replica(entity: Any) -> Replica | None:
+    """How ``entity`` is copied, as its kind says (``None``: no replicas)."""
+    replicate = entity_kinds().get(entity.type).hooks.replica
+    return None if replicate is None else replicate(entity)
 
 
 def replica_key(scene: Scene) -> Hashable | None:
     """What scenes must share to be replicas of one another: their world, time stepping and
-    entities (types, names, targets), their values aside; ``None`` if ``scene`` has anything
-    but particles, force fields and colliders (see the module docstring)."""
+    entities (types, names, targets), their values aside; ``None`` if ``scene`` has an entity
+    its kind does not replicate (see the module docstring)."""
     structure = []
+    replicas = [_replica(entity) for entity in scene.entities]
+    if any(r is None for r in replicas) or not any(r.holds for r in replicas if r is not None):
+        return None
     for entity in scene.entities:
-        if isinstance(entity, ForceField) and entity.kind == "gravitation":
-            return None
-        if not isinstance(entity, (*HOLDERS, ForceField, Collider)):
-            return None
         targets = getattr(entity, "targets", None)
         structure.append((entity.type, entity.name, None if targets is None else tuple(targets)))
-    if not any(isinstance(e, HOLDERS) for e in scene.entities):
-        return None
     settings = scene.integration.model_dump(exclude={"energy_tolerance"})
     return (scene.world.model_dump_json(), tuple(sorted(settings.items())), tuple(structure))
 
@@ -79,17 +80,13 @@ def replica_capacity(scenes: Sequence[Scene]) -> int:
     shared = {"impulse": 0, "penalty": 0, "law": 0}
     copied = dict.fromkeys(shared, 0)
     for j, entity in enumerate(first.entities):
-        if not isinstance(entity, (ForceField, Collider)):
+        replica = _replica(entity)
+        if replica is None or replica.room is None:
             continue
         alone = _same(scenes, j)
-        kind: str
-        if isinstance(entity, Collider):
-            kind = entity.response
-        elif alone and entity.targets is None and entity.kind in _FOLDED_KINDS:
+        if alone and entity.targets is None and replica.folds:
             continue
-        else:
-            kind = "law"
-        (shared if alone else copied)[kind] += 1
+        (shared if alone else copied)[replica.room] += 1
     room = {"impulse": MAX_COLLIDERS, "penalty": MAX_COLLIDERS, "law": MAX_LAW_FIELDS}
     return min(
         [len(scenes)]
@@ -191,7 +188,8 @@ class Replicas:
 
 
 def _holds(entity: Any) -> bool:
-    return isinstance(entity, HOLDERS)
+    replica = _replica(entity)
+    return replica is not None and replica.holds
 
 
 def _member(name: str, k: int) -> str:
@@ -216,7 +214,7 @@ def _merged_scene(scenes: Sequence[Scene], names: list[str]) -> Scene:
         if _holds(entity)
     ]
     for j, (name, entity) in enumerate(zip(names, first.entities, strict=True)):
-        if not isinstance(entity, (ForceField, Collider)):
+        if _holds(entity):
             continue
         targets = holders if entity.targets is None else entity.targets
         if _same(scenes, j):

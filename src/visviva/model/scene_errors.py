@@ -1,11 +1,11 @@
 """Validation problems of a scene, as the user wrote it: one per field, with did-you-mean.
 
-Pydantic reports a problem at a location such as ``("entities", 3, "particles", "mass")`` and
-once per branch of a union; :func:`scene_problems` turns that into one
+Pydantic reports a problem at a location such as ``("entities", 3, "mass")`` and once per
+branch of a union; :func:`scene_problems` turns that into one
 :class:`~visviva.errors.SceneProblem` per field at the path the user wrote
 (``entities[3].mass``), names the allowed keys of a misspelt one, names the new name of a
-renamed one (:mod:`.scene_renames`), and leaves the line number to the caller that has the
-file (``line_of``).
+renamed one (each kind's :attr:`~visviva.entities.EntityKind.renamed`), and leaves the line
+number to the caller that has the file (``line_of``).
 """
 
 from __future__ import annotations
@@ -18,9 +18,10 @@ from pydantic import BaseModel, ValidationError
 
 from .._registry import did_you_mean
 from .._validation import describe
+from ..entities import entity_kinds
+from ..entities.methods import entity_owner, renamed_message
 from ..errors import SceneProblem
-from .scene import ENTITY_TYPES, Integration, Output, Scene, SceneInfo, World
-from .scene_renames import entity_owner, new_name, renamed_message
+from .scene import Integration, Output, Scene, SceneInfo, World
 
 __all__ = ["scene_problems"]
 
@@ -75,7 +76,7 @@ def scene_problems(
         elif error["type"] == "missing":
             got = None
         elif error["type"] == "union_tag_invalid":
-            message = f"unknown entity type; valid types: {', '.join(ENTITY_TYPES)}"
+            message = f"unknown entity type; valid types: {', '.join(entity_kinds())}"
             tag = error["input"].get("type") if isinstance(error["input"], dict) else None
             got = describe(tag)
         elif error["type"] == "finite_number":
@@ -87,11 +88,9 @@ def scene_problems(
 def _field_path(loc: tuple[Any, ...]) -> tuple[Any, ...]:
     """The error's location as the user wrote it: no union-branch or entity-tag segments."""
     path: list[Any] = []
-    for position, segment in enumerate(loc):
+    for segment in loc:
         if isinstance(segment, str) and _UNION_BRANCH.search(segment):
             continue  # a union branch name such as "constrained-float", not a key
-        if position == 2 and loc[0] == "entities" and segment in ENTITY_TYPES:
-            continue  # the discriminator's branch, not a key
         path.append(segment)
     return tuple(path)
 
@@ -119,7 +118,9 @@ def _new_name(
     table = _entity_table(path[:-1], raw, schema)
     if table is None or path[-1] not in table:
         return None
-    return new_name(str(table.get("type")), str(path[-1]))
+    kinds = entity_kinds()
+    kind = str(table.get("type"))
+    return kinds.get(kind).renamed.get(str(path[-1])) if kind in kinds else None
 
 
 def _allowed_keys(
@@ -133,7 +134,8 @@ def _allowed_keys(
     elif schema is None and len(path) >= 2:
         entities = raw.get("entities")
         entity = entities[path[1]] if isinstance(entities, list) else None
-        model = ENTITY_TYPES.get(str(entity.get("type"))) if isinstance(entity, dict) else None
+        kind = entity.get("type") if isinstance(entity, dict) else None
+        model = entity_kinds().get(kind).schema if kind in entity_kinds() else None
         rest = path[2:]
     elif schema is None:
         model = None if path else Scene

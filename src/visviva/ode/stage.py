@@ -25,7 +25,8 @@ __all__ = ["Phase", "Stage"]
 
 
 class Phase(IntEnum):
-    """When in a step a stage runs; stages of one phase run in the order they were built."""
+    """When in a step a stage runs; stages of one phase run by their ``order``, then in the
+    order they were built."""
 
     #: Behaviours steer from the state the integrator reached (boids, crowds).
     BEHAVIOURS = 0
@@ -50,6 +51,8 @@ class Stage(Protocol):
 
     #: When in a step it runs.
     phase: ClassVar[Phase]
+    #: Its place among the stages of its phase (lower first).
+    order: ClassVar[int]
     #: True if the fused compiled steps know how to take its place.
     compiled: ClassVar[bool]
     #: True if it may change the energy (every stage but a projection that keeps it).

@@ -166,6 +166,7 @@ class Boids:
     """
 
     phase: ClassVar[Phase] = Phase.BEHAVIOURS
+    order: ClassVar[int] = 0
     #: Not a part of the fused particle step (which knows only its own stages).
     compiled: ClassVar[bool] = False
     changes_energy: ClassVar[bool] = True

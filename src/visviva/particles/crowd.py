@@ -141,6 +141,8 @@ class Crowd:
     """
 
     phase: ClassVar[Phase] = Phase.BEHAVIOURS
+    #: After the flocks (a scene has both only if it steers other particles).
+    order: ClassVar[int] = 1
     compiled: ClassVar[bool] = False
     changes_energy: ClassVar[bool] = True
     #: Agents leave through exits: recordings keep ``alive`` per frame.

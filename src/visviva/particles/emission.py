@@ -50,6 +50,7 @@ class Emission:
     """
 
     phase: ClassVar[Phase] = Phase.EMISSION
+    order: ClassVar[int] = 0
     compiled: ClassVar[bool] = True
     changes_energy: ClassVar[bool] = True
     #: Particles die at the end of their lifetimes.

@@ -125,6 +125,7 @@ class Handles:
     """
 
     phase: ClassVar[Phase] = Phase.CONSTRAINTS
+    order: ClassVar[int] = 0
     #: The fused particle step applies it (:mod:`visviva.particles.fused`).
     compiled: ClassVar[bool] = True
     #: A moving handle does work on what it holds.

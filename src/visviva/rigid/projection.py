@@ -34,6 +34,8 @@ class BodyProjection:
     """
 
     phase: ClassVar[Phase] = Phase.CONSTRAINTS
+    #: After the handles (which hold particles, not bodies: the two never meet).
+    order: ClassVar[int] = 1
     compiled: ClassVar[bool] = False
     #: Renormalizing keeps the rotation a quaternion stands for: it does not change the energy.
     changes_energy: ClassVar[bool] = False

@@ -33,6 +33,7 @@ from .._validation import real_number, whole_number
 from .._version import __version__
 from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get
+from ..model.model import MAX_STEPS
 from .interrupt import Interrupted, stop_requested
 from .progress import Progress
 from .recorder import FrameCallback, FrameRecorder, FrameSink
@@ -48,9 +49,6 @@ if TYPE_CHECKING:
 
 __all__ = ["Schedule", "advance", "simulate"]
 
-#: A fixed-step run may take at most this many integrator steps (substeps included): a billion
-#: steps is minutes compiled and hours in NumPy; more is a mistake in dt, not a plan.
-MAX_STEPS = 10**9
 #: System-steps per compiled chunk: large enough to hide the call overhead, small enough for the
 #: progress bar to move and the frame buffer to stay small.
 CHUNK_SYSTEM_STEPS = 200_000

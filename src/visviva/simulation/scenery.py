@@ -1,7 +1,7 @@
 """A recording's scenery: the static colliders' surfaces, drawn by every output, never moved.
 
-Recorded once, in the world frame (:mod:`visviva.model.scenery` writes them and says why they
-are not static rigid bodies):
+Recorded once, in the world frame (:mod:`visviva.entities.collider.outputs` writes them and
+says why they are not static rigid bodies):
 
     static/scenery_vertices        float64 (V, 3) [m], world frame, collider after collider
     static/scenery_triangles       int64 (T, 3): counter-clockwise seen from outside
@@ -22,10 +22,11 @@ from typing import Any
 
 import numpy as np
 
+from ..entities.collider.schema import DEFAULT_SCENERY_COLOR
 from ..errors import ModelError
 from .body_geometry import BodyGeometry, vertex_normals
 
-__all__ = ["DEFAULT_SCENERY_COLOR", "SCENERY_STATIC", "Scenery", "read_scenery"]
+__all__ = ["SCENERY_STATIC", "Scenery", "read_scenery"]
 
 #: The static arrays a recording with scenery has (``scenery_color`` is optional).
 SCENERY_STATIC = (
@@ -34,9 +35,6 @@ SCENERY_STATIC = (
     "scenery_vertex_start",
     "scenery_triangle_start",
 )
-#: The colour drawn for a collider without one (in the scene or the recording): a neutral grey,
-#: darker than the video's ground, sRGB.
-DEFAULT_SCENERY_COLOR = (0.6, 0.6, 0.6)
 
 
 @dataclass(frozen=True)

@@ -37,9 +37,10 @@ from ..collision.contacts import DEFAULT_GAP, Contacts
 from ..collision.particle_contacts import PairContacts
 from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get
+from ..model.model import MAX_STEPS
 from ..ode.state import State
 from .interrupt import Interrupted
-from .loop import MAX_STEPS, Schedule, advance
+from .loop import Schedule, advance
 from .progress import Progress
 from .recorder import FrameCallback, FrameRecorder
 from .recording import Recording

@@ -22,12 +22,12 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, ValidationError, field_validator, model_validator
 
+from ..entities.fields import Finite, Name, Strict
 from ..errors import SceneError, SceneProblem, SweepError
 from ..io.scene_files import MAX_SCENE_BYTES, _read_limited, _relative_to, load_scene
 from ..io.scene_locate import locate_json, locate_toml
 from ..model.scene import OutputFormat, Scene
 from ..model.scene_errors import scene_problems
-from ..model.scene_fields import Finite, Name, Strict
 from .paths import PathProblem, resolve
 from .plot_spec import Plot, named, plot_problems
 

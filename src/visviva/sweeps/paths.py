@@ -17,7 +17,8 @@ from pydantic import BaseModel
 
 from .._registry import did_you_mean
 from .._validation import describe
-from ..model.scene_renames import entity_owner, new_name, renamed_message
+from ..entities import entity_kinds
+from ..entities.methods import entity_owner, renamed_message
 
 __all__ = ["display", "replaced", "resolve"]
 
@@ -83,7 +84,8 @@ def resolve(scene: BaseModel, path: str) -> tuple[str | int, ...]:
             if not isinstance(key, str):
                 raise PathProblem(f"`{where}` is a table, not a list: name one of its fields")
             kind = str(getattr(node, "type", None))
-            new = new_name(kind, key) if isinstance(key, str) else None
+            kinds = entity_kinds()
+            new = kinds.get(kind).renamed.get(key) if kind in kinds else None
             if new is not None:
                 owner = entity_owner(kind, getattr(node, "name", None))
                 raise PathProblem(

@@ -19,7 +19,7 @@ from typing import Annotated, Literal
 from pydantic import Field
 
 from .._registry import did_you_mean
-from ..model.scene_fields import Strict
+from ..entities.fields import Strict
 
 __all__ = ["FIGURES", "NESTED_FIGURES", "Plot", "named", "plot_problems"]
 

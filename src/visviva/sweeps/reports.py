@@ -23,10 +23,11 @@ from typing import Any
 
 from pydantic import BaseModel
 
+from ..entities.system.schema import System
+from ..entities.system.systems import SYSTEMS
 from ..io.files import atomic_path
 from ..io.json_values import plain_json
-from ..model.scene import Scene, System
-from ..model.systems import SYSTEMS
+from ..model.scene import Scene
 from .description import Sweep
 from .index_page import write_index
 from .plot_spec import FIGURES, Plot

@@ -1,0 +1,84 @@
+"""Entity kinds: each a folder of its own, found through one registry.
+
+A scene is a list of entities, each with a ``type``: a *kind*. Every kind lives in one folder
+here — its table (``schema.py``: the pydantic schema and the builder's typed method) and how it
+is built (``build.py``: its hooks, :class:`~.kind.KindBuild`) — and is described by one
+:class:`~.kind.EntityKind`. :data:`ENTITY_KINDS` is the only list of kinds: the scene's
+validation, the builder, the model's build and the JSON schema go over it, so adding a kind is
+a folder and a line in :data:`BUILT_IN` — or, from a package of one's own, an entry point
+(:mod:`.plugins`; ``docs/extending.md``).
+
+The built-in kinds, in their order (which is the order their ``finish`` hooks run in):
+particles, particle_cloud, rope, hair, springs, cloth, cloth_mesh, soft_lattice, soft_mesh,
+body, emitter, system, force, collider, particle_collisions, boids, crowd.
+"""
+
+from __future__ import annotations
+
+import threading
+
+from .._registry import Registry
+from . import (
+    body,
+    boids,
+    cloth,
+    cloth_mesh,
+    collider,
+    crowd,
+    emitter,
+    force,
+    hair,
+    particle_cloud,
+    particle_collisions,
+    particles,
+    rope,
+    soft_lattice,
+    soft_mesh,
+    springs,
+    system,
+)
+from .kind import EntityKind, KindBuild
+
+__all__ = ["BUILT_IN", "ENTITY_KINDS", "EntityKind", "KindBuild", "entity_kinds"]
+
+#: The kinds visviva ships, in registry order.
+BUILT_IN: tuple[EntityKind, ...] = (
+    particles.KIND,
+    particle_cloud.KIND,
+    rope.KIND,
+    hair.KIND,
+    springs.KIND,
+    cloth.KIND,
+    cloth_mesh.KIND,
+    soft_lattice.KIND,
+    soft_mesh.KIND,
+    body.KIND,
+    emitter.KIND,
+    system.KIND,
+    force.KIND,
+    collider.KIND,
+    particle_collisions.KIND,
+    boids.KIND,
+    crowd.KIND,
+)
+
+#: Every kind a scene may hold: the built-in ones, then those of installed plugins.
+ENTITY_KINDS: Registry[EntityKind] = Registry("entity type")
+for _kind in BUILT_IN:
+    ENTITY_KINDS.register(_kind)
+
+_plugins_loaded = False
+_plugins_lock = threading.Lock()
+
+
+def entity_kinds() -> Registry[EntityKind]:
+    """:data:`ENTITY_KINDS`, with the installed plugins' kinds loaded (once per process)."""
+    global _plugins_loaded
+    if not _plugins_loaded:
+        with _plugins_lock:
+            if not _plugins_loaded:
+                from .plugins import load_plugins
+
+                load_plugins(ENTITY_KINDS)
+                _plugins_loaded = True
+    return ENTITY_KINDS

@@ -1,0 +1,13 @@
+"""The ``body`` entity kind: a rigid body: a shape with its mass properties, state (x, q, P, L)."""
+
+from ..kind import EntityKind
+from .schema import RENAMED, RigidBody
+
+KIND = EntityKind(
+    name="body",
+    schema=RigidBody,
+    summary="a rigid body: a shape with its mass properties, state (x, q, P, L)",
+    build=f"{__name__}.build",
+    state=True,
+    renamed=RENAMED,
+)

@@ -1,0 +1,92 @@
+"""The scene's static colliders as drawable triangles, recorded once ("scenery").
+
+Colliders do not move, so a recording keeps their surfaces once, in the world frame, and no
+per-frame field (:mod:`visviva.simulation.scenery` reads them back; the collider kind's build
+records them):
+
+    static/scenery_vertices        float64 (V, 3) [m]: the surfaces, collider after collider
+    static/scenery_triangles       int64 (T, 3): counter-clockwise seen from outside, indices
+                                   into scenery_vertices; a collider's use its own vertices
+    static/scenery_vertex_start    int64 (C + 1,): collider c's vertex rows
+    static/scenery_triangle_start  int64 (C + 1,): and its triangle rows
+    static/scenery_color           float64 (C, 3): sRGB in [0, 1]
+    attrs["scenery_names"]         list of C strings
+
+Drawn: boxes (their six faces, four vertices each, so the faces are flat with sharp edges:
+the 12 triangles over the box's 8 corners), spheres (the rigid bodies' tessellation,
+:func:`visviva.rigid.surfaces.unit_sphere`: 32 segments around, 16 from pole to pole) and
+meshes (their own vertices and triangles). Planes are not drawn: a half-space or a slab
+without an edge has no finite surface, and the video already draws a ground.
+
+Why fields of their own rather than static rigid bodies with a constant transform: every
+consumer of ``body_*`` counts the bodies, names them, plots their momenta or animates their
+transforms (the USD and glTF exports write a transform per frame); a collider is none of
+those. The layout is the bodies' (vertices with start rows) so that the outputs draw scenery
+with the same code as a body's surface.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from .schema import DEFAULT_SCENERY_COLOR, Collider
+from .shapes import collider_shape, collider_surface
+
+__all__ = ["scenery_attrs", "scenery_fields"]
+
+
+def _drawn(
+    entries: Sequence[tuple[str, Collider]],
+) -> list[tuple[str, Collider, tuple[np.ndarray, np.ndarray]]]:
+    """The drawable colliders: (where, entity, surface), in the scene's order."""
+    drawn = []
+    for where, entity in entries:
+        if entity.shape == "plane":
+            continue
+        if entity.shape == "mesh":  # checked when the model was built; no tree needed here
+            surface = (
+                np.asarray(entity.vertices, dtype=np.float64),
+                np.asarray(entity.triangles, dtype=np.int64),
+            )
+        else:
+            surface = collider_surface(collider_shape(entity, where))
+        if surface is not None:
+            drawn.append((where, entity, surface))
+    return drawn
+
+
+def scenery_fields(entries: Sequence[tuple[str, Collider]]) -> dict[str, np.ndarray]:
+    """The static arrays of the drawable colliders among ``entries`` (see the module
+    docstring); empty without any (no field is recorded)."""
+    drawn = _drawn(entries)
+    if not drawn:
+        return {}
+    surfaces = [surface for _, _, surface in drawn]
+    vertex_start = np.cumsum([0] + [v.shape[0] for v, _ in surfaces], dtype=np.int64)
+    triangle_start = np.cumsum([0] + [t.shape[0] for _, t in surfaces], dtype=np.int64)
+    return {
+        "scenery_vertices": np.concatenate([v for v, _ in surfaces]).astype(np.float64),
+        "scenery_triangles": np.concatenate(
+            [t + first for (_, t), first in zip(surfaces, vertex_start, strict=False)]
+        ).astype(np.int64),
+        "scenery_vertex_start": vertex_start,
+        "scenery_triangle_start": triangle_start,
+        "scenery_color": np.array(
+            [e.color or DEFAULT_SCENERY_COLOR for _, e, _ in drawn], dtype=np.float64
+        ),
+    }
+
+
+def scenery_attrs(entries: Sequence[tuple[str, Collider]]) -> dict[str, list[str]]:
+    """The drawable colliders' names (``collider_<entity index>`` for one without a name)."""
+    drawn = _drawn(entries)
+    if not drawn:
+        return {}
+    return {
+        "scenery_names": [
+            e.name or f"collider_{where.removeprefix('entities[').removesuffix(']')}"
+            for where, e, _ in drawn
+        ]
+    }

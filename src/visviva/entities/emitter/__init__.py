@@ -1,0 +1,13 @@
+"""The ``emitter`` entity kind: particles born over time from a shape, living their lifetimes."""
+
+from ..kind import EntityKind
+from .schema import RENAMED, Emitter
+
+KIND = EntityKind(
+    name="emitter",
+    schema=Emitter,
+    summary="particles born over time from a shape, living their lifetimes",
+    build=f"{__name__}.build",
+    holds_particles=True,
+    renamed=RENAMED,
+)

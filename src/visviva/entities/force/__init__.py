@@ -1,0 +1,11 @@
+"""The ``force`` entity kind: a force field on particles, or gravitation among them."""
+
+from ..kind import EntityKind
+from .schema import ForceField
+
+KIND = EntityKind(
+    name="force",
+    schema=ForceField,
+    summary="a force field on particles, or gravitation among them",
+    build=f"{__name__}.build",
+)

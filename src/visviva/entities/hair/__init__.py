@@ -1,0 +1,12 @@
+"""The ``hair`` entity kind: a hair strand: edge, bending and torsion springs along a curve."""
+
+from ..kind import EntityKind
+from .schema import Hair
+
+KIND = EntityKind(
+    name="hair",
+    schema=Hair,
+    summary="a hair strand: edge, bending and torsion springs along a curve",
+    build=f"{__name__}.build",
+    holds_particles=True,
+)

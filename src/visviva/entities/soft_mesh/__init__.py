@@ -1,0 +1,12 @@
+"""The ``soft_mesh`` entity kind: a volumetric soft body on a tetrahedral mesh."""
+
+from ..kind import EntityKind
+from .schema import SoftMesh
+
+KIND = EntityKind(
+    name="soft_mesh",
+    schema=SoftMesh,
+    summary="a volumetric soft body on a tetrahedral mesh",
+    build=f"{__name__}.build",
+    holds_particles=True,
+)
