@@ -254,7 +254,7 @@ ramp = 0.1
     builder.set_integration(method="symplectic_euler", dt=0.01, duration=1.0)
     builder.add_hair([[0, 1.5, 0.1], [0, 1.46, 0.1], [0, 1.42, 0.1]], mass=0.0005,
                      stiffness=200.0, bending=20.0,
-                     handle=vv.model.Handle(pivot=(0, 1.5, 0), angular_velocity=1.6, start=0.2,
+                     handle=vv.entities.Handle(pivot=(0, 1.5, 0), angular_velocity=1.6, start=0.2,
                                             stop=0.8, ramp=0.1))  # fmt: skip
     from_python = builder.build()
     assert from_file.scene.entities == from_python.scene.entities

@@ -14,10 +14,10 @@ import numba
 import numpy as np
 
 from ..deformables.topology import STRETCH
+from ..entities.deformable_build import body_networks
 from ..forces.springs import Springs
 from ..model.builder import SceneBuilder
 from ..model.model import Model
-from ..model.parts import body_networks
 from ..simulation.recording import Recording
 from ..simulation.simulation import Simulation
 
@@ -74,7 +74,7 @@ def stretch_pairs(model: Model) -> np.ndarray:
     """The particles ``(S, 2)`` of every body's stretch springs (a cloth's structural springs,
     a soft body's edges): the springs whose strain is the fabric's or the body's stretch."""
     pairs = [np.zeros((0, 2), dtype=np.int64)]
-    for network, first in body_networks(model.scene, model.particle_groups):
+    for network, first in body_networks(model):
         pairs.append(network.pairs[network.family == STRETCH] + first)
     return np.concatenate(pairs)
 

@@ -16,7 +16,9 @@ body, emitter, system, force, collider, particle_collisions, boids, crowd.
 from __future__ import annotations
 
 import threading
+from typing import TYPE_CHECKING
 
+from .._lazy import lazy_names
 from .._registry import Registry
 from . import (
     body,
@@ -37,9 +39,25 @@ from . import (
     springs,
     system,
 )
-from .kind import EntityKind, KindBuild
+from .handles import Handle
+from .kind import EntityKind, KindBuild, Replica
 
-__all__ = ["BUILT_IN", "ENTITY_KINDS", "EntityKind", "KindBuild", "entity_kinds"]
+if TYPE_CHECKING:
+    from .context import BuildContext, Located, ParticleGroup, ParticleRows
+
+__all__ = [
+    "BUILT_IN",
+    "ENTITY_KINDS",
+    "BuildContext",
+    "EntityKind",
+    "Handle",
+    "KindBuild",
+    "Located",
+    "ParticleGroup",
+    "ParticleRows",
+    "Replica",
+    "entity_kinds",
+]
 
 #: The kinds visviva ships, in registry order.
 BUILT_IN: tuple[EntityKind, ...] = (
@@ -66,6 +84,14 @@ BUILT_IN: tuple[EntityKind, ...] = (
 ENTITY_KINDS: Registry[EntityKind] = Registry("entity type")
 for _kind in BUILT_IN:
     ENTITY_KINDS.register(_kind)
+
+# What builds read and make loads on first use (visviva._lazy): the kinds' tables alone are
+# what `visviva schema` reads, without NumPy.
+__getattr__, __dir__ = lazy_names(
+    __name__,
+    __all__,
+    {name: "context" for name in ("BuildContext", "Located", "ParticleGroup", "ParticleRows")},
+)
 
 _plugins_loaded = False
 _plugins_lock = threading.Lock()

@@ -14,7 +14,7 @@ spring graphs; bending and torsion springs skip points and are not drawn).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numpy as np
@@ -29,7 +29,10 @@ from .checks import check_lengths
 from .context import BuildContext, Located, ParticleRows
 from .kind import HOLDS, KindBuild
 
-__all__ = ["deformable_build", "located"]
+__all__ = ["body_networks", "deformable_build", "located"]
+
+#: Each deformable kind's network function, by kind (filled as their build modules load).
+_NETWORKS: dict[str, Callable[[Any], SpringNetwork]] = {}
 
 
 def located(where: str, error: ModelError, field: str | None = None) -> Located:
@@ -43,11 +46,15 @@ def located(where: str, error: ModelError, field: str | None = None) -> Located:
 
 
 def deformable_build(
-    network: Callable[[Any], SpringNetwork], placed_by: str, points_listed: bool = False
+    kind: str,
+    network: Callable[[Any], SpringNetwork],
+    placed_by: str,
+    points_listed: bool = False,
 ) -> KindBuild:
     """The build of a kind of deformable body whose table gives its spring ``network``.
 
     Args:
+        kind: The kind's name.
         network: The body's spring network from its table.
         placed_by: The field that places its points, where points too close or too far for
             a spring are refused (``"points"``, ``"resolution"``, ``"vertices"``).
@@ -55,6 +62,7 @@ def deformable_build(
             ``velocities``, ``mass`` and ``radius`` one value or one per point); else they
             move at one ``velocity``.
     """
+    _NETWORKS[kind] = network
 
     def rows(entity: Any, where: str, context: BuildContext) -> ParticleRows:
         try:
@@ -108,6 +116,17 @@ def deformable_build(
         build=build,
         replica=lambda entity: HOLDS,
     )
+
+
+def body_networks(model: Any) -> Iterator[tuple[SpringNetwork, int]]:
+    """Each deformable body of ``model``: its spring network (springs with their families,
+    surface) and the index of its first particle (its point ``i`` is particle ``first + i``).
+    (Building the model loaded its kinds' build modules, which made their networks known.)"""
+    for group in model.particle_groups:
+        entity = model.scene.entities[group.entity]
+        network = _NETWORKS.get(entity.type)
+        if network is not None:
+            yield network(entity), group.start
 
 
 def _motion(handle: Any, held: np.ndarray, where: str, context: BuildContext) -> HandleMotion:

@@ -14,7 +14,6 @@ import functools
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Concatenate, ParamSpec, Protocol
 
-import numpy as np
 from pydantic import BaseModel
 
 from ..errors import SceneError, SceneProblem
@@ -51,6 +50,8 @@ def given(arguments: dict[str, Any]) -> dict[str, Any]:
 
 
 def _plain(value: Any) -> Any:
+    import numpy as np  # here: reading the kinds' tables (`visviva schema`) needs no NumPy
+
     if isinstance(value, BaseModel):  # a table given as its schema (a Handle): validated again
         return _plain(value.model_dump(exclude_none=True))
     if isinstance(value, np.ndarray):

@@ -61,7 +61,8 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     context = BuildContext(scene, entity_names(scene), settings.dt / settings.substeps)
     try:
         _lay_out_particles(context)
-        _build(context)
+        with np.errstate(all="ignore"):  # values that overflow are judged by the start check
+            _build(context)
     except Located as located:
         raise SceneError([located.problem]) from None
     model = Model(

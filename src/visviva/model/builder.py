@@ -10,7 +10,7 @@ fields as its signature). Each add validates its entity at once (an argument lef
 takes the scene file's default) and returns the entity's index in the scene.
 
 Every deformable body's ``pinned`` points stay where they are, unless its ``handle`` — a
-:class:`~visviva.entities.handles.Handle` or a dict of its fields, as in a scene file's
+:class:`~visviva.entities.Handle` or a dict of its fields, as in a scene file's
 ``[entities.handle]`` table — moves them (:mod:`visviva.particles.handles`)::
 
     builder.add_hair(points, mass=5e-4, stiffness=200.0, bending=20.0,

@@ -25,4 +25,4 @@ def _network(entity: Cloth) -> SpringNetwork:
     )
 
 
-BUILD = deformable_build(_network, "resolution")
+BUILD = deformable_build("cloth", _network, "resolution")

@@ -34,4 +34,4 @@ def _prepare(entity: Any, where: str) -> Any:
     return with_mesh_file(entity, where, check, tuple(entity.pinned))
 
 
-BUILD = replace(deformable_build(_network, "vertices"), prepare=_prepare)
+BUILD = replace(deformable_build("cloth_mesh", _network, "vertices"), prepare=_prepare)

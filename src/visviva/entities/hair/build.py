@@ -18,4 +18,4 @@ def _network(entity: Hair) -> SpringNetwork:
     return hair(points, mass, entity.stiffness, entity.bending, entity.torsion)
 
 
-BUILD = deformable_build(_network, "points", points_listed=True)
+BUILD = deformable_build("hair", _network, "points", points_listed=True)

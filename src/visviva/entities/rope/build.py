@@ -17,4 +17,4 @@ def _network(entity: Rope) -> SpringNetwork:
     return rope(points, mass, entity.stiffness, entity.bending)
 
 
-BUILD = deformable_build(_network, "points", points_listed=True)
+BUILD = deformable_build("rope", _network, "points", points_listed=True)

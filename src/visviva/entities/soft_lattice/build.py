@@ -24,4 +24,4 @@ def _network(entity: SoftLattice) -> SpringNetwork:
     )
 
 
-BUILD = deformable_build(_network, "resolution")
+BUILD = deformable_build("soft_lattice", _network, "resolution")

@@ -21,4 +21,4 @@ def _network(entity: SoftMesh) -> SpringNetwork:
     )
 
 
-BUILD = deformable_build(_network, "vertices")
+BUILD = deformable_build("soft_mesh", _network, "vertices")

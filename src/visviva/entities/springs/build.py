@@ -20,4 +20,4 @@ def _network(entity: SpringGraph) -> SpringNetwork:
     return spring_graph(points, mass, np.array(entity.pairs), stiffness, rest)
 
 
-BUILD = deformable_build(_network, "points", points_listed=True)
+BUILD = deformable_build("springs", _network, "points", points_listed=True)
