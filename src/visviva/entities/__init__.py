@@ -44,6 +44,7 @@ from .kind import EntityKind, KindBuild, Replica
 
 if TYPE_CHECKING:
     from .context import BuildContext, Located, ParticleGroup, ParticleRows
+    from .contributions import force_kind, stage_kind
 
 __all__ = [
     "BUILT_IN",
@@ -57,6 +58,9 @@ __all__ = [
     "ParticleRows",
     "Replica",
     "entity_kinds",
+    "force_kind",
+    "register_entity_kind",
+    "stage_kind",
 ]
 
 #: The kinds visviva ships, in registry order.
@@ -90,7 +94,8 @@ for _kind in BUILT_IN:
 __getattr__, __dir__ = lazy_names(
     __name__,
     __all__,
-    {name: "context" for name in ("BuildContext", "Located", "ParticleGroup", "ParticleRows")},
+    {name: "context" for name in ("BuildContext", "Located", "ParticleGroup", "ParticleRows")}
+    | {"force_kind": "contributions", "stage_kind": "contributions"},
 )
 
 _plugins_loaded = False
@@ -108,3 +113,17 @@ def entity_kinds() -> Registry[EntityKind]:
                 load_plugins(ENTITY_KINDS)
                 _plugins_loaded = True
     return ENTITY_KINDS
+
+
+def register_entity_kind(kind: EntityKind) -> EntityKind:
+    """Register ``kind`` from Python (a plugin installed as a package is registered through
+    its entry point instead): checked as a plugin's kind is, then usable in scenes and by
+    the builder like the built-in kinds.
+
+    Raises:
+        ModelError: Saying why the kind is refused (a name already registered, a schema
+            without its ``type``).
+    """
+    from .plugins import register_entity_kind as register
+
+    return register(kind, entity_kinds())

@@ -104,7 +104,7 @@ class EntityKind:
         schema: The pydantic model of its table, with ``type: Literal[name]``.
         summary: What it is, in a line (``visviva schema``, messages).
         build: The dotted name of the module that holds its :class:`KindBuild` as ``BUILD``
-            (imported on first use).
+            (imported on first use), or the :class:`KindBuild` itself.
         holds_particles: True if its entities hold particles, which forces, colliders and
             behaviours may target by the entity's name.
         state: True if its entities have state of their own in the integrated arrays (rigid
@@ -116,14 +116,16 @@ class EntityKind:
     name: str
     schema: type[BaseModel]
     summary: str
-    build: str
+    build: str | KindBuild
     holds_particles: bool = False
     state: bool = False
     renamed: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
 
     @cached_property
     def hooks(self) -> KindBuild:
-        """The kind's :class:`KindBuild`, from its build module."""
+        """The kind's :class:`KindBuild` (from its build module)."""
+        if isinstance(self.build, KindBuild):
+            return self.build
         hooks = importlib.import_module(self.build).BUILD
         if not isinstance(hooks, KindBuild):
             raise TypeError(f"{self.build}.BUILD must be a KindBuild, not {type(hooks).__name__}")

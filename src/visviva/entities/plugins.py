@@ -1,11 +1,15 @@
-"""Entity kinds from other packages: the ``visviva.entities`` entry points.
+"""Entity kinds from other packages: the ``visviva.entities``, ``visviva.forces`` and
+``visviva.stages`` entry points.
 
 A package adds kinds by naming them in its metadata::
 
-    [project.entry-points."visviva.entities"]
-    magnet = "visviva_magnet:KIND"
+    [project.entry-points."visviva.forces"]
+    magnetic_field = "visviva_magnetic:KIND"
 
-The entry point's object is an :class:`~.kind.EntityKind` (or a list of them). They are loaded
+The entry point's object is an :class:`~.kind.EntityKind` (or a list of them): any kind under
+``visviva.entities``, a kind made by :func:`~.contributions.force_kind` (one force per entity)
+under ``visviva.forces``, one made by :func:`~.contributions.stage_kind` under
+``visviva.stages`` (their classes are checked when they are made). They are loaded
 the first time a scene is read or built, checked like the built-in kinds are
 (:func:`kind_problem`) and registered after them; from then on scene files, the builder
 (``builder.add("magnet", ...)`` and ``builder.add_magnet(...)``), the build and the recordings
@@ -28,10 +32,10 @@ from .._registry import Registry
 from ..errors import ModelError
 from .kind import EntityKind
 
-__all__ = ["GROUP", "PluginWarning", "kind_problem", "load_plugins", "register_entity_kind"]
+__all__ = ["GROUPS", "PluginWarning", "kind_problem", "load_plugins", "register_entity_kind"]
 
-#: The entry-point group of entity kinds.
-GROUP = "visviva.entities"
+#: The entry-point groups of entity kinds: any kind, a force's, a stage's.
+GROUPS = ("visviva.entities", "visviva.forces", "visviva.stages")
 #: What a kind's name may be: its builder method is ``add_<name>``.
 _NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 
@@ -67,7 +71,7 @@ def kind_problem(kind: object, registry: Registry[EntityKind]) -> str | None:
 
 
 def register_entity_kind(kind: EntityKind, registry: Registry[EntityKind]) -> EntityKind:
-    """Register ``kind`` (checked as a plugin's is).
+    """Register ``kind`` in ``registry`` (checked as a plugin's is).
 
     Raises:
         ModelError: Saying why the kind is refused.
@@ -79,11 +83,15 @@ def register_entity_kind(kind: EntityKind, registry: Registry[EntityKind]) -> En
 
 
 def load_plugins(registry: Registry[EntityKind]) -> None:
-    """Register the kinds of every installed ``visviva.entities`` entry point in
-    ``registry``; a plugin refused is left out with a :class:`PluginWarning`."""
-    for point in entry_points(group=GROUP):
+    """Register the kinds of every installed entry point of :data:`GROUPS` in ``registry``; a
+    plugin refused is left out with a :class:`PluginWarning`."""
+    points = [point for group in GROUPS for point in entry_points(group=group)]
+    for point in points:
         try:
             loaded = point.load()
+        except ModelError as error:  # force_kind or stage_kind refused its class
+            _refuse(point, str(error))
+            continue
         except Exception as error:  # a plugin's bug must not take the built-in kinds down
             _refuse(point, f"it failed to import ({type(error).__name__}: {error})")
             continue
