@@ -170,6 +170,7 @@ print(json.dumps({"kinds": kinds, "warnings": [str(w.message) for w in caught]})
          from visviva.entities import EntityKind, KindBuild
          class Cloth(BaseModel):
              type: Literal["cloth"]
+             name: str | None = None
          KIND = EntityKind("cloth", Cloth, "a clash", KindBuild())
          """,
             "clash:KIND",
@@ -183,6 +184,7 @@ print(json.dumps({"kinds": kinds, "warnings": [str(w.message) for w in caught]})
          from visviva.entities import force_kind
          class Table(BaseModel):
              type: Literal["springy"]
+             name: str | None = None
          class Springy:
              conservative = True
              velocity_dependent = False
@@ -273,6 +275,11 @@ def test_kinds_and_classes_are_refused_with_what_to_fix():
         vv.entities.register_entity_kind(EntityKind("cloth", _Table, "x", KindBuild()))
     with pytest.raises(ModelError, match=r'must have the field `type: Literal\["other"\]`'):
         vv.entities.register_entity_kind(EntityKind("other", _Table, "x", KindBuild()))
+    class Nameless(BaseModel):
+        type: Literal["nameless"]
+
+    with pytest.raises(ModelError, match="must have the field `name: str | None = None`"):
+        vv.entities.register_entity_kind(EntityKind("nameless", Nameless, "x", KindBuild()))
     with pytest.raises(ModelError, match="lower-case letters"):
         vv.entities.register_entity_kind(EntityKind("Bad Name", _Table, "x", KindBuild()))
 

@@ -67,6 +67,12 @@ def kind_problem(kind: object, registry: Registry[EntityKind]) -> str | None:
             f"the schema {schema.__name__} of kind {kind.name!r} must have the field "
             f'`type: Literal["{kind.name}"]`, the tag scene files give'
         )
+    name = schema.model_fields.get("name")
+    if name is None or name.is_required():
+        return (
+            f"the schema {schema.__name__} of kind {kind.name!r} must have the field "
+            "`name: str | None = None`, the name other entities and messages call it by"
+        )
     return None
 
 
