@@ -5,7 +5,8 @@ here — its table (``schema.py``: the pydantic schema and the builder's typed m
 is built (``build.py``: its hooks, :class:`~.kind.KindBuild`) — and is described by one
 :class:`~.kind.EntityKind`. :data:`ENTITY_KINDS` is the only list of kinds: the scene's
 validation, the builder, the model's build and the JSON schema go over it, so adding a kind is
-a folder and a line in :data:`BUILT_IN` — or, from a package of one's own, an entry point
+a folder and its line here, in :data:`BUILT_IN` (with its builder method among
+:class:`EntityMethods`' bases) — or, from a package of one's own, an entry point
 (:mod:`.plugins`; ``docs/extending.md``).
 
 The built-in kinds, in their order (which is the order their ``finish`` hooks run in):
@@ -51,6 +52,7 @@ __all__ = [
     "ENTITY_KINDS",
     "BuildContext",
     "EntityKind",
+    "EntityMethods",
     "Handle",
     "KindBuild",
     "Located",
@@ -83,6 +85,31 @@ BUILT_IN: tuple[EntityKind, ...] = (
     boids.KIND,
     crowd.KIND,
 )
+
+
+class EntityMethods(
+    particles.ParticlesMethods,
+    particle_cloud.ParticleCloudMethods,
+    rope.RopeMethods,
+    hair.HairMethods,
+    springs.SpringGraphMethods,
+    cloth.ClothMethods,
+    cloth_mesh.ClothMeshMethods,
+    soft_lattice.SoftLatticeMethods,
+    soft_mesh.SoftMeshMethods,
+    body.RigidBodyMethods,
+    emitter.EmitterMethods,
+    system.SystemMethods,
+    force.ForceFieldMethods,
+    collider.ColliderMethods,
+    particle_collisions.ParticleCollisionMethods,
+    boids.BoidsMethods,
+    crowd.CrowdMethods,
+):
+    """The built-in kinds' typed builder methods (:mod:`.methods`), which
+    :class:`~visviva.model.SceneBuilder` has; a plugin's kind gets a method made from its
+    schema instead."""
+
 
 #: Every kind a scene may hold: the built-in ones, then those of installed plugins.
 ENTITY_KINDS: Registry[EntityKind] = Registry("entity type")

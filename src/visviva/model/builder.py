@@ -28,25 +28,8 @@ from typing import Any
 from pydantic import ValidationError
 
 from .._registry import did_you_mean
-from ..entities import BUILT_IN, entity_kinds
-from ..entities.body.schema import RigidBodyMethods
-from ..entities.boids.schema import BoidsMethods
-from ..entities.cloth.schema import ClothMethods
-from ..entities.cloth_mesh.schema import ClothMeshMethods
-from ..entities.collider.schema import ColliderMethods
-from ..entities.crowd.schema import CrowdMethods
-from ..entities.emitter.schema import EmitterMethods
-from ..entities.force.schema import ForceFieldMethods
-from ..entities.hair.schema import HairMethods
+from ..entities import BUILT_IN, EntityMethods, entity_kinds
 from ..entities.methods import given
-from ..entities.particle_cloud.schema import ParticleCloudMethods
-from ..entities.particle_collisions.schema import ParticleCollisionMethods
-from ..entities.particles.schema import ParticlesMethods
-from ..entities.rope.schema import RopeMethods
-from ..entities.soft_lattice.schema import SoftLatticeMethods
-from ..entities.soft_mesh.schema import SoftMeshMethods
-from ..entities.springs.schema import SpringGraphMethods
-from ..entities.system.schema import SystemMethods
 from ..errors import SceneError, SceneProblem
 from .build import build_model
 from .model import Model
@@ -60,25 +43,7 @@ Vector = Sequence[float]
 BUILT_IN_KINDS = frozenset(kind.name for kind in BUILT_IN)
 
 
-class SceneBuilder(
-    ParticlesMethods,
-    ParticleCloudMethods,
-    RopeMethods,
-    HairMethods,
-    SpringGraphMethods,
-    ClothMethods,
-    ClothMeshMethods,
-    SoftLatticeMethods,
-    SoftMeshMethods,
-    RigidBodyMethods,
-    EmitterMethods,
-    SystemMethods,
-    ForceFieldMethods,
-    ColliderMethods,
-    ParticleCollisionMethods,
-    BoidsMethods,
-    CrowdMethods,
-):
+class SceneBuilder(EntityMethods):
     """Builds a scene step by step.
 
     Args:

@@ -1,7 +1,9 @@
 """The ``body`` entity kind: a rigid body: a shape with its mass properties, state (x, q, P, L)."""
 
 from ..kind import EntityKind
-from .schema import RENAMED, RigidBody
+from .schema import RENAMED, RigidBody, RigidBodyMethods
+
+__all__ = ["KIND", "RigidBodyMethods"]
 
 KIND = EntityKind(
     name="body",

@@ -1,7 +1,9 @@
 """The ``boids`` entity kind: Reynolds' flocking of the particles it names."""
 
 from ..kind import EntityKind
-from .schema import RENAMED, Boids
+from .schema import RENAMED, Boids, BoidsMethods
+
+__all__ = ["KIND", "BoidsMethods"]
 
 KIND = EntityKind(
     name="boids",

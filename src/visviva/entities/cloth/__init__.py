@@ -1,7 +1,9 @@
 """The ``cloth`` entity kind: a cloth grid with structural, shear and bending springs."""
 
 from ..kind import EntityKind
-from .schema import RENAMED, Cloth
+from .schema import RENAMED, Cloth, ClothMethods
+
+__all__ = ["KIND", "ClothMethods"]
 
 KIND = EntityKind(
     name="cloth",

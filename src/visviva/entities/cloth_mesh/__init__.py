@@ -1,7 +1,9 @@
 """The ``cloth_mesh`` entity kind: cloth on any triangle mesh."""
 
 from ..kind import EntityKind
-from .schema import RENAMED, ClothMesh
+from .schema import RENAMED, ClothMesh, ClothMeshMethods
+
+__all__ = ["KIND", "ClothMeshMethods"]
 
 KIND = EntityKind(
     name="cloth_mesh",

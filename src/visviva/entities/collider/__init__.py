@@ -1,7 +1,9 @@
 """The ``collider`` entity kind: a static shape that particles bounce off or are pushed out of."""
 
 from ..kind import EntityKind
-from .schema import Collider
+from .schema import Collider, ColliderMethods
+
+__all__ = ["KIND", "ColliderMethods"]
 
 KIND = EntityKind(
     name="collider",

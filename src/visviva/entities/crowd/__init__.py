@@ -1,7 +1,9 @@
 """The ``crowd`` entity kind: pedestrians walking with the social-force model, through exits."""
 
 from ..kind import EntityKind
-from .schema import Crowd
+from .schema import Crowd, CrowdMethods
+
+__all__ = ["KIND", "CrowdMethods"]
 
 KIND = EntityKind(
     name="crowd",

@@ -1,7 +1,9 @@
 """The ``emitter`` entity kind: particles born over time from a shape, living their lifetimes."""
 
 from ..kind import EntityKind
-from .schema import RENAMED, Emitter
+from .schema import RENAMED, Emitter, EmitterMethods
+
+__all__ = ["KIND", "EmitterMethods"]
 
 KIND = EntityKind(
     name="emitter",

@@ -1,7 +1,9 @@
 """The ``force`` entity kind: a force field on particles, or gravitation among them."""
 
 from ..kind import EntityKind
-from .schema import ForceField
+from .schema import ForceField, ForceFieldMethods
+
+__all__ = ["KIND", "ForceFieldMethods"]
 
 KIND = EntityKind(
     name="force",

@@ -1,7 +1,9 @@
 """The ``hair`` entity kind: a hair strand: edge, bending and torsion springs along a curve."""
 
 from ..kind import EntityKind
-from .schema import Hair
+from .schema import Hair, HairMethods
+
+__all__ = ["KIND", "HairMethods"]
 
 KIND = EntityKind(
     name="hair",

@@ -1,7 +1,9 @@
 """The ``particle_cloud`` entity kind: particles placed at random in a box."""
 
 from ..kind import EntityKind
-from .schema import ParticleCloud
+from .schema import ParticleCloud, ParticleCloudMethods
+
+__all__ = ["KIND", "ParticleCloudMethods"]
 
 KIND = EntityKind(
     name="particle_cloud",

@@ -1,7 +1,9 @@
 """The ``particle_collisions`` entity kind: particles colliding with each other as spheres."""
 
 from ..kind import EntityKind
-from .schema import ParticleCollisionSettings
+from .schema import ParticleCollisionMethods, ParticleCollisionSettings
+
+__all__ = ["KIND", "ParticleCollisionMethods"]
 
 KIND = EntityKind(
     name="particle_collisions",

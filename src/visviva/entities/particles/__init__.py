@@ -1,7 +1,9 @@
 """The ``particles`` entity kind: particles at given positions, moving freely under the forces."""
 
 from ..kind import EntityKind
-from .schema import Particles
+from .schema import Particles, ParticlesMethods
+
+__all__ = ["KIND", "ParticlesMethods"]
 
 KIND = EntityKind(
     name="particles",

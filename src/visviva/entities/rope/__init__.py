@@ -1,7 +1,9 @@
 """The ``rope`` entity kind: particles joined in order by damped springs."""
 
 from ..kind import EntityKind
-from .schema import Rope
+from .schema import Rope, RopeMethods
+
+__all__ = ["KIND", "RopeMethods"]
 
 KIND = EntityKind(
     name="rope",

@@ -1,7 +1,9 @@
 """The ``soft_lattice`` entity kind: a volumetric soft body on a lattice of springs."""
 
 from ..kind import EntityKind
-from .schema import RENAMED, SoftLattice
+from .schema import RENAMED, SoftLattice, SoftLatticeMethods
+
+__all__ = ["KIND", "SoftLatticeMethods"]
 
 KIND = EntityKind(
     name="soft_lattice",

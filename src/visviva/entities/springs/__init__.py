@@ -1,7 +1,9 @@
 """The ``springs`` entity kind: particles joined by damped springs on any graph."""
 
 from ..kind import EntityKind
-from .schema import SpringGraph
+from .schema import SpringGraph, SpringGraphMethods
+
+__all__ = ["KIND", "SpringGraphMethods"]
 
 KIND = EntityKind(
     name="springs",

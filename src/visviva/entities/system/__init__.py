@@ -1,7 +1,9 @@
 """The ``system`` entity kind: a named mechanical system in generalized coordinates."""
 
 from ..kind import EntityKind
-from .schema import System
+from .schema import System, SystemMethods
+
+__all__ = ["KIND", "SystemMethods"]
 
 KIND = EntityKind(
     name="system",
