@@ -524,7 +524,7 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
 
     def visviva_run(f: Callable[..., Any]) -> Any:
         problem = vv.ode.FirstOrderProblem(f, y0)
-        return vv.solve(problem, "rk4", dt=dt, t_end=t_end, record_every=steps)
+        return vv.solve(problem, "rk4", dt=dt, until=t_end, record_every=steps)
 
     vv_numba = measure(lambda: visviva_run(pendulum_numba), args.repeats, "(a) visviva Numba f")
     peer_numba = measure(
@@ -833,11 +833,11 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
 
     def visviva_rk4(steps: int) -> Any:
         problem = vv.ode.FirstOrderProblem(pendulum_numba, y0)
-        return vv.solve(problem, "rk4", dt=t_end / steps, t_end=t_end, record_every=steps)
+        return vv.solve(problem, "rk4", dt=t_end / steps, until=t_end, record_every=steps)
 
     def visviva_dopri5(rtol: float) -> Any:
         problem = vv.ode.FirstOrderProblem(pendulum_numba, y0)
-        return vv.solve(problem, "dopri5", t_end=t_end, rtol=rtol, atol=1e-3 * rtol)
+        return vv.solve(problem, "dopri5", until=t_end, rtol=rtol, atol=1e-3 * rtol)
 
     def solution_error(solution: Any) -> float:
         if not solution.success:

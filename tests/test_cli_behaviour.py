@@ -108,7 +108,7 @@ def test_compare_keeps_a_hostile_scene_name_inside_out(monkeypatch, capsys, tmp_
     scene.write_text(vv.io.dump_scene(builder.scene))
     monkeypatch.chdir(scene.parent)
     status, _, err = run_main(
-        monkeypatch, capsys, "compare", scene, "rk4", "--convergence-time", "0.1"
+        monkeypatch, capsys, "compare", scene, "rk4", "--convergence-duration", "0.1"
     )
     assert status == 0, err
     assert (scene.parent / "out" / "compare-escape" / "summary.json").exists()

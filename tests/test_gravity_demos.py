@@ -108,7 +108,7 @@ def test_large_galaxy_scene_runs_on_the_tree_and_follows_direct_summation(tmp_pa
         softening=0.05,
         seed=0,
     )
-    direct = vv.solve(bodies.problem(softening=0.05), "velocity_verlet", dt=0.01, t_end=0.1)
+    direct = vv.solve(bodies.problem(softening=0.05), "velocity_verlet", dt=0.01, until=0.1)
     a = vv.mechanics.gravity_accelerations(bodies.positions, bodies.masses, G=1.0, softening=0.05)
     departure = np.linalg.norm(tree - direct.q[-1].reshape(-1, 3), axis=1)
     ratio = departure / (0.5 * np.linalg.norm(a, axis=1) * 0.1**2)

@@ -18,7 +18,7 @@ def _solution():
         energy=lambda t, q, v: 0.5 * (q**2 + v**2).sum(axis=-1),
         name="damped pair",
     )
-    return vv.solve(problem, "velocity_verlet", dt=0.01, t_end=1.0, record_every=10)
+    return vv.solve(problem, "velocity_verlet", dt=0.01, until=1.0, record_every=10)
 
 
 def test_round_trip_is_bit_identical(tmp_path):
@@ -67,7 +67,7 @@ def test_several_runs_in_one_file(tmp_path):
     """A comparison keeps one group per run, in order; load picks one by name."""
     runs = {
         name: vv.solve(
-            vv.ode.SecondOrderProblem(lambda t, q: -q, [1.0], [0.0]), name, dt=0.1, t_end=1.0
+            vv.ode.SecondOrderProblem(lambda t, q: -q, [1.0], [0.0]), name, dt=0.1, until=1.0
         ).recording
         for name in ("rk4", "leapfrog", "backward_euler")
     }
@@ -84,7 +84,7 @@ def test_several_runs_in_one_file(tmp_path):
 def test_complex_states_round_trip(tmp_path):
     """The complex test equation y' = iy records complex128."""
     problem = vv.ode.FirstOrderProblem(lambda t, y: 1j * y, [1.0 + 0j])
-    recording = vv.solve(problem, "rk4", dt=0.1, t_end=1.0).recording
+    recording = vv.solve(problem, "rk4", dt=0.1, until=1.0).recording
     loaded = vv.io.load_recording(vv.io.save_recording(recording, tmp_path / "c.h5"))
     assert loaded["y"].dtype == np.complex128
     np.testing.assert_array_equal(loaded["y"], recording["y"])
@@ -119,7 +119,7 @@ def test_not_a_recording_is_refused(tmp_path):
 def test_a_diverged_run_keeps_its_frames(tmp_path):
     """The frames before a blow-up are saved with success = False and the reason."""
     problem = vv.ode.SecondOrderProblem(lambda t, q: -1e4 * q, [1.0], [0.0])
-    solution = vv.solve(problem, "explicit_euler", dt=0.01, t_end=100.0, record_every=10)
+    solution = vv.solve(problem, "explicit_euler", dt=0.01, until=100.0, record_every=10)
     loaded = vv.io.load_recording(vv.io.save_recording(solution.recording, tmp_path / "failed.h5"))
     assert loaded.attrs["success"] is False
     assert "diverged" in loaded.attrs["message"]

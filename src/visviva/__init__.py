@@ -5,7 +5,7 @@ The short tour::
     import visviva as vv
 
     spring = vv.ode.SecondOrderProblem(lambda t, q: -q, q0=[1.0], v0=[0.0])
-    solution = vv.solve(spring, method="velocity_verlet", dt=0.01, t_end=10.0)
+    solution = vv.solve(spring, method="velocity_verlet", dt=0.01, until=10.0)
     solution.q, solution.v, solution.t          # the recorded frames
     vv.integrators.names()                       # every method
     vv.analysis.stability_interval("rk4")        # (-2.785..., 0.0)
@@ -46,7 +46,7 @@ if TYPE_CHECKING:
     )
     from .model import Model, SceneBuilder
     from .scenes import load_model, run_scene
-    from .simulation import Simulation, Solution, simulate, solve
+    from .simulation import Simulation, Solution, solve
     from .simulation.recording import Recording
     from .sweeps import load_sweep, sweep
 
@@ -76,7 +76,6 @@ __all__ = [
     "particles",
     "rigid",
     "run_scene",
-    "simulate",
     "simulation",
     "solve",
     "sweep",
@@ -105,14 +104,22 @@ _FUNCTIONS = {
     "Recording": "simulation",
     "Simulation": "simulation",
     "Solution": "simulation",
-    "simulate": "simulation",
     "solve": "simulation",
     "load_sweep": "sweeps",
     "sweep": "sweeps",
 }
 
 
+#: Public names that are gone, and what replaced them.
+_GONE = {
+    "simulate": "vv.simulate was merged into vv.solve: vv.solve(problem, method, dt=..., "
+    "until=...).raise_for_status().recording is the recording it returned",
+}
+
+
 def __getattr__(name: str) -> Any:
+    if name in _GONE:
+        raise AttributeError(_GONE[name])
     if name in _SUBPACKAGES:
         return importlib.import_module(f".{name}", __name__)
     if name in _FUNCTIONS:

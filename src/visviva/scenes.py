@@ -339,7 +339,7 @@ def recording_attrs(model: Model, seconds: float) -> dict[str, Any]:
         "substeps": settings.substeps,
         "record_every": settings.record_every,
         "t0": 0.0,
-        "t_end": seconds,
+        "until": seconds,
         "playback_speed": model.output_speed,
         "playback_trail": model.output_trail,
         "playback_color_by": model.output_color_by,

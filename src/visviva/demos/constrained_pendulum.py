@@ -44,7 +44,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     from matplotlib.figure import Figure
 
     reduced = solve(
-        classic.pendulum(length=LENGTH).problem([THETA0], [0.0]), "rk4", dt=DT, t_end=duration
+        classic.pendulum(length=LENGTH).problem([THETA0], [0.0]), "rk4", dt=DT, until=duration
     )
     figure = Figure(figsize=(13, 4.5), layout="constrained")
     angle, drift, tension = figure.subplots(1, 3)
@@ -56,7 +56,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
         problem, multiplier = classic.constrained_pendulum(
             THETA0, length=LENGTH, stabilization_rate=alpha
         )
-        particle = solve(problem, "rk4", dt=DT, t_end=duration)
+        particle = solve(problem, "rk4", dt=DT, until=duration)
         label = "particle + λ(r − c)" + (f", Baumgarte α = {alpha:g}/s" if alpha else "")
         output.recordings["constrained" if alpha == 0 else "stabilized"] = _drawn(
             particle.recording

@@ -1,7 +1,7 @@
 """The simulation loop, the adaptive driver and ``solve``."""
 
 from .adaptive import DenseOutput
-from .loop import Schedule, simulate
+from .loop import Schedule
 from .recording import Geometry, Recording
 from .simulation import Simulation, SimulationState
 from .solve import Solution, solve
@@ -17,6 +17,5 @@ __all__ = [
     "Simulation",
     "SimulationState",
     "Solution",
-    "simulate",
     "solve",
 ]

@@ -213,7 +213,7 @@ def plot_convergence(studies: Sequence[ConvergenceStudy]) -> Figure:
             markerfacecolor="none",
         )
     ax.set_xlabel("dt [s]")
-    ax.set_ylabel("error at t_end (max norm)")
+    ax.set_ylabel("error at `until` (max norm)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title("Convergence: circled points are in the fitted asymptotic range")
