@@ -116,14 +116,14 @@ def test_free_fall_matches_the_parabola(tmp_path):
     v0 = np.array([[0.0, 0.0, 0.0], [0.5, 4.0, 0.0]])
     g = np.array([0.0, -9.81, 0.0])
     exact = x0 + v0 * t + 0.5 * g * t**2
-    np.testing.assert_allclose(recording["points"], exact, atol=1e-12)
+    np.testing.assert_allclose(recording["particle_position"], exact, atol=1e-12)
     # Energy is conserved to round-off for this exact integration: E = ½mv² − m g·x.
     assert np.ptp(recording["energy"]) < 1e-12 * np.abs(recording["energy"]).max()
-    assert recording.units["points"] == "m" and recording.units["energy"] == "J"
+    assert recording.units["particle_position"] == "m" and recording.units["energy"] == "J"
     assert recording.attrs["scene"].startswith("[scene]")
     assert recording.attrs["method"] == "velocity_verlet" and recording.attrs["dt"] == 1e-3
     assert recording.attrs["success"] is True
-    np.testing.assert_array_equal(recording.static["radius"], [0.1, 0.1])
+    np.testing.assert_array_equal(recording.static["particle_radius"], [0.1, 0.1])
 
 
 def test_pendulum_system_keeps_its_rod_length(tmp_path):
@@ -166,16 +166,16 @@ def test_streamed_frames_survive_a_crash(tmp_path):
     script = f"""
 import os, numpy as np
 from visviva.io.writer import RecordingWriter
-writer = RecordingWriter({str(path)!r}, units={{"points": "m"}}, flush_every=10)
+writer = RecordingWriter({str(path)!r}, units={{"particle_position": "m"}}, flush_every=10)
 for k in range(25):
-    writer.append(0.1 * k, {{"points": np.full((4, 3), float(k))}})
+    writer.append(0.1 * k, {{"particle_position": np.full((4, 3), float(k))}})
 os._exit(9)  # die without closing the file
 """
     result = subprocess.run([sys.executable, "-c", script], check=False)
     assert result.returncode == 9
     recording = vv.io.load_recording(path)
     assert recording.frames >= 20  # the frames up to the last flush (20) at least
-    np.testing.assert_array_equal(recording["points"][:20, 0, 0], np.arange(20.0))
+    np.testing.assert_array_equal(recording["particle_position"][:20, 0, 0], np.arange(20.0))
     assert recording.attrs["success"] is False
     assert "did not finish" in recording.attrs["message"]
 

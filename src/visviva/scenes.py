@@ -299,10 +299,17 @@ class RunFigures:
                 fields["energy"] = np.asarray(energy, dtype=np.float64)
             writer.append(state.t, fields)
             self.see(state.t, energy)
-            self.points = fields["points"].shape[0] if "points" in fields else 0
+            self.points = drawn_points(fields)
             self.final = final_values(fields)
 
         return record
+
+
+def drawn_points(fields: dict[str, np.ndarray]) -> int:
+    """How many points one recorded frame draws: its particles and its systems' points."""
+    return sum(
+        fields[name].shape[0] for name in ("particle_position", "system_points") if name in fields
+    )
 
 
 #: Recorded fields whose values at the end of a run join its summary, if they are small.

@@ -33,8 +33,8 @@ def _drawn(recording: Recording) -> Recording:
     points[..., 1] += 1.2 * LENGTH  # swing above the video's ground plane
     return Recording(
         recording.time,
-        dict(recording.fields) | {"points": points},
-        units=dict(recording.units) | {"points": "m"},
+        dict(recording.fields) | {"system_points": points},
+        units=dict(recording.units) | {"system_points": "m"},
         attrs=recording.attrs,
         static={"edges": np.array([[0, 1]])},
     )

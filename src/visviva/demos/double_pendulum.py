@@ -38,11 +38,11 @@ def _together(system: Any, pair: Solution) -> Recording:
     edges = np.array(system.edges, dtype=np.int64)
     static = {
         "edges": np.concatenate([edges, edges + 3]),
-        "color": np.array(PIVOT_AND_BOBS[0] + PIVOT_AND_BOBS[1]),
+        "system_color": np.array(PIVOT_AND_BOBS[0] + PIVOT_AND_BOBS[1]),
     }
-    fields = {"q": pair.q[:, 0], "v": pair.v[:, 0], "points": points}
+    fields = {"q": pair.q[:, 0], "v": pair.v[:, 0], "system_points": points}
     attrs = pair.recording.attrs
-    return Recording(pair.t, fields, units={"points": "m"}, attrs=attrs, static=static)
+    return Recording(pair.t, fields, units={"system_points": "m"}, attrs=attrs, static=static)
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
