@@ -83,7 +83,7 @@ def throughput(systems: int, steps: int, repeats: int) -> None:
     system = classic.double_pendulum()
     rng = np.random.default_rng(0)
     q0, v0 = rng.uniform(-2, 2, (systems, 2)), rng.uniform(-1, 1, (systems, 2))
-    t_end = steps * 1e-3
+    until = steps * 1e-3
     y0 = np.concatenate([q0, v0], axis=1)
     cases = {
         "visviva, generated Numba": system.problem(q0, v0, backend="numba"),
@@ -96,7 +96,7 @@ def throughput(systems: int, steps: int, repeats: int) -> None:
         if problem is None:
             call = lambda: common.handwritten_numba_rk4(y0, 0.0, 1e-3, steps)  # noqa: E731
         else:
-            call = lambda p=problem: vv.solve(p, "rk4", dt=1e-3, until=t_end, record_every=steps)  # noqa: E731
+            call = lambda p=problem: vv.solve(p, "rk4", dt=1e-3, until=until, record_every=steps)  # noqa: E731
         timing = common.measure(call, repeats, label)
         rate = systems * steps / timing.median
         rows.append([label, common.fmt_time(timing.median), common.sci(rate)])
