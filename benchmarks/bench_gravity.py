@@ -166,7 +166,7 @@ def bench_direct(args: argparse.Namespace, checks: Checks) -> None:
                 problem,
                 "velocity_verlet",
                 dt=1e-3,
-                t_end=SOLVE_STEPS * 1e-3,
+                until=SOLVE_STEPS * 1e-3,
                 record_every=SOLVE_STEPS,
             ),
             max(1, args.repeats // 2),

@@ -510,7 +510,7 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
     scipy_systems = 10 if args.quick else 100
     steps = 1000
     dt = 1e-3
-    t_end = steps * dt
+    until = steps * dt
     system_steps = systems * steps
     y0 = random_pendulums(systems, seed=20261122)
 
@@ -524,7 +524,7 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
 
     def visviva_run(f: Callable[..., Any]) -> Any:
         problem = vv.ode.FirstOrderProblem(f, y0)
-        return vv.solve(problem, "rk4", dt=dt, t_end=t_end, record_every=steps)
+        return vv.solve(problem, "rk4", dt=dt, until=until, record_every=steps)
 
     vv_numba = measure(lambda: visviva_run(pendulum_numba), args.repeats, "(a) visviva Numba f")
     peer_numba = measure(
@@ -540,7 +540,7 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
         evaluations = 0
         for i in range(scipy_systems):
             solution = solve_ivp(
-                pendulum_numba_returning, (0.0, t_end), y0[i], method="RK45", rtol=1e-6, atol=1e-9
+                pendulum_numba_returning, (0.0, until), y0[i], method="RK45", rtol=1e-6, atol=1e-9
             )
             if not solution.success:
                 raise RuntimeError(f"solve_ivp failed on system {i}: {solution.message}")
@@ -556,7 +556,7 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
         "peer_numba": system_steps / peer_numba.median,
         "peer_numpy": system_steps / peer_numpy.median,
     }
-    system_seconds_per_s = scipy_systems * t_end / peer_scipy.median
+    system_seconds_per_s = scipy_systems * until / peer_scipy.median
     scipy_equivalent = system_seconds_per_s / dt
     scipy_f_per_system = peer_scipy.result[1] / scipy_systems
 
@@ -637,7 +637,7 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
     )
     print()
     print(
-        f"  * solve_ivp: RK45, rtol=1e-6, atol=1e-9, over {t_end:g} s per system, f = the same "
+        f"  * solve_ivp: RK45, rtol=1e-6, atol=1e-9, over {until:g} s per system, f = the same "
         "equations as a Numba function returning the derivative."
     )
     print(
@@ -685,7 +685,7 @@ def bench_batch(args: argparse.Namespace, checks: Checks) -> None:
             f"(y shape {sol.y.shape})",
         )
         checks.check(
-            abs(float(sol.t[-1]) - t_end) < 1e-12,
+            abs(float(sol.t[-1]) - until) < 1e-12,
             f"visviva {name}: last frame at t = {float(sol.t[-1])!r}",
         )
         print(f"       visviva {name}: counters {sol.counters}")
@@ -782,16 +782,16 @@ def ladder_search(
 
 def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
     theta = 0.5
-    t_end = 10.0 if args.quick else 100.0
+    until = 10.0 if args.quick else 100.0
     y0 = np.array([theta, theta, 0.0, 0.0])
-    span = (0.0, t_end)
+    span = (0.0, until)
 
     heading(
         f"(b) Accuracy-matched single system: double pendulum, θ1 = θ2 = {theta} rad, "
-        f"rates 0, t_end = {t_end:g} s"
+        f"rates 0, until = {until:g} s"
     )
     print(
-        "  error = max over the 4 components of |y(t_end) − reference|; reference = solve_ivp "
+        "  error = max over the 4 components of |y(until) − reference|; reference = solve_ivp "
         "DOP853, rtol = atol = 1e-13"
     )
     print(
@@ -818,7 +818,7 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
 
     print(
         f"  reference check: |DOP853(1e-13) − DOP853(3e-14)| = {sci(reference_uncertainty)}; a "
-        f"1e-10 change of θ1(0) changes y(t_end) by {growth:.3g}× as much (regular, not "
+        f"1e-10 change of θ1(0) changes y(until) by {growth:.3g}× as much (regular, not "
         "chaotic, motion)"
     )
 
@@ -833,11 +833,11 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
 
     def visviva_rk4(steps: int) -> Any:
         problem = vv.ode.FirstOrderProblem(pendulum_numba, y0)
-        return vv.solve(problem, "rk4", dt=t_end / steps, t_end=t_end, record_every=steps)
+        return vv.solve(problem, "rk4", dt=until / steps, until=until, record_every=steps)
 
     def visviva_dopri5(rtol: float) -> Any:
         problem = vv.ode.FirstOrderProblem(pendulum_numba, y0)
-        return vv.solve(problem, "dopri5", t_end=t_end, rtol=rtol, atol=1e-3 * rtol)
+        return vv.solve(problem, "dopri5", until=until, rtol=rtol, atol=1e-3 * rtol)
 
     def solution_error(solution: Any) -> float:
         if not solution.success:
@@ -865,7 +865,7 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
         )
         rk4_choice[name] = index
         trail = ", ".join(
-            f"dt={sci(t_end / STEP_LADDER[i])}→{sci(e, 2)}" for i, e in sorted(tried.items())
+            f"dt={sci(until / STEP_LADDER[i])}→{sci(e, 2)}" for i, e in sorted(tried.items())
         )
         print(f"    rk4    to {name:6s} ({sci(target)}): {trail}")
         index, tried = ladder_search(
@@ -934,7 +934,7 @@ def bench_accuracy(args: argparse.Namespace, checks: Checks) -> None:
             f"(b) visviva rk4 matched to {name}",
         )
         add_visviva(
-            f"visviva rk4, matched to {name}", timing, f"dt {sci(t_end / steps)} ({steps:,} steps)"
+            f"visviva rk4, matched to {name}", timing, f"dt {sci(until / steps)} ({steps:,} steps)"
         )
         rtol = RTOL_LADDER[dopri5_choice[name]]
         timing = measure(

@@ -48,7 +48,7 @@ system = classic.double_pendulum()
 derived = time.perf_counter()
 problem = system.problem([2.0, 1.0], [0.0, 0.0])
 compiled = time.perf_counter()
-vv.solve(problem, "rk4", dt=1e-3, t_end=0.01)
+vv.solve(problem, "rk4", dt=1e-3, until=0.01)
 ran = time.perf_counter()
 print(imported - started, derived - imported, compiled - derived, ran - compiled)
 """
@@ -83,7 +83,7 @@ def throughput(systems: int, steps: int, repeats: int) -> None:
     system = classic.double_pendulum()
     rng = np.random.default_rng(0)
     q0, v0 = rng.uniform(-2, 2, (systems, 2)), rng.uniform(-1, 1, (systems, 2))
-    t_end = steps * 1e-3
+    until = steps * 1e-3
     y0 = np.concatenate([q0, v0], axis=1)
     cases = {
         "visviva, generated Numba": system.problem(q0, v0, backend="numba"),
@@ -96,7 +96,7 @@ def throughput(systems: int, steps: int, repeats: int) -> None:
         if problem is None:
             call = lambda: common.handwritten_numba_rk4(y0, 0.0, 1e-3, steps)  # noqa: E731
         else:
-            call = lambda p=problem: vv.solve(p, "rk4", dt=1e-3, t_end=t_end, record_every=steps)  # noqa: E731
+            call = lambda p=problem: vv.solve(p, "rk4", dt=1e-3, until=until, record_every=steps)  # noqa: E731
         timing = common.measure(call, repeats, label)
         rate = systems * steps / timing.median
         rows.append([label, common.fmt_time(timing.median), common.sci(rate)])

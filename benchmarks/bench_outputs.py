@@ -74,8 +74,8 @@ def main() -> None:
             import h5py
 
             with h5py.File(Path(tmp) / "floor.h5", "w") as file:
-                file.create_dataset("points", data=recording["points"])
-                file.create_dataset("velocities", data=recording["velocities"])
+                file.create_dataset("particle_position", data=recording["particle_position"])
+                file.create_dataset("particle_velocity", data=recording["particle_velocity"])
 
         timed("h5py, the same arrays in one call (floor)", floor)
         print(f"  recording.h5: {size(out / 'recording.h5')}")

@@ -42,7 +42,7 @@ def swirl(count: int, frames: int, fps: float = 30.0) -> vv.Recording:
     points[..., 0] = radius * np.cos(angle)
     points[..., 2] = radius * np.sin(angle)
     points[..., 1] = height + 0.2 * np.sin(2.0 * t[:, None] + phase)
-    return vv.Recording(t, {"points": points}, units={"points": "m"})
+    return vv.Recording(t, {"particle_position": points}, units={"particle_position": "m"})
 
 
 def timed(label: str, call):
@@ -88,7 +88,7 @@ def main() -> None:
         print(f"  {'  per frame':50s} {1e3 * seconds / frames:8.1f} ms")
         gif = Path(folder) / "swirl.gif"
         short = vv.Recording(
-            recording.time[: frames // 3], {"points": geometry.points[: frames // 3]}
+            recording.time[: frames // 3], {"particle_position": geometry.points[: frames // 3]}
         )
         timed(
             f"render_video → gif 480×270, {frames // 3} frames",

@@ -76,7 +76,8 @@ def waving_cloth(n: int = 64, frames: int = 300) -> vv.Recording:
     i, j = np.meshgrid(np.arange(n - 1), np.arange(n - 1), indexing="ij")
     a = (i * n + j).ravel()
     faces = np.concatenate([np.stack([a, a + 1, a + n], 1), np.stack([a + 1, a + n + 1, a + n], 1)])
-    return vv.Recording(t, {"points": points}, static={"faces": faces}, units={"points": "m"})
+    units = {"particle_position": "m"}
+    return vv.Recording(t, {"particle_position": points}, static={"faces": faces}, units=units)
 
 
 def falling() -> vv.Recording:
@@ -86,7 +87,9 @@ def falling() -> vv.Recording:
     points[:, :, 0] = [0.0, 1.0, 2.0]
     points[:, :, 1] = 2.0 - 4.9 * t[:, None] ** 2
     return vv.Recording(
-        t, {"points": points}, static={"radius": np.full(3, 0.1), "edges": np.array([[0, 1]])}
+        t,
+        {"particle_position": points},
+        static={"particle_radius": np.full(3, 0.1), "edges": np.array([[0, 1]])},
     )
 
 

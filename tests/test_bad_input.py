@@ -3,8 +3,8 @@
 The promise (DESIGN.md, "Contracts worth keeping stable"): invalid input raises
 :class:`visviva.ModelError` naming the argument, the value received and what is accepted, and it
 does so before the first step. To prove "before any step", the user functions here count their
-calls: building a problem calls each function exactly once to validate it, and ``solve`` /
-``simulate`` with an invalid argument must not call ``f`` at all.
+calls: building a problem calls each function exactly once to validate it, and ``solve``
+with an invalid argument must not call ``f`` at all.
 """
 
 from __future__ import annotations
@@ -256,7 +256,7 @@ def test_complex_rate_for_a_real_state_is_refused(build):
 
 def test_complex_state_with_complex_rate_is_accepted():
     rotation = vv.ode.FirstOrderProblem(lambda t, y: 1j * y, y0=[1.0 + 0j])
-    sol = vv.solve(rotation, method="rk4", dt=1e-3, t_end=1.0)
+    sol = vv.solve(rotation, method="rk4", dt=1e-3, until=1.0)
     # y(t) = exp(i t); RK4's global error is O(h^4) = 1e-12 here.
     np.testing.assert_allclose(sol.y[-1, 0], np.exp(1j), atol=1e-11)
 
@@ -496,27 +496,27 @@ def test_bad_initial_time_is_refused(kind, t0, shown):
 def test_solve_refuses_bad_dt(decay, method, dt, shown):
     """dt ≤ 0, non-finite or not a real number is named with its value; f is never called."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, method, dt=dt, t_end=1.0), "`dt`", shown)
+    refused(lambda: vv.solve(problem, method, dt=dt, until=1.0), "`dt`", shown)
     assert f.calls == 0
 
 
 def test_solve_refuses_dt_too_small_to_count_the_steps(decay):
     """A denormal dt gives an infinite number of steps: refused as a bad `dt`, not an overflow."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, "rk4", dt=5e-324, t_end=1.0), "`dt`", "5e-324")
+    refused(lambda: vv.solve(problem, "rk4", dt=5e-324, until=1.0), "`dt`", "5e-324")
     assert f.calls == 0
 
 
 @pytest.mark.parametrize("method", ["rk4", "dopri5"])
 @pytest.mark.parametrize(
-    ("t_end", "fragments"),
+    ("until", "fragments"),
     [(-1.0, ("-1.0", "t0", "0.0")), (math.nan, ("nan",)), ("1", ("'1'",)), (10**400, ())],
     ids=["before-t0", "nan", "string", "int-beyond-float"],
 )
-def test_solve_refuses_bad_t_end(decay, method, t_end, fragments):
-    """t_end before t0 or not a finite number is named with its value; f is never called."""
+def test_solve_refuses_bad_until(decay, method, until, fragments):
+    """until before t0 or not a finite number is named with its value; f is never called."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, method, dt=0.1, t_end=t_end), "`t_end`", *fragments)
+    refused(lambda: vv.solve(problem, method, dt=0.1, until=until), "`until`", *fragments)
     assert f.calls == 0
 
 
@@ -528,7 +528,7 @@ def test_unknown_method_lists_valid_names_and_suggests_the_closest(spring, typo,
     """A misspelt method gets "Did you mean" plus every valid name; nothing is integrated."""
     problem, acceleration = spring
     message = refused(
-        lambda: vv.solve(problem, typo, dt=0.1, t_end=1.0),
+        lambda: vv.solve(problem, typo, dt=0.1, until=1.0),
         repr(typo),
         f"Did you mean {suggestion}?",
     )
@@ -541,7 +541,7 @@ def test_unknown_method_far_from_every_name_lists_the_valid_ones(decay):
     """A name close to nothing gets the list of valid names and no misleading suggestion."""
     problem, f = decay
     message = refused(
-        lambda: vv.solve(problem, "no_such_method", dt=0.1, t_end=1.0),
+        lambda: vv.solve(problem, "no_such_method", dt=0.1, until=1.0),
         "'no_such_method'",
         "rk4",
         "velocity_verlet",
@@ -557,7 +557,7 @@ def test_unknown_method_far_from_every_name_lists_the_valid_ones(decay):
 def test_method_that_is_not_a_name_is_refused(decay, method, type_name):
     """method must be a name or an Integrator; the type received is named."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, method, dt=0.1, t_end=1.0), "`method`", type_name)
+    refused(lambda: vv.solve(problem, method, dt=0.1, until=1.0), "`method`", type_name)
     assert f.calls == 0
 
 
@@ -566,7 +566,7 @@ def test_split_state_method_on_first_order_problem_is_refused(decay, method):
     """Symplectic (q, v) methods need a SecondOrderProblem; the message says how to build one."""
     problem, f = decay
     refused(
-        lambda: vv.solve(problem, method, dt=0.1, t_end=1.0),
+        lambda: vv.solve(problem, method, dt=0.1, until=1.0),
         repr(method),
         "second-order",
         "SecondOrderProblem",
@@ -582,7 +582,7 @@ def test_adaptive_options_are_refused_for_fixed_step_methods(decay, option, valu
     """rtol/atol/t_eval/dense_output would be silently ignored by rk4: refused instead."""
     problem, f = decay
     refused(
-        lambda: vv.solve(problem, "rk4", dt=0.1, t_end=1.0, **{option: value}),
+        lambda: vv.solve(problem, "rk4", dt=0.1, until=1.0, **{option: value}),
         f"`{option}`",
         "adaptive",
     )
@@ -592,7 +592,7 @@ def test_adaptive_options_are_refused_for_fixed_step_methods(decay, option, valu
 def test_fixed_step_method_needs_dt(decay):
     """rk4 without dt is refused, naming dt and the method."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, "rk4", t_end=1.0), "`dt`", "required", "'rk4'")
+    refused(lambda: vv.solve(problem, "rk4", until=1.0), "`dt`", "required", "'rk4'")
     assert f.calls == 0
 
 
@@ -600,7 +600,7 @@ def test_adaptive_run_needs_a_method_with_error_control(decay):
     """adaptive=True for rk4 is refused and the adaptive methods are listed."""
     problem, f = decay
     refused(
-        lambda: vv.solve(problem, "rk4", dt=0.1, t_end=1.0, adaptive=True),
+        lambda: vv.solve(problem, "rk4", dt=0.1, until=1.0, adaptive=True),
         "'rk4'",
         "error control",
         "dopri5",
@@ -622,7 +622,7 @@ def test_record_every_and_substeps_must_be_positive_whole_numbers(decay, option,
     """Frame and substep counts are whole numbers ≥ 1; a bad one is named with its value."""
     problem, f = decay
     refused(
-        lambda: vv.solve(problem, "rk4", dt=0.1, t_end=1.0, **{option: value}), f"`{option}`", shown
+        lambda: vv.solve(problem, "rk4", dt=0.1, until=1.0, **{option: value}), f"`{option}`", shown
     )
     assert f.calls == 0
 
@@ -630,20 +630,20 @@ def test_record_every_and_substeps_must_be_positive_whole_numbers(decay, option,
 @pytest.mark.parametrize(
     ("t_eval", "fragments"),
     [
-        ([-0.5, 0.5], ("[t0, t_end]", "-0.5")),
-        ([0.5, 2.0], ("[t0, t_end]", "2.0")),
+        ([-0.5, 0.5], ("[t0, until]", "-0.5")),
+        ([0.5, 2.0], ("[t0, until]", "2.0")),
         ([0.5, 0.2], ("increasing", "0.2")),
         ([0.5, 0.5, 0.7], ("increasing", "0.5")),
         ([], ("empty",)),
         ([0.5, math.nan], ("finite", "nan")),
     ],
-    ids=["before-t0", "after-t_end", "decreasing", "repeated", "empty", "nan"],
+    ids=["before-t0", "after-until", "decreasing", "repeated", "empty", "nan"],
 )
 def test_dopri5_refuses_bad_t_eval(decay, t_eval, fragments):
-    """Output times must be finite, strictly increasing and inside [t0, t_end]; the offending
+    """Output times must be finite, strictly increasing and inside [t0, until]; the offending
     time is shown."""
     problem, f = decay
-    refused(lambda: vv.solve(problem, "dopri5", t_end=1.0, t_eval=t_eval), "`t_eval`", *fragments)
+    refused(lambda: vv.solve(problem, "dopri5", until=1.0, t_eval=t_eval), "`t_eval`", *fragments)
     assert f.calls == 0
 
 
@@ -655,7 +655,7 @@ def test_dopri5_refuses_bad_tolerances(decay, option, value):
     """Tolerances must be finite, rtol > 0 and atol ≥ 0."""
     problem, f = decay
     refused(
-        lambda: vv.solve(problem, "dopri5", t_end=1.0, **{option: value}),
+        lambda: vv.solve(problem, "dopri5", until=1.0, **{option: value}),
         f"`{option}`",
         repr(value),
     )
@@ -669,26 +669,30 @@ def test_compiled_true_that_cannot_be_honoured_is_refused(decay, method, fragmen
     """compiled=True with a NumPy f, or with an adaptive method, is refused, not ignored."""
     problem, f = decay
     refused(
-        lambda: vv.solve(problem, method, dt=0.1, t_end=1.0, compiled=True),
+        lambda: vv.solve(problem, method, dt=0.1, until=1.0, compiled=True),
         "compiled=True",
         *fragments,
     )
     assert f.calls == 0
 
 
-@pytest.mark.parametrize("run", [vv.solve, vv.simulate], ids=["solve", "simulate"])
-def test_something_that_is_not_a_problem_is_refused(run):
+def test_something_that_is_not_a_problem_is_refused():
     """Passing the right-hand side itself instead of a problem is a ModelError naming `problem`."""
     refused(
-        lambda: run(restoring, "rk4", dt=0.1, t_end=1.0),
+        lambda: vv.solve(restoring, "rk4", dt=0.1, until=1.0),
         "`problem`",
         "function",
         "FirstOrderProblem",
     )
 
 
+def test_simulate_is_gone_and_says_what_replaced_it():
+    with pytest.raises(AttributeError, match=r"merged into vv.solve: .*raise_for_status"):
+        vv.simulate  # noqa: B018
+
+
 # --------------------------------------------------------------------------------------------
-# vv.simulate: the same core cases through the loop's own entry point.
+# vv.solve with a fixed-step method: the same core cases as the loop sees them.
 
 
 @pytest.mark.parametrize(
@@ -700,8 +704,8 @@ def test_something_that_is_not_a_problem_is_refused(run):
         ({"dt": math.inf}, ("`dt`", "inf")),
         ({"dt": "0.1"}, ("`dt`", "'0.1'")),
         ({"dt": True}, ("`dt`", "True")),
-        ({"t_end": -1.0}, ("`t_end`", "-1.0", "t0")),
-        ({"t_end": math.nan}, ("`t_end`", "nan")),
+        ({"until": -1.0}, ("`until`", "-1.0", "t0")),
+        ({"until": math.nan}, ("`until`", "nan")),
         ({"method": "rk5"}, ("'rk5'", "Did you mean 'rk4'?", "velocity_verlet")),
         ({"method": 4}, ("`method`", "int")),
         ({"record_every": 0}, ("`record_every`", "0")),
@@ -714,23 +718,12 @@ def test_something_that_is_not_a_problem_is_refused(run):
         "-".join(f"{k}={v}" for k, v in value.items()) if isinstance(value, dict) else None
     ),
 )
-def test_simulate_refuses_bad_arguments(decay, arguments, fragments):
-    """vv.simulate names the bad argument and its value, and never calls f."""
+def test_fixed_step_solve_refuses_bad_arguments(decay, arguments, fragments):
+    """vv.solve names the bad argument and its value, and never calls f."""
     problem, f = decay
-    options = {"method": "rk4", "dt": 0.1, "t_end": 1.0} | arguments
+    options = {"method": "rk4", "dt": 0.1, "until": 1.0} | arguments
     method = options.pop("method")
-    refused(lambda: vv.simulate(problem, method, **options), *fragments)
-    assert f.calls == 0
-
-
-def test_simulate_refuses_symplectic_method_on_first_order_problem(decay):
-    """velocity_verlet needs the split (q, v) state; simulate says so before stepping."""
-    problem, f = decay
-    refused(
-        lambda: vv.simulate(problem, "velocity_verlet", dt=0.1, t_end=1.0),
-        "'velocity_verlet'",
-        "SecondOrderProblem",
-    )
+    refused(lambda: vv.solve(problem, method, **options), *fragments)
     assert f.calls == 0
 
 
@@ -851,7 +844,7 @@ def test_stability_interval_of_unknown_method_suggests_the_closest():
         ),
         (
             lambda: vv.solve(
-                FirstOrderProblem(restoring, [1.0]), "dopri5", t_end=1.0, t_eval=[0.5, 2.0]
+                FirstOrderProblem(restoring, [1.0]), "dopri5", until=1.0, t_eval=[0.5, 2.0]
             ),
             "[0.5, 2.0]",
         ),
@@ -886,6 +879,6 @@ def test_any_bad_dt_is_a_model_error_about_dt(dt, method):
     problem = SecondOrderProblem(acceleration, [1.0], [0.0])
     acceleration.calls = 0
     with pytest.raises(ModelError) as caught:
-        vv.solve(problem, method, dt=dt, t_end=1.0)
+        vv.solve(problem, method, dt=dt, until=1.0)
     assert "dt" in str(caught.value)
     assert acceleration.calls == 0

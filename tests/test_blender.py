@@ -74,7 +74,7 @@ def falling_points() -> vv.Recording:
     points[:, :, 1] = 2.0 - 4.9 * t[:, None] ** 2
     points[:, :, 2] = np.sin(t[:, None] * np.array([1.0, 2.0, 3.0, 4.0]))
     radius = np.array([0.1, 0.05, 0.2, 0.1])
-    return vv.Recording(t, {"points": points}, static={"radius": radius})
+    return vv.Recording(t, {"particle_position": points}, static={"particle_radius": radius})
 
 
 def folding_quad_and_a_ball() -> vv.Recording:
@@ -87,13 +87,14 @@ def folding_quad_and_a_ball() -> vv.Recording:
     points[:, 4, 1] = np.sin(2.0 * t)
     points[:, :, 1] += 0.5 * t[:, None]
     faces = np.array([[1, 3, 2], [2, 3, 4]])
-    return vv.Recording(t, {"points": points}, static={"faces": faces})
+    return vv.Recording(t, {"particle_position": points}, static={"faces": faces})
 
 
 def _checked(recording: vv.Recording) -> tuple[np.ndarray, list[int], float]:
     shown = frames_at_rate(recording.time, FPS)
-    tolerance = 2e-6 * max(1.0, float(np.abs(recording["points"]).max()))  # float32, twice
-    return recording["points"][shown], [0, shown.size // 2, shown.size - 1], tolerance
+    points = recording.geometry().points
+    tolerance = 2e-6 * max(1.0, float(np.abs(points).max()))  # float32, twice
+    return points[shown], [0, shown.size // 2, shown.size - 1], tolerance
 
 
 def test_points_in_usd_and_gltf(tmp_path):
@@ -137,7 +138,7 @@ def test_kepler_demo_glb_is_small_and_right_in_blender(tmp_path):
     assert glb.stat().st_size <= 1_000_000  # 21 MB with dense morph weights before
     (run, *_) = vv.io.read_recordings(tmp_path / "recording.h5").values()
     expected, frames, tolerance = _checked(run)
-    tolerance = 1e-6 * float(np.abs(run["points"]).max()) * 4
+    tolerance = 1e-6 * float(np.abs(run["system_points"]).max()) * 4
     for path, key in ((glb, "bodies"), (tmp_path / "scene.usdc", "points")):
         view = blender_view(path, frames)
         for k in frames:

@@ -20,10 +20,10 @@ def test_rock_follows_the_parabola():
     q0, v0 = np.array([0.0, 1.0, 0.0]), np.array([3.0, 8.0, -1.0])
     problem = classic.rock(mass=0.5).problem(q0, v0)
     exact = lambda t: classic.rock_trajectory(t, q0, v0)  # noqa: E731
-    verlet = vv.solve(problem, method="velocity_verlet", dt=0.01, t_end=1.5)
+    verlet = vv.solve(problem, method="velocity_verlet", dt=0.01, until=1.5)
     np.testing.assert_allclose(verlet.q, exact(verlet.t), atol=1e-12)
     h = 0.01
-    euler = vv.solve(problem, method="explicit_euler", dt=h, t_end=1.5)
+    euler = vv.solve(problem, method="explicit_euler", dt=h, until=1.5)
     error = euler.q[:, 1] - exact(euler.t)[:, 1]
     np.testing.assert_allclose(error, 0.5 * G * h * euler.t, atol=1e-12)
 
@@ -33,13 +33,13 @@ def test_reduced_and_constrained_pendulums_agree():
     motion, both RK4 at h = 1e-3 (global error ~h⁴)."""
     theta0, length = 1.2, 0.8
     reduced = vv.solve(
-        classic.pendulum(length=length).problem([theta0], [0.0]), method="rk4", dt=1e-3, t_end=5.0
+        classic.pendulum(length=length).problem([theta0], [0.0]), method="rk4", dt=1e-3, until=5.0
     )
     for alpha in (0.0, 20.0):
         problem, multiplier = classic.constrained_pendulum(
             theta0, length=length, stabilization_rate=alpha
         )
-        particle = vv.solve(problem, method="rk4", dt=1e-3, t_end=5.0)
+        particle = vv.solve(problem, method="rk4", dt=1e-3, until=5.0)
         x, y = particle.q[:, 0], particle.q[:, 1]
         np.testing.assert_allclose(np.arctan2(x, -y), reduced.q[:, 0], atol=1e-7)
         drift = np.abs(np.hypot(x, y) - length).max()
@@ -57,7 +57,7 @@ def test_baumgarte_pulls_a_drifted_particle_back_to_the_circle():
     off = vv.ode.SecondOrderProblem(
         problem.force.func, problem.q0 * 1.01, problem.v0, energy=problem.energy.func
     )
-    solution = vv.solve(off, method="rk4", dt=1e-3, t_end=1.0)
+    solution = vv.solve(off, method="rk4", dt=1e-3, until=1.0)
     radius = np.hypot(solution.q[:, 0], solution.q[:, 1])
     assert abs(radius[0] - 1.01) < 1e-12 and abs(radius[-1] - 1.0) < 1e-6
 
@@ -76,14 +76,14 @@ def test_spring_pendulum_equations_and_energy():
         -(2 * rdot * thetadot + G * math.sin(theta)) / r,
     ]
     np.testing.assert_allclose(out, expected, rtol=1e-13)
-    solution = vv.solve(problem, method="rk4", dt=1e-3, t_end=10.0)
+    solution = vv.solve(problem, method="rk4", dt=1e-3, until=10.0)
     assert np.ptp(solution.energy) / abs(solution.energy[0]) < 1e-9  # RK4 drift ~ h⁴ per unit time
 
 
 @pytest.mark.parametrize("damping", [0.4, 4.0, 10.0])  # under-, critically and over-damped
 def test_damped_oscillator_matches_every_regime(damping):
     system = classic.damped_oscillator(mass=1.0, stiffness=4.0, damping=damping)
-    solution = vv.solve(system.problem([1.0], [0.5]), method="rk4", dt=1e-3, t_end=4.0)
+    solution = vv.solve(system.problem([1.0], [0.5]), method="rk4", dt=1e-3, until=4.0)
     exact = classic.damped_oscillator_solution(
         solution.t, 1.0, 0.5, mass=1.0, stiffness=4.0, damping=damping
     )
@@ -107,7 +107,7 @@ def test_pendulum_period_limits_and_errors():
 
 def test_small_angle_solution_is_the_linearised_motion():
     theta = classic.pendulum(length=1.0)
-    solution = vv.solve(theta.problem([1e-3], [0.0]), method="rk4", dt=1e-3, t_end=3.0)
+    solution = vv.solve(theta.problem([1e-3], [0.0]), method="rk4", dt=1e-3, until=3.0)
     linear = classic.small_angle_pendulum(solution.t, 1e-3, length=1.0)
     # The neglected sin θ − θ ≈ θ³/6 shifts the phase by ~θ0²/16 per radian: ~1e-7 · ω t · θ0.
     np.testing.assert_allclose(solution.q[:, 0], linear, atol=1e-9)

@@ -62,9 +62,9 @@ def _recording(tmp_path: Path, **fields) -> Path:
 
 
 def test_plot_refuses_a_recording_without_energy_or_momenta(monkeypatch, capsys, tmp_path):
-    path = _recording(tmp_path, points=np.zeros((5, 2, 3)))
+    path = _recording(tmp_path, particle_position=np.zeros((5, 2, 3)))
     line = refused(monkeypatch, capsys, "plot", path, "--energy")
-    assert "no energy to plot" in line and "(fields: points)" in line
+    assert "no energy to plot" in line and "(fields: particle_position)" in line
     for flags in ((), ("--momentum",)):
         line = refused(monkeypatch, capsys, "plot", path, *flags)
         assert "neither energy nor momenta" in line
@@ -74,8 +74,8 @@ def test_plot_refuses_a_recording_without_energy_or_momenta(monkeypatch, capsys,
 def test_plot_draws_what_the_recording_has(monkeypatch, capsys, tmp_path):
     recording = vv.Recording(
         np.linspace(0.0, 1.0, 5),
-        {"points": np.zeros((5, 2, 3)), "velocities": np.ones((5, 2, 3))},
-        static={"mass": np.ones(2)},
+        {"particle_position": np.zeros((5, 2, 3)), "particle_velocity": np.ones((5, 2, 3))},
+        static={"particle_mass": np.ones(2)},
     )
     path = vv.io.save_recording(recording, tmp_path / "recording.h5")
     status, out, err = run_main(monkeypatch, capsys, "plot", path)
@@ -85,7 +85,8 @@ def test_plot_draws_what_the_recording_has(monkeypatch, capsys, tmp_path):
 
 def test_several_runs_are_chosen_with_the_run_flag(monkeypatch, capsys, tmp_path):
     time = np.linspace(0.0, 1.0, 3)
-    runs = {name: vv.Recording(time, {"points": np.zeros((3, 1, 3))}) for name in ("a", "b")}
+    points = {"particle_position": np.zeros((3, 1, 3))}
+    runs = {name: vv.Recording(time, points) for name in ("a", "b")}
     path = vv.io.write_recordings(tmp_path / "recording.h5", runs)
     line = refused(monkeypatch, capsys, "view", path)
     assert "--run NAME" in line and "run=" not in line.replace("(in Python: run=NAME)", "")
@@ -108,7 +109,7 @@ def test_compare_keeps_a_hostile_scene_name_inside_out(monkeypatch, capsys, tmp_
     scene.write_text(vv.io.dump_scene(builder.scene))
     monkeypatch.chdir(scene.parent)
     status, _, err = run_main(
-        monkeypatch, capsys, "compare", scene, "rk4", "--convergence-time", "0.1"
+        monkeypatch, capsys, "compare", scene, "rk4", "--convergence-duration", "0.1"
     )
     assert status == 0, err
     assert (scene.parent / "out" / "compare-escape" / "summary.json").exists()
@@ -134,7 +135,7 @@ def test_a_figure_needs_an_image_suffix_and_may_go_into_a_new_folder(monkeypatch
 
 
 def test_export_to_obj_prints_one_line(monkeypatch, capsys, tmp_path):
-    path = _recording(tmp_path, points=np.zeros((5, 2, 3)))
+    path = _recording(tmp_path, particle_position=np.zeros((5, 2, 3)))
     status, out, err = run_main(monkeypatch, capsys, "export", path, "--to", "obj", "--fps", "4")
     assert status == 0, err
     assert out.splitlines() == [f"wrote 5 OBJ files into {tmp_path / 'obj'}/ (frame_0000.obj …)"]
@@ -148,7 +149,9 @@ def test_export_plays_at_the_speed_its_run_was_made_with(monkeypatch, capsys, tm
     points = np.zeros((53, 1, 3))
     points[:, 0, 0] = np.cos(2 * np.pi * t / year)
     recording = vv.Recording(
-        t, {"points": points}, attrs={"playback_speed": week, "playback_trail": 8 * week}
+        t,
+        {"particle_position": points},
+        attrs={"playback_speed": week, "playback_trail": 8 * week},
     )
     path = vv.io.save_recording(recording, tmp_path / "recording.h5")
     status, out, err = run_main(monkeypatch, capsys, "export", path, "--to", "gif", "--fps", "2")
@@ -181,7 +184,7 @@ def test_demos_record_how_they_play(tmp_path):
     for run in vv.io.read_recordings(tmp_path / "recording.h5").values():
         assert run.attrs["playback_speed"] == kepler.speed
         assert run.attrs["playback_trail"] == kepler.trail > 0.0  # Kepler's ellipse is drawn
-        assert run.static["color"].shape == (2, 3)
+        assert run.static["system_color"].shape == (2, 3)
 
 
 @pytest.mark.parametrize(
@@ -196,7 +199,7 @@ def test_demos_record_how_they_play(tmp_path):
     ],
 )
 def test_playback_numbers_at_the_edge_of_a_float(monkeypatch, capsys, tmp_path, args, fragment):
-    path = _recording(tmp_path, points=np.zeros((5, 2, 3)))
+    path = _recording(tmp_path, particle_position=np.zeros((5, 2, 3)))
     command, *options = args
     status, _, err = run_main(monkeypatch, capsys, command, path, *options)
     assert "Traceback" not in err

@@ -40,9 +40,9 @@ def _speed_error(dt: float) -> float:
     """Largest |v(t) − v⁰(1 − e^(−t/τ))| over 5τ of a lone agent starting at rest."""
     simulation = vv.Simulation(_walker(dt, 5 * TAU).build())
     recording = simulation.record(until=5 * TAU, record_every=1)
-    t, v = recording.time, recording["velocities"][:, 0, :]
+    t, v = recording.time, recording["particle_velocity"][:, 0, :]
     assert np.all(v[:, 1] == 0.0) and np.all(v[:, 2] == 0.0)  # straight along x, no fall
-    assert np.all(recording["points"][:, 0, 1] == 1.0)  # the height is kept
+    assert np.all(recording["particle_position"][:, 0, 1] == 1.0)  # the height is kept
     return float(np.abs(v[:, 0] - V0 * (1.0 - np.exp(-t / TAU))).max())
 
 

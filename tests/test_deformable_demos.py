@@ -27,7 +27,7 @@ def outputs(directory: Path, figure: str) -> vv.simulation.Recording:
         assert (directory / file).stat().st_size > 1000, file
     assert summary(directory)["complete"] is True
     recording = next(iter(vv.io.read_recordings(directory / "recording.h5").values()))
-    points = recording["points"]
+    points = recording["particle_position"]
     assert points.shape[0] > 10 and points.shape[1] > 0
     assert np.abs(points[-1] - points[0]).max() > 1e-3
     return recording
@@ -47,7 +47,7 @@ def test_cloth_hang_never_gains_energy_and_rests_on_its_pins(tmp_path):
     assert load["springs_pull_down"] == pytest.approx(load["free_points_weight"], rel=1e-3)
     assert load["springs_pull_sideways"] < 1e-3 * load["cloth_weight_M_g"]
     # The pins stay where they are to the last bit; the fabric stretches by about 1 %.
-    pins = recording["points"][:, [0, 19]]
+    pins = recording["particle_position"][:, [0, 19]]
     assert np.array_equal(pins, np.broadcast_to(pins[0], pins.shape))
     assert 0.0 < data["largest_stretch_at_rest"] < 0.02
     assert 0.0 < data["sag_at_rest_m"]["top_edge_middle"] < 0.05
@@ -88,7 +88,7 @@ def test_flag_leans_where_the_wind_and_its_weight_balance(tmp_path):
     angle = data["deflection_deg"]
     assert abs(angle["mean_second_half"] - angle["rigid_plate"]) < angle["tolerance"]
     assert angle["drag_over_weight"] < angle["mean_second_half"] < angle["largest"]
-    staff = recording["points"][:, :16]
+    staff = recording["particle_position"][:, :16]
     assert np.array_equal(staff, np.broadcast_to(staff[0], staff.shape))
 
 
@@ -102,7 +102,7 @@ def test_hair_swings_from_the_turning_head_with_the_period_of_a_hanging_chain(tm
     assert roots["off_hairline_m"] <= roots["tolerance_m"]
     assert roots["turn_spread_rad"] < 1e-12 and roots["turn_error_rad"] < 1e-12
     assert roots["still_before_turn"] is True and roots["still_after_stop"] is True
-    t, velocities = recording.time, recording["velocities"][:, [0, 8, 18, 30, 44]]
+    t, velocities = recording.time, recording["particle_velocity"][:, [0, 8, 18, 30, 44]]
     turn = data["head_turn"]
     during = (t > turn["start"] + turn["ramp"]) & (t < turn["stop"] - turn["ramp"])
     # At full speed each root moves at ω R along the hairline, and before and after, not at all.

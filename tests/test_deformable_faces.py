@@ -235,7 +235,7 @@ def cloth(tmp_path_factory: pytest.TempPathFactory) -> vv.Recording:
     vv.io.save_recording(recorded, path)
     recording = vv.io.load_recording(path)
     assert recording.static["faces"].shape == (2 * 5 * 4, 3) and "edges" not in recording.static
-    points = recording["points"]
+    points = recording["particle_position"]
     assert np.abs(points[-1] - points[0]).max() > 0.1  # it fell and swung
     return recording
 
@@ -251,7 +251,7 @@ def test_usd_holds_the_sheet_as_one_mesh_of_its_triangles(cloth, tmp_path):
     shown = frames_at_rate(cloth.time, FPS)
     last = shown.size - 1
     read = np.array(mesh.GetPointsAttr().Get(last))
-    np.testing.assert_allclose(read, cloth["points"][shown[last]], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(read, cloth["particle_position"][shown[last]], rtol=0, atol=1e-6)
 
 
 def test_gltf_holds_the_sheet_as_one_primitive_of_its_triangles(cloth, tmp_path):
@@ -355,10 +355,11 @@ def test_points_off_the_surface_keep_their_spheres_radii_and_colours(browser, tm
     points[:, :, 1] += t[:, None]
     static = {
         "faces": np.array([[0, 2, 1], [1, 2, 3]]),
-        "radius": np.array([0.08, 0.08, 0.08, 0.08, 0.2, 0.1]),
-        "color": np.array([[1.0, 0.0, 0.0]] * 4 + [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+        "particle_radius": np.array([0.08, 0.08, 0.08, 0.08, 0.2, 0.1]),
+        "particle_color": np.array([[1.0, 0.0, 0.0]] * 4 + [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
     }
-    recording = vv.Recording(t, {"points": points}, static=static, units={"points": "m"})
+    fields, units = {"particle_position": points}, {"particle_position": "m"}
+    recording = vv.Recording(t, fields, static=static, units=units)
     _, drawn = shown(browser, write_viewer(recording, tmp_path / "mixed.html"), 5)
     assert drawn["count"] == 2 and drawn["colours"] == [[0, 255, 0], [0, 0, 255]]
     np.testing.assert_allclose(drawn["radii"], [0.2, 0.1], rtol=1e-6)

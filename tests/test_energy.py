@@ -46,7 +46,7 @@ def _oscillator(compiled=False):
 def test_euler_energy_factor_is_exact(method, sign):
     """E_n / E_0 = (1 + (ωh)²)^(±n) to round-off."""
     dt, n = 0.01, 300
-    solution = vv.solve(_oscillator(), method, dt=dt, t_end=n * dt)
+    solution = vv.solve(_oscillator(), method, dt=dt, until=n * dt)
     steps = np.arange(n + 1)
     expected = (1.0 + (OMEGA * dt) ** 2) ** (sign * steps)
     np.testing.assert_allclose(solution.energy / solution.energy[0], expected, rtol=1e-9)
@@ -54,7 +54,7 @@ def test_euler_energy_factor_is_exact(method, sign):
 
 def _energy_error(method, dt, steps):
     solution = vv.solve(
-        _oscillator(compiled=True), method, dt=dt, t_end=steps * dt, record_every=100
+        _oscillator(compiled=True), method, dt=dt, until=steps * dt, record_every=100
     )
     assert solution.recording.attrs["compiled"]
     return solution.energy / solution.energy[0] - 1.0
@@ -96,7 +96,7 @@ def test_symplectic_euler_energy_error_has_its_closed_form(method):
 @pytest.mark.parametrize("method", ["trapezoidal", "implicit_midpoint"])
 def test_implicit_second_order_methods_conserve_linear_energy(method):
     """|R(iy)| = 1: the energy of a linear oscillator is kept to the Newton tolerance."""
-    solution = vv.solve(_oscillator(), method, dt=0.1, t_end=100.0)
+    solution = vv.solve(_oscillator(), method, dt=0.1, until=100.0)
     np.testing.assert_allclose(solution.energy, solution.energy[0], rtol=1e-9)
 
 
@@ -104,7 +104,7 @@ def test_implicit_second_order_methods_conserve_linear_energy(method):
 def test_runge_kutta_slowly_loses_energy(method):
     """|R(iy)| < 1 just inside the imaginary interval: RK4 damps, by (1 − (ωh)^6/72)^2 per
     step to leading order — a small, monotone loss, not an oscillation."""
-    solution = vv.solve(_oscillator(), method, dt=0.05, t_end=100.0, adaptive=False)
+    solution = vv.solve(_oscillator(), method, dt=0.05, until=100.0, adaptive=False)
     ratio = solution.energy / solution.energy[0]
     assert np.all(np.diff(ratio) <= 1e-15)
     if method == "rk4":
@@ -125,7 +125,7 @@ def test_verlet_runs_backwards_to_its_start(method):
         vv.ode.SecondOrderProblem(acceleration, q0, v0),
         method,
         dt=0.01,
-        t_end=10.0,
+        until=10.0,
         record_every=1000,
     )
     q1, v1 = forward.q[-1], forward.v[-1]
@@ -133,7 +133,7 @@ def test_verlet_runs_backwards_to_its_start(method):
         vv.ode.SecondOrderProblem(acceleration, q1, -v1),
         method,
         dt=0.01,
-        t_end=10.0,
+        until=10.0,
         record_every=1000,
     )
     np.testing.assert_allclose(back.q[-1], q0, rtol=0, atol=1e-13)
@@ -148,7 +148,7 @@ def test_explicit_euler_energy_grows_on_the_circle_of_seed_004():
     h, n = 0.1, 200
     radius = {}
     for method in ("explicit_euler", "backward_euler", "symplectic_euler"):
-        s = vv.solve(circular_problem(), method, dt=h, t_end=n * h)
+        s = vv.solve(circular_problem(), method, dt=h, until=n * h)
         radius[method] = np.hypot(s.q[:, 0], s.v[:, 0])
     growth = np.sqrt(1 + h**2) ** np.arange(n + 1)
     np.testing.assert_allclose(radius["explicit_euler"], growth, rtol=1e-12)

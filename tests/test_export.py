@@ -42,8 +42,13 @@ def moving_points(frames: int = FRAMES, *, static: dict[str, Any] | None = None)
     points[:, :, 0] = [0.0, 1.0, 2.0, 3.0] + 0.1 * np.cos(3.0 * t[:, None])
     points[:, :, 1] = 2.0 - 4.9 * t[:, None] ** 2
     points[:, :, 2] = np.sin(t[:, None] * np.array([1.0, 2.0, 3.0, 4.0]))
-    arrays = {"radius": np.array([0.1, 0.05, 0.2, 0.1])} | (static or {})
-    return vv.Recording(t, {"points": points}, static=arrays, units={"points": "m", "radius": "m"})
+    arrays = {"particle_radius": np.array([0.1, 0.05, 0.2, 0.1])} | (static or {})
+    return vv.Recording(
+        t,
+        {"particle_position": points},
+        static=arrays,
+        units={"particle_position": "m", "particle_radius": "m"},
+    )
 
 
 def quad() -> vv.Recording:
@@ -54,16 +59,16 @@ def quad() -> vv.Recording:
     points = np.repeat(corners[None], t.size, axis=0)
     points[:, 3, 1] = np.sin(2.0 * t)  # the far corner folds up
     points[:, :, 1] += 0.5 * t[:, None]  # the whole quad rises
-    recording.fields["points"] = points
+    recording.fields["particle_position"] = points
     return recording
 
 
 def expected(recording: vv.Recording, fps: float = FPS) -> tuple[np.ndarray, list[int], float]:
     """Recorded positions at each output frame, the output frames checked, and a tolerance [m]."""
     shown = frames_at_rate(recording.time, fps)
-    positions = recording["points"][shown]
+    positions = recording["particle_position"][shown]
     checked = [0, shown.size // 2, shown.size - 1]
-    return positions, checked, FLOAT32_RTOL * float(np.abs(recording["points"]).max())
+    return positions, checked, FLOAT32_RTOL * float(np.abs(recording["particle_position"]).max())
 
 
 # --- independent readers -------------------------------------------------------------------
@@ -175,7 +180,7 @@ def test_usd_points_positions_metadata_and_extent(tmp_path: Path) -> None:
     points = UsdGeom.Points(stage.GetPrimAtPath("/World/points"))
     np.testing.assert_allclose(np.array(points.GetWidthsAttr().Get()), [0.2, 0.1, 0.4, 0.2])
     assert len(points.GetPointsAttr().GetTimeSamples()) == count
-    radius = recording.static["radius"][:, None]
+    radius = recording.static["particle_radius"][:, None]
     for k in checked:
         read = np.array(points.GetPointsAttr().Get(k))
         np.testing.assert_allclose(read, positions[k], rtol=0, atol=tolerance)
@@ -195,7 +200,7 @@ def test_usd_default_fps_is_the_recorded_rate_and_usdc_is_binary(tmp_path: Path)
     assert stage.GetTimeCodesPerSecond() == RATE
     assert stage.GetEndTimeCode() == FRAMES - 1  # every recorded frame
     np.testing.assert_allclose(
-        usd_points(path, "/World/points", 37), recording["points"][37], rtol=0, atol=1e-6
+        usd_points(path, "/World/points", 37), recording["particle_position"][37], rtol=0, atol=1e-6
     )
 
 
@@ -299,7 +304,9 @@ def test_glb_of_many_points_is_a_mesh_with_sparse_step_weights(tmp_path: Path) -
     rng = np.random.default_rng(3)
     start = rng.standard_normal((MAX_BODY_NODES + 1, 3))
     points = start + t[:, None, None] * np.array([0.0, 1.0, 0.0])
-    recording = vv.Recording(t, {"points": points}, static={"radius": np.full(len(start), 0.02)})
+    recording = vv.Recording(
+        t, {"particle_position": points}, static={"particle_radius": np.full(len(start), 0.02)}
+    )
     positions, checked, tolerance = expected(recording)
     (path,) = export_recording(recording, tmp_path / "cloud.glb", fps=FPS)
     document, blob, frames = gltf_frames(path)
@@ -421,7 +428,9 @@ def test_uneven_recording_exports_at_30_fps(tmp_path: Path) -> None:
     _, samples = read_pc2(path)
     shown = frames_at_rate(recording.time, 30.0)
     assert samples.shape[0] == shown.size
-    np.testing.assert_allclose(samples[-1], recording["points"][shown[-1]], rtol=0, atol=1e-5)
+    np.testing.assert_allclose(
+        samples[-1], recording["particle_position"][shown[-1]], rtol=0, atol=1e-5
+    )
 
 
 # --- bad input: refused before anything is written -----------------------------------------
@@ -467,8 +476,10 @@ def test_unknown_or_unfitting_format(tmp_path: Path) -> None:
 
 def test_recording_without_points(tmp_path: Path) -> None:
     abstract = vv.Recording(np.arange(3.0), {"q": np.zeros((3, 2))})
-    assert_refused(tmp_path, "no `points` field", abstract, tmp_path / "a.usd")
-    empty = vv.Recording(np.arange(3.0), {"points": np.zeros((3, 0, 3))})
+    assert_refused(
+        tmp_path, "no `particle_position` or `system_points` field", abstract, tmp_path / "a.usd"
+    )
+    empty = vv.Recording(np.arange(3.0), {"particle_position": np.zeros((3, 0, 3))})
     assert_refused(tmp_path, "holds no points", empty, tmp_path / "a.glb")
 
 
@@ -492,7 +503,7 @@ def test_bad_fps_and_non_finite_positions(tmp_path: Path) -> None:
         tmp_path, r"`fps` must be a real number", recording, tmp_path / "a.pc2", fps="24"
     )
     assert_refused(tmp_path, "more than 1000000", recording, tmp_path / "a.pc2", fps=1e9)
-    recording["points"][40, 2, 1] = np.nan
+    recording["particle_position"][40, 2, 1] = np.nan
     assert_refused(
         tmp_path,
         r"recorded frame 40 \(t = 0\.8 s\) is not finite at point 2",
@@ -505,7 +516,7 @@ def test_bad_fps_and_non_finite_positions(tmp_path: Path) -> None:
 def test_glb_over_the_size_limit(tmp_path: Path) -> None:
     # 2 recorded frames 1 s apart at 90,000 frames/s: 90,001 output frames of 1000 points.
     t = np.array([0.0, 1.0])
-    recording = vv.Recording(t, {"points": np.zeros((2, 1000, 3))})
+    recording = vv.Recording(t, {"particle_position": np.zeros((2, 1000, 3))})
     with pytest.raises(ModelError) as error:
         export_recording(recording, tmp_path / "big.glb", fps=90_000.0)
     message = str(error.value)

@@ -62,6 +62,6 @@ def test_iterations_must_be_a_positive_whole_number():
 
 def test_systems_without_springs_take_backward_euler():
     spring = vv.ode.SecondOrderProblem(lambda t, q: -q, q0=[1.0], v0=[0.0])
-    ours = vv.solve(spring, FastMassSprings(), dt=0.1, t_end=1.0)
-    euler = vv.solve(spring, "backward_euler", dt=0.1, t_end=1.0)
+    ours = vv.solve(spring, FastMassSprings(), dt=0.1, until=1.0)
+    euler = vv.solve(spring, "backward_euler", dt=0.1, until=1.0)
     np.testing.assert_allclose(ours.q, euler.q, rtol=0, atol=1e-12)

@@ -104,7 +104,7 @@ def test_momentum_of_a_softened_cluster_is_conserved():
     each drift leaves P alone, so P stays put to 1e-13 of Σ |m_i v_i| over 2000 steps."""
     cluster = mech.plummer_sphere(64, total_mass=1.0, scale_radius=1.0, G=1.0, seed=5)
     solution = vv.solve(
-        cluster.problem(softening=0.05), "velocity_verlet", dt=2e-3, t_end=4.0, record_every=100
+        cluster.problem(softening=0.05), "velocity_verlet", dt=2e-3, until=4.0, record_every=100
     )
     v = solution.v.reshape(len(solution.t), 64, 3)
     x = solution.q.reshape(len(solution.t), 64, 3)
@@ -151,7 +151,7 @@ def test_kepler_energy_and_angular_momentum_over_a_thousand_orbits(method):
     conserves L exactly for a central force, so only rounding remains (~1e-13)."""
     dt = KEPLER.period / 1000
     solution = vv.solve(
-        KEPLER.bodies().problem(), method, dt=dt, t_end=1000 * KEPLER.period, record_every=101
+        KEPLER.bodies().problem(), method, dt=dt, until=1000 * KEPLER.period, record_every=101
     )
     energy = solution.energy
     assert np.abs(energy - energy[0]).max() / abs(energy[0]) <= 2e-4
@@ -172,7 +172,7 @@ def test_kepler_positions_follow_the_ellipse_with_second_order_error():
             KEPLER.bodies().problem(),
             "velocity_verlet",
             dt=KEPLER.period / steps,
-            t_end=10 * KEPLER.period,
+            until=10 * KEPLER.period,
             record_every=steps // 10,
         )
         exact = KEPLER.positions(solution.t).reshape(len(solution.t), 6)
@@ -366,7 +366,7 @@ def test_sun_earth_moon_year_and_month():
     system = mech.sun_earth_moon()
     np.testing.assert_allclose(system.momentum(), 0.0, atol=1e-16 * 2e30 * 3e4)
     day = 86_400.0
-    solution = vv.solve(system.problem(), "velocity_verlet", dt=3600.0, t_end=730.5 * day)
+    solution = vv.solve(system.problem(), "velocity_verlet", dt=3600.0, until=730.5 * day)
     x = solution.q.reshape(len(solution.t), 3, 3)
 
     def mean_period(relative):
@@ -396,9 +396,9 @@ def test_batched_problem_matches_separate_runs():
         G=1.0,
         softening=0.05,
     )
-    together = vv.solve(batch, "leapfrog", dt=1e-2, t_end=1.0, record_every=20)
+    together = vv.solve(batch, "leapfrog", dt=1e-2, until=1.0, record_every=20)
     for k, cluster in enumerate(clusters):
-        alone = vv.solve(cluster.problem(softening=0.05), "leapfrog", dt=1e-2, t_end=1.0)
+        alone = vv.solve(cluster.problem(softening=0.05), "leapfrog", dt=1e-2, until=1.0)
         np.testing.assert_allclose(together.q[-1, k], alone.q[-1], rtol=0, atol=1e-12)
         assert together.energy[-1, k] == pytest.approx(alone.energy[-1], rel=1e-12)
 
@@ -407,9 +407,9 @@ def test_compiled_few_body_path_matches_the_kernels():
     """Three bodies take the compiled one-system acceleration; Barnes–Hut (one group, so exact)
     takes the parallel kernels: the same trajectory to rounding."""
     bodies = mech.plummer_sphere(3, total_mass=1.0, scale_radius=1.0, G=1.0, seed=13)
-    compiled = vv.solve(bodies.problem(softening=0.1), "velocity_verlet", dt=1e-2, t_end=2.0)
+    compiled = vv.solve(bodies.problem(softening=0.1), "velocity_verlet", dt=1e-2, until=2.0)
     kernel = vv.solve(
-        bodies.problem(softening=0.1, method="barnes_hut"), "velocity_verlet", dt=1e-2, t_end=2.0
+        bodies.problem(softening=0.1, method="barnes_hut"), "velocity_verlet", dt=1e-2, until=2.0
     )
     np.testing.assert_allclose(compiled.q, kernel.q, rtol=0, atol=1e-12)
     np.testing.assert_allclose(compiled.energy, kernel.energy, rtol=1e-12)

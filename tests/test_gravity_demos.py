@@ -67,7 +67,7 @@ def test_kepler_scene_follows_the_ellipse(tmp_path):
     vv.run_scene(model, out)
     recording = vv.io.load_recording(out / "recording.h5")
     orbit = vv.mechanics.kepler_orbit(1.0, 0.3, masses=(1.0, 0.5), G=1.0)
-    points = recording["points"]  # the bodies' positions, recorded once
+    points = recording["system_points"]  # the bodies' positions, recorded once
     # Verlet, h = 0.01 s over about one orbit: position error ~h² · (n² a) · t ≈ 1e-3 m.
     np.testing.assert_allclose(points, orbit.positions(recording.time), atol=3e-3)
 
@@ -95,7 +95,7 @@ def test_large_galaxy_scene_runs_on_the_tree_and_follows_direct_summation(tmp_pa
     out = tmp_path / "run"
     vv.run_scene(model, out)
     recording = vv.io.load_recording(out / "recording.h5")
-    tree = recording["points"][-1]
+    tree = recording["system_points"][-1]
     assert tree.shape == (4202, 3) and recording.time[-1] == pytest.approx(0.1)
     bodies = vv.mechanics.colliding_disks(
         2100,
@@ -108,7 +108,7 @@ def test_large_galaxy_scene_runs_on_the_tree_and_follows_direct_summation(tmp_pa
         softening=0.05,
         seed=0,
     )
-    direct = vv.solve(bodies.problem(softening=0.05), "velocity_verlet", dt=0.01, t_end=0.1)
+    direct = vv.solve(bodies.problem(softening=0.05), "velocity_verlet", dt=0.01, until=0.1)
     a = vv.mechanics.gravity_accelerations(bodies.positions, bodies.masses, G=1.0, softening=0.05)
     departure = np.linalg.norm(tree - direct.q[-1].reshape(-1, 3), axis=1)
     ratio = departure / (0.5 * np.linalg.norm(a, axis=1) * 0.1**2)
@@ -129,7 +129,7 @@ def test_cluster_scene_stays_in_virial_equilibrium(tmp_path):
     recording = vv.io.load_recording(out / "recording.h5")
     energy = recording["energy"]
     assert np.abs(energy - energy[0]).max() <= 1e-4 * abs(energy[0])
-    x = recording["points"][-1]
+    x = recording["system_points"][-1]
     m = np.full(500, 1.0 / 500)
     potential = vv.mechanics.gravitational_potential_energy(x, m, G=1.0, softening=0.05)
     kinetic = energy[-1] - potential
@@ -137,16 +137,18 @@ def test_cluster_scene_stays_in_virial_equilibrium(tmp_path):
 
 
 def test_gravitating_bodies_are_recorded_once(tmp_path):
-    """The bodies' coordinates are their positions: a recording holds them once, as points and
-    velocities [(frames, N, 3)], not again as q and v (the star cluster's 721 MB became 481 MB),
-    and the points are the positions themselves, with no offset for the picture."""
+    """The bodies' coordinates are their positions: a recording holds them once, as the
+    systems' points and velocities [(frames, N, 3)], not again as q and v (the star cluster's
+    721 MB became 481 MB), and the points are the positions themselves, with no offset for the
+    picture."""
     model = build_model(parse_scene(scene("cluster", "bodies = 64, softening = 0.05", 0.1)))
     vv.run_scene(model, tmp_path / "scene")
     recording = vv.io.load_recording(tmp_path / "scene" / "recording.h5")
-    assert set(recording.fields) == {"points", "velocities", "energy"}
-    assert recording.units["points"] == "m" and recording.units["velocities"] == "m/s"
+    assert set(recording.fields) == {"system_points", "system_velocity", "energy"}
+    assert recording.units["system_points"] == "m"
+    assert recording.units["system_velocity"] == "m/s"
     start = vv.mechanics.plummer_sphere(64, total_mass=1.0, scale_radius=1.0, G=1.0, seed=0)
-    np.testing.assert_array_equal(recording["points"][0], start.positions)
+    np.testing.assert_array_equal(recording["system_points"][0], start.positions)
     run_demo("kepler", tmp_path / "demo", duration=6.0)
     for run in vv.io.read_recordings(tmp_path / "demo" / "recording.h5").values():
-        assert set(run.fields) == {"points", "velocities", "energy"}
+        assert set(run.fields) == {"system_points", "system_velocity", "energy"}

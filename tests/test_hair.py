@@ -123,7 +123,7 @@ def test_a_strand_from_a_scene_file_is_drawn_by_its_edges(tmp_path):
     recording = vv.io.load_recording(tmp_path / "out" / "recording.h5")
     # The strand's points follow the particle (slots 1–5); bending and torsion are not drawn.
     np.testing.assert_array_equal(recording.static["edges"], [[1, 2], [2, 3], [3, 4], [4, 5]])
-    assert recording["points"][-1, 1].tolist() == [0.0, 0.0, 0.0]
+    assert recording["particle_position"][-1, 1].tolist() == [0.0, 0.0, 0.0]
 
 
 @pytest.mark.parametrize(

@@ -256,17 +256,17 @@ def test_a_malformed_recording_is_refused_by_every_reader(tmp_path, damage, monk
 def test_python_api_refuses_runs_that_would_never_end():
     problem = vv.ode.FirstOrderProblem(lambda t, y: -y, [1.0, 0.0])
     with pytest.raises(vv.ModelError, match="substep"):
-        vv.solve(problem, method="rk4", dt=0.1, t_end=1.0, substeps=10**30)
+        vv.solve(problem, method="rk4", dt=0.1, until=1.0, substeps=10**30)
     with pytest.raises(vv.ModelError, match="limit is 1e"):
-        vv.solve(problem, method="rk4", dt=1e-10, t_end=1.0)
+        vv.solve(problem, method="rk4", dt=1e-10, until=1.0)
     with pytest.raises(vv.ModelError, match="`atol` must be positive"):
-        vv.solve(problem, method="dopri5", t_end=1.0, atol=0.0)
+        vv.solve(problem, method="dopri5", until=1.0, atol=0.0)
 
 
 def test_a_function_that_changes_its_shape_is_named():
     problem = vv.ode.FirstOrderProblem(lambda t, y: -y if t == 0 else np.zeros(3), [1.0, 0.0])
     with pytest.raises(vv.ModelError, match=r"returned shape \(3,\) at t = 0\.05"):
-        vv.solve(problem, method="rk4", dt=0.1, t_end=1.0)
+        vv.solve(problem, method="rk4", dt=0.1, until=1.0)
 
 
 # Hypothesis: mutated example scenes are refused cleanly or run; validate and run agree.

@@ -29,8 +29,8 @@ def test_finite_difference_newton_agrees_with_analytic(method, name):
     """Same answer to the Newton tolerance whether the Jacobian is analytic or by differences;
     finite differences cost extra evaluations of f, the analytic one none."""
     problem = reference_problem(name).problem
-    analytic = vv.solve(problem, method, dt=0.05, t_end=3.0)
-    numeric = vv.solve(_without_jacobian(problem), method, dt=0.05, t_end=3.0)
+    analytic = vv.solve(problem, method, dt=0.05, until=3.0)
+    numeric = vv.solve(_without_jacobian(problem), method, dt=0.05, until=3.0)
     for field in analytic.recording.fields:
         np.testing.assert_allclose(
             numeric.recording[field], analytic.recording[field], rtol=0, atol=1e-9
@@ -115,8 +115,8 @@ def test_sparse_newton_matches_dense(method):
 
     sparse = vv.ode.SecondOrderProblem(force, q0, np.zeros_like(q0), jacobian=jacobian)
     dense = vv.ode.SecondOrderProblem(force, q0, np.zeros_like(q0), jacobian=dense_jacobian)
-    a = vv.solve(sparse, method, dt=0.05, t_end=1.0)
-    b = vv.solve(dense, method, dt=0.05, t_end=1.0)
+    a = vv.solve(sparse, method, dt=0.05, until=1.0)
+    b = vv.solve(dense, method, dt=0.05, until=1.0)
     np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-10)
 
 
@@ -126,7 +126,7 @@ def test_backward_euler_is_exact_for_the_linear_chain_recurrence():
     n, h = 30, 0.1
     force, jacobian, q0, stiffness = _chain(n)
     problem = vv.ode.SecondOrderProblem(force, q0, np.zeros(n), jacobian=jacobian)
-    solution = vv.solve(problem, "backward_euler", dt=h, t_end=2.0)
+    solution = vv.solve(problem, "backward_euler", dt=h, until=2.0)
     k = stiffness.toarray()
     d = -0.3 * np.eye(n)
     q, v = q0.copy(), np.zeros(n)
@@ -151,8 +151,8 @@ def test_mass_matrix_forms_agree(form, method):
         force, mass, q0, np.zeros(3), jacobian=jacobian
     )
     scaled = vv.ode.SecondOrderProblem(lambda t, q, v: force(t, q, v) / masses, q0, np.zeros(3))
-    a = vv.solve(with_mass, method, dt=0.01, t_end=1.0)
-    b = vv.solve(scaled, method, dt=0.01, t_end=1.0)
+    a = vv.solve(with_mass, method, dt=0.01, until=1.0)
+    b = vv.solve(scaled, method, dt=0.01, until=1.0)
     np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-9)
 
 
@@ -163,7 +163,7 @@ def test_batched_newton_equals_separate_solves():
     batch = vv.ode.SecondOrderProblem(
         problem.force.func, angles, np.zeros_like(angles), jacobian=problem.jacobian.func
     )
-    together = vv.solve(batch, "trapezoidal", dt=0.1, t_end=5.0)
+    together = vv.solve(batch, "trapezoidal", dt=0.1, until=5.0)
     for i, angle in enumerate(angles):
         alone = vv.solve(
             vv.ode.SecondOrderProblem(
@@ -171,7 +171,7 @@ def test_batched_newton_equals_separate_solves():
             ),
             "trapezoidal",
             dt=0.1,
-            t_end=5.0,
+            until=5.0,
         )
         np.testing.assert_allclose(together.q[:, i], alone.q, rtol=0, atol=1e-10)
 
@@ -182,8 +182,8 @@ def test_stiff_decay_is_handled_by_backward_euler_not_explicit():
     problem = vv.ode.FirstOrderProblem(
         lambda t, y: -1e4 * (y - np.cos(t)), [2.0], jacobian=lambda t, y: np.full((1, 1), -1e4)
     )
-    assert not vv.solve(problem, "explicit_euler", dt=0.01, t_end=10.0).success
-    implicit = vv.solve(problem, "backward_euler", dt=0.01, t_end=10.0)
+    assert not vv.solve(problem, "explicit_euler", dt=0.01, until=10.0).success
+    implicit = vv.solve(problem, "backward_euler", dt=0.01, until=10.0)
     # After the transient, y follows cos t to O(1/|λ|) plus the O(h) method error.
     np.testing.assert_allclose(implicit.y[50:, 0], np.cos(implicit.t[50:]), atol=2e-3)
 
@@ -202,7 +202,7 @@ def test_line_search_rescues_newton_where_full_steps_diverge(monkeypatch):
         return np.zeros((1, 1)), np.array([[-mu_g * (2 / np.pi) / (eps * (1 + (v[0] / eps) ** 2))]])
 
     problem = vv.ode.SecondOrderProblem(force, [0.0], [v0], jacobian=jacobian)
-    solution = vv.solve(problem, "backward_euler", dt=h, t_end=h)
+    solution = vv.solve(problem, "backward_euler", dt=h, until=h)
     assert solution.success and solution.recording.attrs["line_search_steps"] > 0
 
     def residual(v):
@@ -215,4 +215,4 @@ def test_line_search_rescues_newton_where_full_steps_diverge(monkeypatch):
     np.testing.assert_allclose(solution.v[-1, 0], 0.5 * (low + high), rtol=1e-9)
     # Without it, the full steps fly off and the step fails (with a clear error).
     monkeypatch.setattr("visviva.integrators.newton.LINE_SEARCH_HALVINGS", 0)
-    assert not vv.solve(problem, "backward_euler", dt=h, t_end=h).success
+    assert not vv.solve(problem, "backward_euler", dt=h, until=h).success

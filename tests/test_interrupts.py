@@ -82,7 +82,7 @@ def test_a_signal_stops_the_run_and_keeps_the_recording(tmp_path, sig, status):
     assert recording.attrs["complete"] is False and recording.attrs["interrupted"] == name
     # The recording ends where the run stopped; every frame is whole.
     assert recording.time[-1] == pytest.approx(summary["t_reached_s"])
-    assert recording["points"].shape[0] == recording.time.size == recording["energy"].size
+    assert recording["system_points"].shape[0] == recording.time.size == recording["energy"].size
     assert summary["steps"] == round(summary["t_reached_s"] / 0.001)
 
 

@@ -34,7 +34,7 @@ def _three_bodies():
 
 
 def test_verlet_conserves_momentum_and_angular_momentum_to_round_off():
-    solution = vv.solve(_three_bodies(), "velocity_verlet", dt=1e-3, t_end=5.0, record_every=50)
+    solution = vv.solve(_three_bodies(), "velocity_verlet", dt=1e-3, until=5.0, record_every=50)
     x = solution.q.reshape(-1, 3, 2)
     v = solution.v.reshape(-1, 3, 2)
     momentum = vv.analysis.linear_momentum(MASSES, v)
@@ -48,7 +48,7 @@ def test_verlet_conserves_momentum_and_angular_momentum_to_round_off():
 
 def test_centre_of_mass_moves_uniformly():
     """With no external force the centre of mass moves at the constant velocity P / M."""
-    solution = vv.solve(_three_bodies(), "leapfrog", dt=1e-3, t_end=2.0, record_every=100)
+    solution = vv.solve(_three_bodies(), "leapfrog", dt=1e-3, until=2.0, record_every=100)
     centre = vv.analysis.center_of_mass(MASSES, solution.q.reshape(-1, 3, 2))
     velocity = vv.analysis.linear_momentum(MASSES, solution.v[0].reshape(3, 2)) / MASSES.sum()
     np.testing.assert_allclose(centre, centre[0] + solution.t[:, None] * velocity, atol=1e-12)

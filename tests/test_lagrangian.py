@@ -216,8 +216,8 @@ def test_velocity_terms_give_coriolis_and_centrifugal_forces():
 def test_canonical_and_second_order_forms_agree():
     system = rotating_frame()
     q0, v0 = np.array([1.0, 0.0]), np.array([0.0, 0.2])
-    second = vv.solve(system.problem(q0, v0), method="rk4", dt=1e-3, t_end=2.0)
-    canonical = vv.solve(system.canonical_problem(q0, v0), method="rk4", dt=1e-3, t_end=2.0)
+    second = vv.solve(system.problem(q0, v0), method="rk4", dt=1e-3, until=2.0)
+    canonical = vv.solve(system.canonical_problem(q0, v0), method="rk4", dt=1e-3, until=2.0)
     # Same flow in other variables; both RK4 at h = 1e-3 (global error ~ h⁴ ≈ 1e-12).
     np.testing.assert_allclose(canonical.y[-1, :2], second.q[-1], atol=1e-10)
     # The Jacobi integral E = ½ m |q̇|² − ½ m Ω² |q|² is conserved by the exact flow.
@@ -235,7 +235,7 @@ def test_damping_as_a_generalized_force():
         forces=[-c * vx],
         parameters={"m": 1.0, "k": 4.0, "c": 0.4},
     )
-    solution = vv.solve(system.problem([1.0], [0.0]), method="rk4", dt=1e-3, t_end=5.0)
+    solution = vv.solve(system.problem([1.0], [0.0]), method="rk4", dt=1e-3, until=5.0)
     gamma, omega_d = 0.2, math.sqrt(4.0 - 0.04)
     exact = np.exp(-gamma * solution.t) * (
         np.cos(omega_d * solution.t) + gamma / omega_d * np.sin(omega_d * solution.t)
@@ -259,7 +259,7 @@ def test_pendulum_period_is_the_elliptic_integral(theta0):
     system = pendulum(length)
     errors = []
     for dt in (0.04, 0.02):
-        solution = vv.solve(system.problem([theta0], [0.0]), method="rk4", dt=dt, t_end=10 * exact)
+        solution = vv.solve(system.problem([theta0], [0.0]), method="rk4", dt=dt, until=10 * exact)
         errors.append(abs(measured_period(solution) - exact) / exact)
     # Error of order h⁴ (the Hermite location is O(h⁴) too): halving h divides it by ~16.
     assert errors[1] < 2e-7
@@ -282,14 +282,14 @@ def test_double_pendulum_energy_stays_bounded_under_implicit_midpoint():
     3.9 ≈ 2²), flat over 200 s in both cases."""
     system = double_pendulum()
     problem = system.canonical_problem([2.0, 1.0], [0.0, 0.0])
-    solution = vv.solve(problem, method="implicit_midpoint", dt=0.01, t_end=100.0)
+    solution = vv.solve(problem, method="implicit_midpoint", dt=0.01, until=100.0)
     error = np.abs(solution.energy - solution.energy[0]) / abs(solution.energy[0])
     tenth = error.size // 10
     assert error.max() < 0.15
     # No drift: the last tenth of the run is no worse than the first tenth (within 2×).
     assert error[-tenth:].max() < 2.0 * error[:tenth].max()
     euler = vv.solve(
-        system.problem([2.0, 1.0], [0.0, 0.0]), method="explicit_euler", dt=0.01, t_end=20.0
+        system.problem([2.0, 1.0], [0.0, 0.0]), method="explicit_euler", dt=0.01, until=20.0
     )
     assert euler.energy[-1] - euler.energy[0] > 10 * error.max() * abs(solution.energy[0])
 
@@ -376,7 +376,7 @@ import visviva as vv
 system = vv.mechanics.classic.double_pendulum()
 problem = system.problem([1.0, 0.5], [0.0, 0.0])
 functions = [f.func for f in (problem.force, problem.jacobian, problem.energy) if f is not None]
-solution = vv.solve(problem, "rk4", dt=0.01, t_end=0.5)
+solution = vv.solve(problem, "rk4", dt=0.01, until=0.5)
 hits = sum(sum(f.stats.cache_hits.values()) for f in functions)
 print(hits, repr(float(solution.q[-1, 1])))
 """

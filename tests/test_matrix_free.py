@@ -113,9 +113,9 @@ def test_newton_krylov_agrees_with_dense_newton(monkeypatch, method):
     trajectories agree to about that tolerance times the amplitude (0.01 m), not to the
     finite-difference error of the products (~1e-8 relative), which only slows Newton."""
     problem = spring_chain(300, damping=0.2)
-    dense = vv.simulate(problem, method, dt=0.01, t_end=0.2)
+    dense = vv.solve(problem, method, dt=0.01, until=0.2).raise_for_status().recording
     _with_threshold(monkeypatch, 100)
-    krylov = vv.simulate(problem, method, dt=0.01, t_end=0.2)
+    krylov = vv.solve(problem, method, dt=0.01, until=0.2).raise_for_status().recording
     np.testing.assert_allclose(krylov["q"], dense["q"], rtol=0, atol=1e-10)
     np.testing.assert_allclose(krylov["v"], dense["v"], rtol=0, atol=1e-9)
     # Work: no n-column finite-difference Jacobian (300 force evaluations per Newton
@@ -134,9 +134,9 @@ def test_newton_krylov_on_a_first_order_problem(monkeypatch):
         return 100.0 * (padded[2:] - 2.0 * padded[1:-1] + padded[:-2]) - y**3
 
     problem = vv.ode.FirstOrderProblem(f, np.sin(np.linspace(0, 3 * np.pi, n)))
-    dense = vv.simulate(problem, "backward_euler", dt=0.01, t_end=0.1)
+    dense = vv.solve(problem, "backward_euler", dt=0.01, until=0.1).raise_for_status().recording
     _with_threshold(monkeypatch, 100)
-    krylov = vv.simulate(problem, "backward_euler", dt=0.01, t_end=0.1)
+    krylov = vv.solve(problem, "backward_euler", dt=0.01, until=0.1).raise_for_status().recording
     np.testing.assert_allclose(krylov["y"], dense["y"], rtol=0, atol=1e-9)
     assert krylov.attrs["krylov_iterations"] > 0 and krylov.attrs["jacobian_evaluations"] == 0
 

@@ -41,7 +41,7 @@ def test_declared_order_is_measured(method, problem):
     study = vv.analysis.convergence_order(
         reference.problem,
         method,
-        t_end=2.0,
+        until=2.0,
         reference=reference.exact,
         dt=_steps(problem, vv.integrators.get(method).order),
     )
@@ -57,7 +57,7 @@ def test_errors_halve_for_first_order_methods():
     study = vv.analysis.convergence_order(
         reference.problem,
         "explicit_euler",
-        t_end=1.0,
+        until=1.0,
         reference=reference.exact,
         dt=[1e-2 / 2**k for k in range(5)],
     )
@@ -71,7 +71,7 @@ def test_taylor_update_is_exact_for_constant_force():
     rock = vv.ode.SecondOrderProblem(
         lambda t, q: np.broadcast_to(g, q.shape).copy(), q0=[0.0, 1.0], v0=[3.0, 4.0]
     )
-    solution = vv.solve(rock, "taylor", dt=0.1, t_end=0.8)
+    solution = vv.solve(rock, "taylor", dt=0.1, until=0.8)
     t = solution.t[:, None]
     expected = np.array([0.0, 1.0]) + np.array([3.0, 4.0]) * t + 0.5 * g * t**2
     np.testing.assert_allclose(solution.q, expected, rtol=0, atol=1e-13)
@@ -83,7 +83,7 @@ def test_adaptive_dopri5_meets_its_tolerance():
     exact_q, exact_v = reference.exact(10.0)
     errors = []
     for rtol in (1e-4, 1e-6, 1e-8, 1e-10):
-        solution = vv.solve(reference.problem, "dopri5", t_end=10.0, rtol=rtol, atol=rtol * 1e-3)
+        solution = vv.solve(reference.problem, "dopri5", until=10.0, rtol=rtol, atol=rtol * 1e-3)
         assert solution.success
         errors.append(max(abs(solution.q[-1, 0] - exact_q[0]), abs(solution.v[-1, 0] - exact_v[0])))
         # Global error of a few times the local tolerance over ~1.6 periods.
@@ -117,7 +117,7 @@ def test_dopri5_t_eval_interpolates_to_the_requested_times():
     reference = reference_problem("first-order")
     times = np.linspace(0.0, 2.0, 17)
     solution = vv.solve(
-        reference.problem, "dopri5", t_end=2.0, rtol=1e-10, atol=1e-12, t_eval=times
+        reference.problem, "dopri5", until=2.0, rtol=1e-10, atol=1e-12, t_eval=times
     )
     np.testing.assert_array_equal(solution.t, times)
     exact = np.array([reference.exact(t)[0] for t in times])
@@ -128,7 +128,7 @@ def test_dopri5_counts_six_evaluations_per_step():
     """First same as last: 6 evaluations per attempted step, plus 1 for the first and 1 for
     the automatic choice of the initial step."""
     reference = reference_problem("first-order")
-    solution = vv.solve(reference.problem, "dopri5", t_end=2.0, rtol=1e-8)
+    solution = vv.solve(reference.problem, "dopri5", until=2.0, rtol=1e-8)
     counters = solution.counters
     attempted = counters["accepted_steps"] + counters["rejected_steps"]
     assert counters["f_evaluations"] == 6 * attempted + 2

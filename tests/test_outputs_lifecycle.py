@@ -73,8 +73,13 @@ def lifecycle(alive: np.ndarray = ALIVE) -> vv.Recording:
     colour = np.where(alive[..., None], live_colour()[repeat], np.float32(0.5))
     return vv.Recording(
         np.arange(frames) / RATE,
-        {"points": points, "alive": alive, "radius": radius, "color": colour},
-        units={"points": "m", "radius": "m"},
+        {
+            "particle_position": points,
+            "particle_alive": alive,
+            "particle_radius": radius,
+            "particle_color": colour,
+        },
+        units={"particle_position": "m", "particle_radius": "m"},
     )
 
 
@@ -274,16 +279,16 @@ def test_gltf_mesh_layout_collapses_dead_points_onto_live_ones(tmp_path):
     copies = 60
     base = lifecycle()
     offset = np.repeat(np.arange(copies) * 20.0, SLOTS)
-    points = np.tile(base["points"], (1, copies, 1))
+    points = np.tile(base["particle_position"], (1, copies, 1))
     points[..., 2] += np.where(np.tile(ALIVE, copies), offset, 0.0)
     alive = np.tile(ALIVE, copies)
     recording = vv.Recording(
         base.time,
         {
-            "points": points,
-            "alive": alive,
-            "radius": np.tile(base["radius"], copies),
-            "color": np.tile(base["color"], (1, copies, 1)),
+            "particle_position": points,
+            "particle_alive": alive,
+            "particle_radius": np.tile(base["particle_radius"], copies),
+            "particle_color": np.tile(base["particle_color"], (1, copies, 1)),
         },
     )
     (path,) = export_recording(recording, tmp_path / "cloud.glb", fps=RATE)
@@ -300,7 +305,7 @@ def test_gltf_mesh_layout_collapses_dead_points_onto_live_ones(tmp_path):
         assert nearest.max() < 1e-4, k
         np.testing.assert_allclose(frame[alive[k]], live, rtol=0, atol=1e-4)
         # The largest live point takes the dead ones.
-        radii = np.where(alive[k], recording["radius"][k], -1.0)
+        radii = np.where(alive[k], recording["particle_radius"][k], -1.0)
         np.testing.assert_allclose(
             frame[~alive[k]] - points[k, np.argmax(radii)], 0.0, rtol=0, atol=1e-4
         )
@@ -308,11 +313,11 @@ def test_gltf_mesh_layout_collapses_dead_points_onto_live_ones(tmp_path):
     first = np.argmax(alive, axis=0)
     colours = gltf_accessor(document, blob, primitive.attributes.COLOR_0)
     np.testing.assert_allclose(
-        colours, linear(recording["color"][first, np.arange(alive.shape[1])]), rtol=1e-6
+        colours, linear(recording["particle_color"][first, np.arange(alive.shape[1])]), rtol=1e-6
     )
     radii = gltf_accessor(document, blob, primitive.attributes._RADIUS)
     np.testing.assert_allclose(
-        radii, recording["radius"][first, np.arange(alive.shape[1])], rtol=1e-6
+        radii, recording["particle_radius"][first, np.arange(alive.shape[1])], rtol=1e-6
     )
     # Bounds: the POSITION accessors never reach the origin's parked points at y = 0.
     assert document.accessors[primitive.attributes.POSITION].min[1] > 0.5

@@ -34,7 +34,7 @@ def test_fountain_fills_to_rate_times_mean_lifetime_and_rises_as_linear_drag_all
     run_demo("fountain", tmp_path, duration=3.0, formats=["gif"], fps=5)
     recording = outputs(tmp_path, "fountain")
     data = summary(tmp_path)
-    t, live = recording.time, recording["alive"].sum(axis=1)
+    t, live = recording.time, recording["particle_alive"].sum(axis=1)
     # Little's law: after the longest lifetime, rate × mean lifetime = 2400 × 1.8 drops.
     steady = t >= fountain.LIFETIME[1]
     expected = fountain.RATE * np.mean(fountain.LIFETIME)
@@ -52,8 +52,8 @@ def test_fountain_fills_to_rate_times_mean_lifetime_and_rises_as_linear_drag_all
     assert apex["measured"] < 0.97 * apex["drag_free_v2_over_2g"]
     # Nothing falls through the basin floor (a drop growing by its size ramp may sink by its
     # growth in one step); drops land and spread over it.
-    alive, radius = recording["alive"], recording["radius"]
-    gap = np.where(alive, recording["points"][..., 1] - radius, np.inf)
+    alive, radius = recording["particle_alive"], recording["particle_radius"]
+    gap = np.where(alive, recording["particle_position"][..., 1] - radius, np.inf)
     assert (gap[alive] > -0.01 * radius[alive]).all()
     assert (gap[-1] < 1e-3).sum() > 500
     assert iio.imread(tmp_path / "animation.gif", index=None).shape[0] == 16  # 3 s at 5/s
@@ -73,7 +73,7 @@ def test_fireworks_births_drops_and_sparks_that_darken(tmp_path):
     for shell in data["sphere_radius_after_burst"].values():
         assert shell["measured_m"] == pytest.approx(shell["drag_law_m"], rel=0.03)
     model = fireworks.build_scene(duration).build()
-    alive, color = recording["alive"], recording["color"]
+    alive, color = recording["particle_alive"], recording["particle_color"]
     for spec in model.emitters:
         if not spec.name.endswith("sparks"):
             continue
@@ -88,7 +88,7 @@ def test_fireworks_births_drops_and_sparks_that_darken(tmp_path):
     # The shells die at the top of their flights, U²/(2g) above the ground.
     shells = [s for s in model.emitters if s.name.endswith("shell")]
     for spec, shell in zip(shells, fireworks.SHELLS, strict=True):
-        height = recording["points"][:, spec.first_slot, 1][alive[:, spec.first_slot]]
+        height = recording["particle_position"][:, spec.first_slot, 1][alive[:, spec.first_slot]]
         # First order in the step: symplectic Euler and the straight flight of a newborn's
         # first partial step each shift the apex by about U·dt/2.
         assert height.max() == pytest.approx(shell.burst_point[1], abs=shell.speed * fireworks.DT)
@@ -98,8 +98,8 @@ def test_snow_settles_on_the_ball_and_the_ground_without_entering_them(tmp_path)
     run_demo("snow", tmp_path)  # its full 6.5 s: the snowfall stops at 3 s
     recording = outputs(tmp_path, "snow")
     data = summary(tmp_path)
-    alive, radius = recording["alive"], recording["radius"]
-    ball, ground = snow.gaps(recording["points"], radius)
+    alive, radius = recording["particle_alive"], recording["particle_radius"]
+    ball, ground = snow.gaps(recording["particle_position"], radius)
     # No flake inside a collider by more than 1 % of its radius, in any frame.
     assert (ball[alive] >= -0.01 * radius[alive]).all()
     assert (ground[alive] >= -0.01 * radius[alive]).all()

@@ -136,7 +136,7 @@ def test_sparse_newton_agrees_with_the_dense_finite_difference_solve():
     dense = vv.ode.SecondOrderProblem.from_force(
         problem.force.func, problem.mass.values, problem.q0, problem.v0
     )
-    solution = vv.solve(dense, "backward_euler", dt=0.01, t_end=0.05)
+    solution = vv.solve(dense, "backward_euler", dt=0.01, until=0.05)
     np.testing.assert_allclose(sparse.raw_state.parts[0], solution.q[-1], atol=1e-9)
     np.testing.assert_allclose(sparse.raw_state.parts[1], solution.v[-1], atol=1e-9)
 

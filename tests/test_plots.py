@@ -9,7 +9,7 @@ import visviva as vv
 from visviva.viz.plots import plot_energy, plot_phase
 
 
-def _oscillator_runs(omega: float = 2.0 * np.pi, dt: float = 0.02, t_end: float = 5.0):
+def _oscillator_runs(omega: float = 2.0 * np.pi, dt: float = 0.02, until: float = 5.0):
     spring = vv.ode.SecondOrderProblem(
         lambda t, q: -(omega**2) * q,
         q0=[1.0],
@@ -17,7 +17,7 @@ def _oscillator_runs(omega: float = 2.0 * np.pi, dt: float = 0.02, t_end: float 
         energy=lambda t, q, v: 0.5 * v[..., 0] ** 2 + 0.5 * omega**2 * q[..., 0] ** 2,
     )
     return {
-        method: vv.simulate(spring, method, dt=dt, t_end=t_end)
+        method: vv.solve(spring, method, dt=dt, until=until).recording
         for method in ("explicit_euler", "backward_euler", "velocity_verlet")
     }
 

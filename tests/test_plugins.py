@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 import textwrap
@@ -275,10 +276,11 @@ def test_kinds_and_classes_are_refused_with_what_to_fix():
         vv.entities.register_entity_kind(EntityKind("cloth", _Table, "x", KindBuild()))
     with pytest.raises(ModelError, match=r'must have the field `type: Literal\["other"\]`'):
         vv.entities.register_entity_kind(EntityKind("other", _Table, "x", KindBuild()))
+
     class Nameless(BaseModel):
         type: Literal["nameless"]
 
-    with pytest.raises(ModelError, match="must have the field `name: str | None = None`"):
+    with pytest.raises(ModelError, match=re.escape("must have the field `name: str | None`")):
         vv.entities.register_entity_kind(EntityKind("nameless", Nameless, "x", KindBuild()))
     with pytest.raises(ModelError, match="lower-case letters"):
         vv.entities.register_entity_kind(EntityKind("Bad Name", _Table, "x", KindBuild()))

@@ -157,10 +157,10 @@ def test_the_run_records_each_surface_once_and_each_transform_per_frame(run):
     assert recording["body_orientation"].shape == (frames, 3, 4)
     assert recording.units["body_origin"] == "m" and recording.units["body_vertices"] == "m"
     np.testing.assert_allclose(np.linalg.norm(recording["body_orientation"], axis=2), 1.0, 1e-12)
-    # Nothing of a body's surface is recorded per frame: the fields are points and transforms.
+    # Nothing of a body's surface is recorded per frame: the fields are particles and transforms.
     assert set(recording.fields) == {
-        "points",
-        "velocities",
+        "particle_position",
+        "particle_velocity",
         "body_origin",
         "body_orientation",
         "energy",
@@ -328,7 +328,7 @@ def test_obj_and_pc2_hold_the_points_then_the_placed_body_vertices(run):
     out, recording = run
     origins, orientations = shown_transforms(recording)
     shown = frames_at_rate(recording.time, FPS)
-    points = recording["points"][shown]
+    points = recording["particle_position"][shown]
     count = points.shape[1]
     files = sorted((out / "obj").glob("*.obj"))
     _, cache = read_pc2(out / "points.pc2")
@@ -370,7 +370,7 @@ def test_obj_numbers_the_body_triangles_after_the_live_points(tmp_path):
     points = np.broadcast_to(np.arange(9.0).reshape(3, 3), (frames, 3, 3))
     mixed = vv.Recording(
         recording.time,
-        recording.fields | {"points": points, "alive": alive},
+        recording.fields | {"particle_position": points, "particle_alive": alive},
         static=recording.static,
         attrs=recording.attrs,
     )

@@ -127,4 +127,4 @@ def test_recordings_draw_the_stretch_springs_as_edges(tmp_path):
     recording = vv.io.load_recording(tmp_path / "recording.h5")
     # The rope's points follow the loose particle (slots 1–4); bend springs are not drawn.
     np.testing.assert_array_equal(recording.static["edges"], [[1, 2], [2, 3], [3, 4]])
-    np.testing.assert_allclose(recording.static["color"][1:], [[0.9, 0.2, 0.1]] * 4)
+    np.testing.assert_allclose(recording.static["particle_color"][1:], [[0.9, 0.2, 0.1]] * 4)

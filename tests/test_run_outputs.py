@@ -67,7 +67,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, vv.Recording]:
 def shown_positions(recording: vv.Recording) -> tuple[np.ndarray, list[int], float]:
     """Positions [m] at each output frame, three frames to check and a float32 tolerance [m]."""
     shown = frames_at_rate(recording.time, FPS)
-    positions = recording["points"][shown]
+    positions = recording["particle_position"][shown]
     checked = [0, shown.size // 2, shown.size - 1]
     return positions, checked, FLOAT32_RTOL * float(np.abs(positions).max())
 
@@ -163,8 +163,8 @@ def test_export_command_writes_the_run_names_next_to_the_recording(
     # Without --fps the exports play at a whole number of frames per second: the recording's
     # 100 frames/s capped at 60 (docs/export.md).
     _, pc2 = read_pc2(tmp_path / "points.pc2")
-    tolerance = FLOAT32_RTOL * float(np.abs(recording["points"]).max())
-    expected = recording["points"][frames_at_rate(recording.time, 60.0)]
+    tolerance = FLOAT32_RTOL * float(np.abs(recording["particle_position"]).max())
+    expected = recording["particle_position"][frames_at_rate(recording.time, 60.0)]
     np.testing.assert_allclose(pc2, expected, rtol=0, atol=tolerance)
     status, output = run_main(monkeypatch, capsys, "export", source, "--to", "pc2")
     assert status == 2 and "--force" in output

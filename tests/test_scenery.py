@@ -141,7 +141,7 @@ def test_a_recording_without_drawn_colliders_has_no_scenery_field(tmp_path, monk
     path = tmp_path / "plain.h5"
     vv.io.save_recording(recording, path)
     loaded = vv.io.load_recording(path)
-    assert sorted(loaded.static) == ["mass", "radius"]
+    assert sorted(loaded.static) == ["particle_mass", "particle_radius"]
     assert loaded.geometry().scenery is None
 
 
@@ -322,7 +322,7 @@ def test_obj_writes_the_colliders_once_beside_the_sequence(recording, tmp_path):
     assert len(frames) == frames_at_rate(recording.time, 10.0).size
     # The frames hold the particles only, as without colliders.
     vertices, _, _ = read_obj(frames[0])
-    assert vertices.shape[0] == recording["points"].shape[1]
+    assert vertices.shape[0] == recording["particle_position"].shape[1]
     scenery = recording.geometry().scenery
     assert scenery is not None
     text = paths[-1].read_text()

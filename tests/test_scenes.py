@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import json
 import subprocess
 import sys
@@ -13,6 +14,7 @@ import pytest
 import visviva as vv
 from visviva.io.scene_files import dump_scene, load_scene, parse_scene
 from visviva.io.writer import RecordingWriter
+from visviva.model.scene import ENTITY_TYPES
 from visviva.scenes import dry_run
 
 EXAMPLES_DIR = Path(__file__).parents[1] / "examples" / "scenes"
@@ -61,6 +63,17 @@ def test_builder_and_file_give_the_same_model():
         np.testing.assert_array_equal(getattr(from_python, name), getattr(from_file, name))
     assert from_python.integration == from_file.integration
     np.testing.assert_array_equal(from_python.gravity, from_file.gravity)
+
+
+@pytest.mark.parametrize("kind", list(ENTITY_TYPES))
+def test_each_builder_method_takes_exactly_its_tables_fields(kind):
+    """One home per field: ``add_<kind>``'s keywords are the fields of the kind's table (its
+    ``type`` aside), typed, with no ``**kwargs``, so a renamed field is renamed in both."""
+    signature = inspect.signature(getattr(vv.SceneBuilder, f"add_{kind}"))
+    parameters = {n: p for n, p in signature.parameters.items() if n != "self"}
+    assert all(p.kind is not p.VAR_KEYWORD for p in parameters.values())
+    assert all(p.annotation is not p.empty for p in parameters.values())
+    assert set(parameters) == set(ENTITY_TYPES[kind].model_fields) - {"type"}
 
 
 def test_model_is_frozen():
@@ -116,14 +129,14 @@ def test_free_fall_matches_the_parabola(tmp_path):
     v0 = np.array([[0.0, 0.0, 0.0], [0.5, 4.0, 0.0]])
     g = np.array([0.0, -9.81, 0.0])
     exact = x0 + v0 * t + 0.5 * g * t**2
-    np.testing.assert_allclose(recording["points"], exact, atol=1e-12)
+    np.testing.assert_allclose(recording["particle_position"], exact, atol=1e-12)
     # Energy is conserved to round-off for this exact integration: E = ½mv² − m g·x.
     assert np.ptp(recording["energy"]) < 1e-12 * np.abs(recording["energy"]).max()
-    assert recording.units["points"] == "m" and recording.units["energy"] == "J"
+    assert recording.units["particle_position"] == "m" and recording.units["energy"] == "J"
     assert recording.attrs["scene"].startswith("[scene]")
     assert recording.attrs["method"] == "velocity_verlet" and recording.attrs["dt"] == 1e-3
     assert recording.attrs["success"] is True
-    np.testing.assert_array_equal(recording.static["radius"], [0.1, 0.1])
+    np.testing.assert_array_equal(recording.static["particle_radius"], [0.1, 0.1])
 
 
 def test_pendulum_system_keeps_its_rod_length(tmp_path):
@@ -166,16 +179,16 @@ def test_streamed_frames_survive_a_crash(tmp_path):
     script = f"""
 import os, numpy as np
 from visviva.io.writer import RecordingWriter
-writer = RecordingWriter({str(path)!r}, units={{"points": "m"}}, flush_every=10)
+writer = RecordingWriter({str(path)!r}, units={{"particle_position": "m"}}, flush_every=10)
 for k in range(25):
-    writer.append(0.1 * k, {{"points": np.full((4, 3), float(k))}})
+    writer.append(0.1 * k, {{"particle_position": np.full((4, 3), float(k))}})
 os._exit(9)  # die without closing the file
 """
     result = subprocess.run([sys.executable, "-c", script], check=False)
     assert result.returncode == 9
     recording = vv.io.load_recording(path)
     assert recording.frames >= 20  # the frames up to the last flush (20) at least
-    np.testing.assert_array_equal(recording["points"][:20, 0, 0], np.arange(20.0))
+    np.testing.assert_array_equal(recording["particle_position"][:20, 0, 0], np.arange(20.0))
     assert recording.attrs["success"] is False
     assert "did not finish" in recording.attrs["message"]
 

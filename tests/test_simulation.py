@@ -16,7 +16,7 @@ def test_time_comes_from_the_step_counter():
     """Frame k is at exactly t0 + k·dt (no accumulated `t += dt` rounding)."""
     t0, dt, steps = 0.1, 0.1, 20_000
     problem = vv.ode.FirstOrderProblem(lambda t, y: 0.0 * y, [1.0], t0=t0)
-    solution = vv.solve(problem, "explicit_euler", dt=dt, t_end=t0 + steps * dt, record_every=100)
+    solution = vv.solve(problem, "explicit_euler", dt=dt, until=t0 + steps * dt, record_every=100)
     expected = t0 + np.arange(0, steps + 1, 100) * dt
     expected[-1] = t0 + steps * dt
     np.testing.assert_array_equal(solution.t, expected)
@@ -34,31 +34,31 @@ def test_time_seen_by_the_force_is_exact():
         seen.append(t)
         return np.zeros_like(y)
 
-    vv.solve(vv.ode.FirstOrderProblem(f, [0.0]), "explicit_euler", dt=0.1, t_end=1.0)
+    vv.solve(vv.ode.FirstOrderProblem(f, [0.0]), "explicit_euler", dt=0.1, until=1.0)
     np.testing.assert_array_equal(seen[1:], 0.1 * np.arange(10))  # [0] is the shape check
 
 
-def test_last_step_is_shortened_to_land_on_t_end():
-    """t_end − t0 not a multiple of dt: full steps, then one shorter step ending at t_end."""
-    solution = vv.solve(_spring(), "rk4", dt=0.3, t_end=1.0)
+def test_last_step_is_shortened_to_land_on_until():
+    """until − t0 not a multiple of dt: full steps, then one shorter step ending at until."""
+    solution = vv.solve(_spring(), "rk4", dt=0.3, until=1.0)
     np.testing.assert_array_equal(solution.t, [0.0, 0.3, 2 * 0.3, 3 * 0.3, 1.0])
     np.testing.assert_allclose(solution.q[-1, 0], np.cos(1.0), atol=1e-4)
 
 
 @pytest.mark.parametrize(
-    ("t_end", "every", "frames"),
+    ("until", "every", "frames"),
     [(1.0, 3, [0, 3, 6, 9, 10]), (1.2, 4, [0, 4, 8, 12]), (1.25, 4, [0, 4, 8, 12, 13])],
 )
-def test_record_every_keeps_every_kth_step_and_the_last(t_end, every, frames):
-    solution = vv.solve(_spring(), "leapfrog", dt=0.1, t_end=t_end, record_every=every)
-    expected = np.minimum(np.array(frames) * 0.1, t_end)
+def test_record_every_keeps_every_kth_step_and_the_last(until, every, frames):
+    solution = vv.solve(_spring(), "leapfrog", dt=0.1, until=until, record_every=every)
+    expected = np.minimum(np.array(frames) * 0.1, until)
     np.testing.assert_allclose(solution.t, expected, rtol=0, atol=1e-15)
 
 
 def test_substeps_equal_smaller_steps():
     """dt with 4 substeps is the same computation as dt/4 recorded every 4th step."""
-    a = vv.solve(_spring(), "velocity_verlet", dt=0.2, t_end=2.0, substeps=4)
-    b = vv.solve(_spring(), "velocity_verlet", dt=0.05, t_end=2.0, record_every=4)
+    a = vv.solve(_spring(), "velocity_verlet", dt=0.2, until=2.0, substeps=4)
+    b = vv.solve(_spring(), "velocity_verlet", dt=0.05, until=2.0, record_every=4)
     np.testing.assert_allclose(a.t, b.t, rtol=0, atol=1e-15)
     np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-15)
     assert a.counters["accepted_steps"] == 40
@@ -74,14 +74,14 @@ def test_a_batch_equals_its_systems_run_one_by_one(method):
         return -np.sin(q) - 0.1 * v
 
     batch = vv.solve(
-        vv.ode.SecondOrderProblem(acceleration, q0, v0), method, dt=0.05, t_end=1.0, adaptive=False
+        vv.ode.SecondOrderProblem(acceleration, q0, v0), method, dt=0.05, until=1.0, adaptive=False
     )
     for i in range(5):
         alone = vv.solve(
             vv.ode.SecondOrderProblem(acceleration, q0[i], v0[i]),
             method,
             dt=0.05,
-            t_end=1.0,
+            until=1.0,
             adaptive=False,
         )
         np.testing.assert_allclose(batch.q[:, i], alone.q, rtol=0, atol=1e-12)
@@ -142,8 +142,8 @@ def test_compiled_loop_matches_numpy_loop(method, form):
         q0, v0 = rng.uniform(-1, 1, shape), rng.uniform(-1, 1, shape)
         compiled = vv.ode.SecondOrderProblem.from_force(compiled_force, mass, q0, v0)
         reference = vv.ode.SecondOrderProblem.from_force(numpy_force, mass, q0, v0)
-        a = vv.solve(compiled, method, dt=0.01, t_end=1.234, record_every=7, substeps=2)
-        b = vv.solve(reference, method, dt=0.01, t_end=1.234, record_every=7, substeps=2)
+        a = vv.solve(compiled, method, dt=0.01, until=1.234, record_every=7, substeps=2)
+        b = vv.solve(reference, method, dt=0.01, until=1.234, record_every=7, substeps=2)
         assert a.recording.attrs["compiled"] and not b.recording.attrs["compiled"]
         np.testing.assert_array_equal(a.t, b.t)
         np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-13)
@@ -172,9 +172,9 @@ def _first_order_numba(t, y, out):
 
 def test_compiled_first_order_matches_numpy():
     y0 = np.random.default_rng(4).uniform(-1, 1, (11, 2))
-    a = vv.solve(vv.ode.FirstOrderProblem(_first_order_numba, y0), "rk4", dt=0.01, t_end=2.0)
+    a = vv.solve(vv.ode.FirstOrderProblem(_first_order_numba, y0), "rk4", dt=0.01, until=2.0)
     b = vv.solve(
-        vv.ode.FirstOrderProblem(_first_order_numba, y0), "rk4", dt=0.01, t_end=2.0, compiled=False
+        vv.ode.FirstOrderProblem(_first_order_numba, y0), "rk4", dt=0.01, until=2.0, compiled=False
     )
     assert a.recording.attrs["compiled"] and not b.recording.attrs["compiled"]
     np.testing.assert_allclose(a.y, b.y, rtol=0, atol=1e-13)
@@ -184,7 +184,7 @@ def test_explicit_euler_on_a_stiff_spring_diverges_with_advice():
     """ω = 100, dt = 0.05: the watch stops the run, names t, step and component, and the
     advisor explains that explicit Euler is unstable on undamped oscillations (dt = 0)."""
     problem = _spring(q0=[1.0, 0.0], v0=[0.0, 0.0], stiffness=100.0**2)
-    solution = vv.solve(problem, "explicit_euler", dt=0.05, t_end=100.0)
+    solution = vv.solve(problem, "explicit_euler", dt=0.05, until=100.0)
     assert not solution.success
     error = solution.error
     assert isinstance(error, vv.SimulationDiverged)
@@ -213,7 +213,7 @@ def test_rk4_divergence_reports_the_stable_step(compiled):
 
     problem = vv.ode.SecondOrderProblem(acceleration, q0=[[1.0], [0.5]], v0=[[0.0], [0.0]])
     with pytest.raises(vv.SimulationDiverged) as caught:
-        vv.simulate(problem, "rk4", dt=0.05, t_end=1000.0)
+        vv.solve(problem, "rk4", dt=0.05, until=1000.0).raise_for_status()
     error = caught.value
     assert error.suggested_dt == pytest.approx(2 * np.sqrt(2) / 100, rel=1e-6)
     assert "(system 0)" in str(error)
@@ -224,14 +224,14 @@ def test_rk4_divergence_reports_the_stable_step(compiled):
 def test_divergence_limit_scales_with_the_initial_state():
     """Orbits in metres (|q| ~ 1.5e11) do not trip the default limit."""
     problem = vv.ode.SecondOrderProblem(lambda t, q: -q * 1e-14, q0=[1.5e11], v0=[3e4])
-    assert vv.solve(problem, "leapfrog", dt=1.0, t_end=100.0).success
+    assert vv.solve(problem, "leapfrog", dt=1.0, until=100.0).success
 
 
 def test_newton_failure_is_reported_not_silent():
     """An implicit step that cannot converge in its iteration cap fails with a message."""
     problem = reference_problem("pendulum").problem
     method = vv.integrators.BackwardEuler(max_iterations=1)
-    solution = vv.solve(problem, method, dt=0.5, t_end=5.0)
+    solution = vv.solve(problem, method, dt=0.5, until=5.0)
     assert not solution.success
     assert isinstance(solution.error, vv.NewtonConvergenceError)
     assert "did not converge" in solution.message and "t=0.5" in solution.message
@@ -242,9 +242,9 @@ def test_work_counters_match_the_declared_costs():
     """Explicit methods evaluate f exactly `evaluations_per_step` times per step (Verlet's
     first step evaluates the starting acceleration too)."""
     for name in ("explicit_euler", "midpoint", "rk4", "symplectic_euler", "leapfrog"):
-        solution = vv.solve(_spring(), name, dt=0.1, t_end=10.0)
+        solution = vv.solve(_spring(), name, dt=0.1, until=10.0)
         per_step = vv.integrators.get(name).evaluations_per_step
         assert solution.counters["f_evaluations"] == 100 * per_step
     assert (
-        vv.solve(_spring(), "velocity_verlet", dt=0.1, t_end=10.0).counters["f_evaluations"] == 101
+        vv.solve(_spring(), "velocity_verlet", dt=0.1, until=10.0).counters["f_evaluations"] == 101
     )

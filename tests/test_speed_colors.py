@@ -36,7 +36,7 @@ def racing(frames: int = 20, count: int = 50) -> vv.Recording:
     points[:, :, 2] = np.arange(count)
     velocities = np.zeros_like(points)
     velocities[:, :, 0] = speed
-    return vv.Recording(t, {"points": points, "velocities": velocities})
+    return vv.Recording(t, {"particle_position": points, "particle_velocity": velocities})
 
 
 def test_each_point_takes_the_colour_of_its_speed_on_one_scale_for_the_clip():
@@ -54,12 +54,16 @@ def test_each_point_takes_the_colour_of_its_speed_on_one_scale_for_the_clip():
 
 def test_dead_points_do_not_stretch_the_scale_and_points_without_velocity_keep_colour():
     recording = racing(frames=4, count=3)
-    fields = dict(recording.fields)
-    fields["velocities"] = fields["velocities"][:, :2] * 1.0  # the third point: a system's
-    fields["velocities"][:, 1, 0] = [1.0, 1.0, 1.0, 1000.0]  # dead when it is fast
-    fields["alive"] = np.array([[True, True, True]] * 3 + [[True, False, True]])
+    fields = {
+        "particle_position": recording["particle_position"][:, :2],
+        "particle_velocity": recording["particle_velocity"][:, :2] * 1.0,
+        "system_points": recording["particle_position"][:, 2:],  # the third point: a system's
+        "particle_alive": np.array([[True, True]] * 3 + [[True, False]]),
+    }
+    fields["particle_velocity"][:, 1, 0] = [1.0, 1.0, 1.0, 1000.0]  # dead when it is fast
     colours = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
-    recording = vv.Recording(recording.time, fields, static={"color": colours})
+    static = {"particle_color": colours[:2], "system_color": colours[2:]}
+    recording = vv.Recording(recording.time, fields, static=static)
     geometry, scale = colored_by_speed(recording, recording.geometry())
     assert scale.top <= 1.0  # the 1000 m/s of a dead slot is not on the scale
     np.testing.assert_array_equal(geometry.color[:, 2], np.tile(colours[2], (4, 1)))
@@ -67,7 +71,8 @@ def test_dead_points_do_not_stretch_the_scale_and_points_without_velocity_keep_c
 
 def test_a_still_scene_is_drawn_at_the_bottom_of_the_scale_not_divided_by_zero():
     t = np.linspace(0.0, 1.0, 3)
-    recording = vv.Recording(t, {"points": np.zeros((3, 2, 3)), "velocities": np.zeros((3, 2, 3))})
+    still = {"particle_position": np.zeros((3, 2, 3)), "particle_velocity": np.zeros((3, 2, 3))}
+    recording = vv.Recording(t, still)
     geometry, scale = colored_by_speed(recording, recording.geometry())
     assert scale.top == 1.0
     np.testing.assert_allclose(geometry.color, np.broadcast_to(_viridis(np.zeros(1)), (3, 2, 3)))
@@ -76,11 +81,12 @@ def test_a_still_scene_is_drawn_at_the_bottom_of_the_scale_not_divided_by_zero()
 def test_the_video_draws_fast_points_yellow_and_labels_the_scale(tmp_path):
     recording = racing(frames=6, count=2)
     fields = dict(recording.fields)
-    fields["velocities"] = fields["velocities"] * 1.0
-    fields["velocities"][:, 1, 0] = 10.0
-    fields["points"] = fields["points"] * 0.0
-    fields["points"][:, 1, 0] = 2.0
-    recording = vv.Recording(recording.time, fields, static={"radius": np.array([0.4, 0.4])})
+    fields["particle_velocity"] = fields["particle_velocity"] * 1.0
+    fields["particle_velocity"][:, 1, 0] = 10.0
+    fields["particle_position"] = fields["particle_position"] * 0.0
+    fields["particle_position"][:, 1, 0] = 2.0
+    radius = {"particle_radius": np.array([0.4, 0.4])}
+    recording = vv.Recording(recording.time, fields, static=radius)
     path = render_video(recording, tmp_path / "v.gif", fps=5, size=(160, 96), color_by="speed")
     image = np.asarray(Image.open(path).convert("RGB")).astype(int)
     red, green, blue = image[..., 0], image[..., 1], image[..., 2]
@@ -125,8 +131,10 @@ def test_an_unknown_mode_is_refused_before_anything_is_written(tmp_path, mode):
 
 
 def test_a_recording_without_velocities_is_refused_with_the_way_out(tmp_path):
-    recording = vv.Recording(np.linspace(0, 1, 3), {"points": np.zeros((3, 2, 3))})
-    with pytest.raises(ModelError, match=r"needs the recording's `velocities`.*color_by = \""):
+    recording = vv.Recording(np.linspace(0, 1, 3), {"particle_position": np.zeros((3, 2, 3))})
+    with pytest.raises(
+        ModelError, match=r"needs the velocities of the drawn points.*color_by = \""
+    ):
         write_viewer(recording, tmp_path / "v.html", color_by="speed")
     assert not (tmp_path / "v.html").exists()
 

@@ -96,7 +96,7 @@ def test_a_spring_graph_from_a_scene_file_is_drawn_by_its_springs(tmp_path):
     vv.run_scene(vv.load_model(path), tmp_path / "out")
     recording = vv.io.load_recording(tmp_path / "out" / "recording.h5")
     np.testing.assert_array_equal(recording.static["edges"], [[0, 1], [1, 2], [2, 0]])
-    assert recording["points"][-1, 2, 1] < 0.8  # the free apex sags under its weight
+    assert recording["particle_position"][-1, 2, 1] < 0.8  # the free apex sags under its weight
 
 
 @pytest.mark.parametrize(

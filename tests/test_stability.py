@@ -105,8 +105,8 @@ def _test_equation(lam):
 def test_explicit_euler_stable_exactly_below_two_over_lambda(lam):
     """y' = λy, λ < 0: bounded for dt < 2/|λ| (|1 + hλ| < 1), growing above (seed 000)."""
     limit = 2.0 / abs(lam)
-    stable = vv.solve(_test_equation(lam), "explicit_euler", dt=0.95 * limit, t_end=200 * limit)
-    unstable = vv.solve(_test_equation(lam), "explicit_euler", dt=1.05 * limit, t_end=210 * limit)
+    stable = vv.solve(_test_equation(lam), "explicit_euler", dt=0.95 * limit, until=200 * limit)
+    unstable = vv.solve(_test_equation(lam), "explicit_euler", dt=1.05 * limit, until=210 * limit)
     assert np.abs(stable.y).max() <= 1.0 and abs(stable.y[-1, 0]) < 1e-4
     # 1 + hλ = −1.1: 200 steps multiply y by exactly (−1.1)^200.
     assert len(unstable.t) == 201
@@ -116,7 +116,7 @@ def test_explicit_euler_stable_exactly_below_two_over_lambda(lam):
 @pytest.mark.parametrize("dt", [0.01, 0.5, 1.9, 2.1, 10.0, 1e4])
 def test_backward_euler_decays_for_every_step(dt):
     """λ = −3: y_n = (1 + 3h)^−n decays monotonically for any h (A-stability)."""
-    solution = vv.solve(_test_equation(-3.0), "backward_euler", dt=dt, t_end=20 * dt)
+    solution = vv.solve(_test_equation(-3.0), "backward_euler", dt=dt, until=20 * dt)
     assert np.all(np.diff(np.abs(solution.y[:, 0])) < 0)
     np.testing.assert_allclose(solution.y[-1, 0], (1 + 3 * dt) ** -20, rtol=1e-9)
 
@@ -124,9 +124,9 @@ def test_backward_euler_decays_for_every_step(dt):
 def test_backward_euler_decays_where_the_exact_solution_grows():
     """Seed 000's caveat: y' = +y grows like e^t, but backward Euler with h > 2 decays, since
     |1/(1 − h)| < 1 — stability is not accuracy."""
-    solution = vv.solve(_test_equation(1.0), "backward_euler", dt=3.0, t_end=30.0)
+    solution = vv.solve(_test_equation(1.0), "backward_euler", dt=3.0, until=30.0)
     np.testing.assert_allclose(solution.y[:, 0], (-0.5) ** np.arange(11), rtol=1e-9)
-    growing = vv.solve(_test_equation(1.0), "backward_euler", dt=0.5, t_end=5.0)
+    growing = vv.solve(_test_equation(1.0), "backward_euler", dt=0.5, until=5.0)
     np.testing.assert_allclose(growing.y[-1, 0], 2.0**10, rtol=1e-9)
 
 

@@ -28,7 +28,10 @@ def falling_and_resting() -> vv.Recording:
     points[:, 0, 1] = 1.8 - 0.6 * t**2
     points[:, 1, 1] = RADIUS
     return vv.Recording(
-        t, {"points": points}, static={"radius": np.full(2, RADIUS)}, units={"points": "m"}
+        t,
+        {"particle_position": points},
+        static={"particle_radius": np.full(2, RADIUS)},
+        units={"particle_position": "m"},
     )
 
 
@@ -91,7 +94,7 @@ def test_spheres_are_where_the_camera_puts_them(videos, suffix):
     camera = Camera.framing(drawn_bounds(recording.geometry()), aspect=SIZE[0] / SIZE[1])
     found, expected = {}, {}
     for k in (0, -1):
-        expected[k] = project(camera, recording["points"][k])
+        expected[k] = project(camera, recording["particle_position"][k])
         mask = sphere_mask(videos[suffix][k])
         split = int(expected[k][:, 0].mean())  # a column between the two spheres
         left, right = mask.copy(), mask.copy()
@@ -102,7 +105,7 @@ def test_spheres_are_where_the_camera_puts_them(videos, suffix):
             assert np.linalg.norm(found[k][i] - expected[k][i]) < 0.75, (k, i, found[k][i])
         # Perspective size: the resting sphere covers π·(f·r/d)² pixels, to within 10 %.
         focal = 0.5 * SIZE[1] / math.tan(math.radians(camera.field_of_view) / 2)
-        distance = np.linalg.norm(np.subtract(camera.eye, recording["points"][k, 1]))
+        distance = np.linalg.norm(np.subtract(camera.eye, recording["particle_position"][k, 1]))
         assert right.sum() == pytest.approx(math.pi * (focal * RADIUS / distance) ** 2, rel=0.1)
     # The falling sphere moved down the picture (rows grow downwards) by tens of pixels ...
     assert found[-1][0][1] - found[0][0][1] > 25.0
@@ -115,7 +118,7 @@ def test_first_and_last_frames_differ_only_where_things_moved(videos, suffix):
     recording = falling_and_resting()
     camera = Camera.framing(drawn_bounds(recording.geometry()), aspect=SIZE[0] / SIZE[1])
     first, last = (videos[suffix][k].astype(float) for k in (0, -1))
-    x, y = project(camera, recording["points"][0, 0])[0].astype(int)
+    x, y = project(camera, recording["particle_position"][0, 0])[0].astype(int)
     moved = np.abs(first - last)[y - 3 : y + 4, x - 3 : x + 4].mean()
     corner = np.abs(first - last)[-12:, :12].mean()  # bottom-left: ground, far from all
     assert moved > 60.0
@@ -147,7 +150,9 @@ def test_gif_at_30_fps_alternates_delays_and_repeated_frames_merge(tmp_path):
     t = np.arange(10) / 10.0
     points = np.zeros((10, 1, 3))
     points[:, 0, 1] = 1.0 - 0.5 * t
-    recording = vv.Recording(t, {"points": points}, static={"radius": np.array([0.2])})
+    recording = vv.Recording(
+        t, {"particle_position": points}, static={"particle_radius": np.array([0.2])}
+    )
     path = render_video(recording, tmp_path / "slow.gif", fps=30.0, size=(64, 48))
     shown = frames_at_rate(t, 30.0)
     with Image.open(path) as gif:
@@ -165,7 +170,9 @@ def test_edges_are_drawn_as_dark_lines(tmp_path):
     square = np.array([[-1.0, 1.0, -1.0], [1.0, 1.0, -1.0], [1.0, 1.0, 1.0], [-1.0, 1.0, 1.0]])
     points = np.repeat(square[None], 3, axis=0)
     edges = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
-    recording = vv.Recording(np.arange(3) / 10.0, {"points": points}, static={"edges": edges})
+    recording = vv.Recording(
+        np.arange(3) / 10.0, {"particle_position": points}, static={"edges": edges}
+    )
     path = render_video(recording, tmp_path / "square.mp4", fps=10.0, size=(320, 192))
     image = read_frames(path)[0].astype(float)
     camera = Camera.framing(drawn_bounds(recording.geometry()), aspect=320 / 192)
@@ -182,7 +189,7 @@ def test_faces_show_their_front_and_back_colours(tmp_path, order, side):
     corners = np.array([[-1.0, 0.5, 1.0], [1.0, 0.5, 1.0], [0.0, 0.5, -1.0]])
     points = np.repeat(corners[None], 2, axis=0)
     recording = vv.Recording(
-        np.array([0.0, 0.1]), {"points": points}, static={"faces": np.array([order])}
+        np.array([0.0, 0.1]), {"particle_position": points}, static={"faces": np.array([order])}
     )
     path = render_video(recording, tmp_path / "triangle.gif", fps=10.0, size=(160, 96))
     image = read_frames(path)[0].astype(float)
@@ -235,7 +242,7 @@ def no_points() -> vv.Recording:
     ("name", "recording", "kwargs", "message"),
     [
         ("drop.avi", falling_and_resting, {}, r"`path` must end in \.mp4 or \.gif"),
-        ("drop.mp4", no_points, {}, "no `points` field"),
+        ("drop.mp4", no_points, {}, "no `particle_position` or `system_points` field"),
         ("drop.mp4", falling_and_resting, {"fps": 0.0}, "`fps` must be positive"),
         ("drop.gif", falling_and_resting, {"fps": -5}, "`fps` must be positive"),
         ("drop.gif", falling_and_resting, {"fps": 60.0}, "at most 50"),
@@ -254,7 +261,7 @@ def test_bad_input_is_refused_before_writing(tmp_path, name, recording, kwargs, 
 
 def test_non_finite_points_and_missing_directory(tmp_path):
     recording = falling_and_resting()
-    recording.fields["points"][7, 1, 2] = np.nan
+    recording.fields["particle_position"][7, 1, 2] = np.nan
     with pytest.raises(vv.ModelError, match="frame 7, point 1"):
         render_video(recording, tmp_path / "drop.mp4")
     with pytest.raises(vv.ModelError, match="does not exist"):
@@ -280,11 +287,11 @@ def test_a_failure_while_rendering_leaves_no_file(tmp_path, monkeypatch):
 @pytest.mark.parametrize("suffix", ["mp4", "gif"])
 def test_a_still_and_an_empty_scene_render(tmp_path, suffix):
     # One frame of one point without a radius (a scene of no size), and points of no count.
-    still = vv.Recording(np.array([0.0]), {"points": np.zeros((1, 1, 3))})
+    still = vv.Recording(np.array([0.0]), {"particle_position": np.zeros((1, 1, 3))})
     frames = read_frames(render_video(still, tmp_path / f"still.{suffix}", size=(64, 48)))
     assert frames.shape == (1, 48, 64, 3)
     assert sphere_mask(frames[0]).sum() > 50  # the default camera frames the lone sphere
-    empty = vv.Recording(np.arange(3) / 30.0, {"points": np.zeros((3, 0, 3))})
+    empty = vv.Recording(np.arange(3) / 30.0, {"particle_position": np.zeros((3, 0, 3))})
     frames = read_frames(render_video(empty, tmp_path / f"empty.{suffix}", size=(64, 48)))
     assert len(frames) == 3 and sphere_mask(frames[0]).sum() == 0
 
@@ -300,9 +307,9 @@ def _orbit(frames: int = 121, *, span: float = 365.25 * 86_400.0) -> vv.Recordin
     points[:, 1, 0], points[:, 1, 2] = np.cos(angle), -np.sin(angle)
     return vv.Recording(
         t,
-        {"points": points},
+        {"particle_position": points},
         static={
-            "color": np.array([[1.0, 0.78, 0.18], [0.16, 0.42, 0.86]]),
+            "particle_color": np.array([[1.0, 0.78, 0.18], [0.16, 0.42, 0.86]]),
             "display_radius": np.array([0.15, 0.06]),
         },
     )
@@ -331,7 +338,9 @@ def test_the_label_says_when_sizes_are_not_to_scale_and_picks_a_readable_unit():
     orbit = _orbit()
     assert _painter(orbit).label(182.625 * 86_400.0) == "t = 182.6 days, sizes not to scale"
     recording = vv.Recording(
-        np.linspace(0.0, 2.0, 3), {"points": np.zeros((3, 1, 3))}, static={"radius": [0.1]}
+        np.linspace(0.0, 2.0, 3),
+        {"particle_position": np.zeros((3, 1, 3))},
+        static={"particle_radius": [0.1]},
     )
     assert _painter(recording).label(1.5) == "t = 1.500 s"
     from visviva.viz.timescale import format_time
@@ -357,7 +366,7 @@ def test_trails_draw_the_path_behind_each_point():
 
 
 def test_trails_are_refused_for_many_points(tmp_path):
-    recording = vv.Recording(np.arange(3.0), {"points": np.zeros((3, 1001, 3))})
+    recording = vv.Recording(np.arange(3.0), {"particle_position": np.zeros((3, 1001, 3))})
     with pytest.raises(vv.ModelError, match="at most 1000 points"):
         vv.viz.video.render_video(recording, tmp_path / "a.gif", fps=1.0, trail=1.0)
     assert list(tmp_path.iterdir()) == []

@@ -48,9 +48,9 @@ def falling_recording() -> vv.Recording:
     points[:, :, 1] = 2.0 - 4.9 * t[:, None] ** 2
     return vv.Recording(
         t,
-        {"points": points},
-        static={"radius": np.full(3, 0.1), "edges": np.array([[0, 1], [1, 2]])},
-        units={"points": "m", "radius": "m"},
+        {"particle_position": points},
+        static={"particle_radius": np.full(3, 0.1), "edges": np.array([[0, 1], [1, 2]])},
+        units={"particle_position": "m", "particle_radius": "m"},
         attrs={"method": "velocity_verlet", "dt": 0.01, "substeps": 4},
     )
 
@@ -66,7 +66,9 @@ def waving_cloth(n: int = 64, frames: int = 300) -> vv.Recording:
     i, j = np.meshgrid(np.arange(n - 1), np.arange(n - 1), indexing="ij")
     a = (i * n + j).ravel()
     faces = np.concatenate([np.stack([a, a + 1, a + n], 1), np.stack([a + 1, a + n + 1, a + n], 1)])
-    return vv.Recording(t, {"points": points}, static={"faces": faces}, units={"points": "m"})
+    return vv.Recording(
+        t, {"particle_position": points}, static={"faces": faces}, units={"particle_position": "m"}
+    )
 
 
 @pytest.fixture(scope="module")
@@ -144,7 +146,9 @@ def test_embedded_frames_are_the_recording_resampled(falling):
     np.testing.assert_array_equal(falling.js("visviva.times"), recording.time[shown])
     for k in (0, 17, 49):
         points = np.array(falling.js(f"visviva.points({k})")).reshape(3, 3)
-        assert_quantized(points, recording["points"][shown[k]], recording["points"][shown])
+        assert_quantized(
+            points, recording["particle_position"][shown[k]], recording["particle_position"][shown]
+        )
     assert falling.js("document.getElementById('legend').textContent").count("velocity_verlet")
 
 
@@ -157,7 +161,7 @@ def test_base64_fallback_for_browsers_without_uint8array_frombase64(browser, fal
         recording = falling_recording()
         np.testing.assert_array_equal(opened.js("visviva.times"), recording.time)
         points = np.array(opened.js("visviva.points(49)")).reshape(3, 3)
-        assert_quantized(points, recording["points"][49], recording["points"])
+        assert_quantized(points, recording["particle_position"][49], recording["particle_position"])
     finally:
         opened.page.close()
 
@@ -301,7 +305,7 @@ def test_title_is_text_not_markup(browser, tmp_path):
 
 
 def test_a_single_still_point_loads_and_does_not_play(browser, tmp_path):
-    recording = vv.Recording(np.array([0.5]), {"points": np.array([[[0.0, 1.0, 0.0]]])})
+    recording = vv.Recording(np.array([0.5]), {"particle_position": np.array([[[0.0, 1.0, 0.0]]])})
     opened = Opened(browser, write_viewer(recording, tmp_path / "still.html"))
     try:
         assert opened.errors == []
@@ -330,7 +334,7 @@ def test_cloth_of_4096_vertices_and_300_frames_loads_quickly(browser, tmp_path):
         # pathologies on a slow, shared machine.
         assert ready < 10.0 and wall < 15.0
         last = np.array(opened.js("visviva.points(299)")).reshape(-1, 3)
-        assert_quantized(last, recording["points"][299], recording["points"])
+        assert_quantized(last, recording["particle_position"][299], recording["particle_position"])
         image = opened.image(150)
         orange = (image[..., 0] - image[..., 2]) > 80  # the cloth, #d9822b shaded
         assert orange.sum() > 0.05 * orange.size
@@ -341,13 +345,17 @@ def test_cloth_of_4096_vertices_and_300_frames_loads_quickly(browser, tmp_path):
 def test_default_rate():
     even = falling_recording()
     assert default_fps(even) == pytest.approx(25.0, rel=1e-12)
-    fast = vv.Recording(np.arange(1001) * 1e-3, {"points": np.zeros((1001, 1, 3))})
+    fast = vv.Recording(np.arange(1001) * 1e-3, {"particle_position": np.zeros((1001, 1, 3))})
     assert default_fps(fast) == pytest.approx(1000.0 / 17.0, rel=1e-12)
     np.testing.assert_array_equal(frames_at_rate(fast.time, default_fps(fast)), np.arange(59) * 17)
     # A shortened last interval still counts as even; uneven frames play at 30 fps.
-    short_end = vv.Recording(np.array([0.0, 0.1, 0.2, 0.25]), {"points": np.zeros((4, 1, 3))})
+    short_end = vv.Recording(
+        np.array([0.0, 0.1, 0.2, 0.25]), {"particle_position": np.zeros((4, 1, 3))}
+    )
     assert default_fps(short_end) == pytest.approx(10.0, rel=1e-12)
-    uneven = vv.Recording(np.array([0.0, 0.1, 0.3, 0.35]), {"points": np.zeros((4, 1, 3))})
+    uneven = vv.Recording(
+        np.array([0.0, 0.1, 0.3, 0.35]), {"particle_position": np.zeros((4, 1, 3))}
+    )
     assert default_fps(uneven) == 30.0
 
 
@@ -355,7 +363,7 @@ def test_default_rate_is_lowered_to_fit_the_size_cap():
     # 2¹⁸ points = 3 MiB per frame: 21 frames fit the 64 MiB cap; 100 s at 10 Hz do not.
     # (A broadcast view: the 6 GB of positions are never allocated.)
     points = np.broadcast_to(np.zeros((1, 1, 3)), (1001, 2**18, 3))
-    recording = vv.Recording(np.linspace(0.0, 100.0, 1001), {"points": points})
+    recording = vv.Recording(np.linspace(0.0, 100.0, 1001), {"particle_position": points})
     with pytest.warns(UserWarning, match="frames/s"):
         fps = default_fps(recording)
     frames = frames_at_rate(recording.time, fps).size
@@ -364,9 +372,9 @@ def test_default_rate_is_lowered_to_fit_the_size_cap():
 
 
 def blown_up(recording: vv.Recording) -> vv.Recording:
-    points = recording["points"].copy()
+    points = recording["particle_position"].copy()
     points[26:, 1] = np.inf
-    return vv.Recording(recording.time, {"points": points})
+    return vv.Recording(recording.time, {"particle_position": points})
 
 
 @pytest.mark.parametrize(
@@ -374,12 +382,12 @@ def blown_up(recording: vv.Recording) -> vv.Recording:
     [
         (lambda r, p: write_viewer("rec.h5", p), "`recording` must be a visviva Recording"),
         (
-            lambda r, p: write_viewer(vv.Recording(r.time, {"q": r["points"]}), p),
-            "no `points` field",
+            lambda r, p: write_viewer(vv.Recording(r.time, {"q": r["particle_position"]}), p),
+            "no `particle_position` or `system_points` field",
         ),
         (
             lambda r, p: write_viewer(
-                vv.Recording(np.zeros(0), {"points": np.zeros((0, 1, 3))}), p
+                vv.Recording(np.zeros(0), {"particle_position": np.zeros((0, 1, 3))}), p
             ),
             "no frames",
         ),
@@ -391,7 +399,7 @@ def blown_up(recording: vv.Recording) -> vv.Recording:
         (lambda r, p: write_viewer(blown_up(r), p), "recorded frame 26 are not finite"),
         (
             lambda r, p: write_viewer(
-                vv.Recording(np.array([0.0, 10.0]), {"points": np.zeros((2, 2**18, 3))}),
+                vv.Recording(np.array([0.0, 10.0]), {"particle_position": np.zeros((2, 2**18, 3))}),
                 p,
                 fps=10.0,
             ),
@@ -431,9 +439,10 @@ def test_galaxy_viewer_is_quantized_to_under_12_megabytes(tmp_path):
     times, decoded = _embedded_positions(page)
     shown = np.searchsorted(recording.time, times)
     np.testing.assert_array_equal(recording.time[shown], times)
-    assert_quantized(decoded, recording["points"][shown], recording["points"][shown])
+    stars = recording["system_points"]
+    assert_quantized(decoded, stars[shown], stars[shown])
     # The documented precision: half a step of a ~20 m box is about 0.15 mm.
-    flat = recording["points"].reshape(-1, 3)
+    flat = stars.reshape(-1, 3)
     assert np.max(flat.max(axis=0) - flat.min(axis=0)) / 65535 / 2 < 2.5e-4
 
 
@@ -446,9 +455,9 @@ def test_colours_display_radii_trails_and_time_unit_reach_the_page(browser, tmp_
     points[:, 1, 0], points[:, 1, 2] = np.cos(2 * np.pi * t / year), -np.sin(2 * np.pi * t / year)
     recording = vv.Recording(
         t,
-        {"points": points},
+        {"particle_position": points},
         static={
-            "color": np.array([[1.0, 0.78, 0.18], [0.16, 0.42, 0.86]]),
+            "particle_color": np.array([[1.0, 0.78, 0.18], [0.16, 0.42, 0.86]]),
             "display_radius": np.array([0.15, 0.06]),
         },
     )

@@ -38,7 +38,7 @@ if __name__ == "__main__":
     register()
     decay = vv.ode.FirstOrderProblem(lambda t, y: -y, [1.0])
     study = vv.analysis.convergence_order(
-        decay, "kutta3", t_end=1.0, reference=lambda t: np.exp(-t)
+        decay, "kutta3", until=1.0, reference=lambda t: np.exp(-t)
     )
     print(f"kutta3: measured order {study.order:.2f}")
     print("real stability interval:", vv.analysis.stability_interval("kutta3"))

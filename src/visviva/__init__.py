@@ -5,7 +5,7 @@ The short tour::
     import visviva as vv
 
     spring = vv.ode.SecondOrderProblem(lambda t, q: -q, q0=[1.0], v0=[0.0])
-    solution = vv.solve(spring, method="velocity_verlet", dt=0.01, t_end=10.0)
+    solution = vv.solve(spring, method="velocity_verlet", dt=0.01, until=10.0)
     solution.q, solution.v, solution.t          # the recorded frames
     vv.integrators.names()                       # every method
     vv.analysis.stability_interval("rk4")        # (-2.785..., 0.0)
@@ -16,7 +16,7 @@ Subpackages and the main functions load on first use, so that ``import visviva``
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ._lazy import lazy_names
 from ._version import __version__
@@ -52,7 +52,7 @@ if TYPE_CHECKING:
     )
     from .model import Model, SceneBuilder
     from .scenes import load_model, run_scene
-    from .simulation import Simulation, Solution, simulate, solve
+    from .simulation import Simulation, Solution, solve
     from .simulation.recording import Recording
     from .sweeps import load_sweep, sweep
 
@@ -87,7 +87,6 @@ __all__ = [
     "particles",
     "rigid",
     "run_scene",
-    "simulate",
     "simulation",
     "solve",
     "sweep",
@@ -103,11 +102,22 @@ _FUNCTIONS = {
     "Recording": "simulation",
     "Simulation": "simulation",
     "Solution": "simulation",
-    "simulate": "simulation",
     "solve": "simulation",
     "load_sweep": "sweeps",
     "sweep": "sweeps",
 }
 
+#: Public names that are gone, and what replaced them.
+_GONE = {
+    "simulate": "vv.simulate was merged into vv.solve: vv.solve(problem, method, dt=..., "
+    "until=...).raise_for_status().recording is the recording it returned",
+}
+
 # Subpackages load on first use too; tests/test_surface.py checks that __all__ lists each one.
-__getattr__, __dir__ = lazy_names(__name__, __all__, _FUNCTIONS)
+_load, __dir__ = lazy_names(__name__, __all__, _FUNCTIONS)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _GONE:
+        raise AttributeError(_GONE[name])
+    return _load(name)

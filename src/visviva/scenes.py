@@ -299,10 +299,17 @@ class RunFigures:
                 fields["energy"] = np.asarray(energy, dtype=np.float64)
             writer.append(state.t, fields)
             self.see(state.t, energy)
-            self.points = fields["points"].shape[0] if "points" in fields else 0
+            self.points = drawn_points(fields)
             self.final = final_values(fields)
 
         return record
+
+
+def drawn_points(fields: dict[str, np.ndarray]) -> int:
+    """How many points one recorded frame draws: its particles and its systems' points."""
+    return sum(
+        fields[name].shape[0] for name in ("particle_position", "system_points") if name in fields
+    )
 
 
 #: Recorded fields whose values at the end of a run join its summary, if they are small.
@@ -339,7 +346,7 @@ def recording_attrs(model: Model, seconds: float) -> dict[str, Any]:
         "substeps": settings.substeps,
         "record_every": settings.record_every,
         "t0": 0.0,
-        "t_end": seconds,
+        "until": seconds,
         "playback_speed": model.output_speed,
         "playback_trail": model.output_trail,
         "playback_color_by": model.output_color_by,

@@ -55,7 +55,7 @@ def separation(
     problem: Problem,
     *,
     delta: float = 1e-9,
-    t_end: float,
+    until: float,
     dt: float,
     method: str | Integrator = "rk4",
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -67,8 +67,8 @@ def separation(
     Args:
         problem: One system (not a batch); its initial state starts the reference trajectory.
         delta: Initial separation, in the unit of that first entry.
-        t_end: End of the run [s].
-        dt: Step [s], rounded so that a whole number of steps ends at ``t_end``.
+        until: End of the run [s].
+        dt: Step [s], rounded so that a whole number of steps ends at ``until``.
         method: Integrator name or instance.
 
     Returns:
@@ -80,7 +80,7 @@ def separation(
     """
     system, reference, integrator = _start(problem, method)
     delta = real_number("delta", delta, positive=True)
-    steps, h = _steps(real_number("t_end", t_end, unit=" s") - problem.t0, dt, "t_end")
+    steps, h = _steps(real_number("until", until, unit=" s") - problem.t0, dt, "until")
     companion = _displaced(reference, delta)
     times = problem.t0 + h * np.arange(steps + 1)
     distance = np.empty(steps + 1)
@@ -98,7 +98,7 @@ def separation(
 def lyapunov_exponent(
     problem: Problem,
     *,
-    t_end: float,
+    until: float,
     dt: float,
     interval: float = 1.0,
     delta: float = 1e-8,
@@ -108,8 +108,8 @@ def lyapunov_exponent(
 
     Args:
         problem: One system (not a batch); its initial state starts the reference trajectory.
-        t_end: End of the estimate [s]; the result is a finite-time exponent over
-            ``[t0, t_end]``, rounded to a whole number of intervals.
+        until: End of the estimate [s]; the result is a finite-time exponent over
+            ``[t0, until]``, rounded to a whole number of intervals.
         dt: Integration step [s], rounded so that a whole number of steps fills an interval.
         interval: Renormalisation period [s]: short enough that ``δ0 e^{λ·interval}`` stays
             well below the size of the attractor.
@@ -123,11 +123,11 @@ def lyapunov_exponent(
     system, reference, integrator = _start(problem, method)
     interval = real_number("interval", interval, positive=True, unit=" s")
     delta = real_number("delta", delta, positive=True)
-    span = real_number("t_end", t_end, unit=" s") - problem.t0
+    span = real_number("until", until, unit=" s") - problem.t0
     count = round(span / interval)
     if count < 1:
         raise ModelError(
-            f"`t_end` ({t_end} s) must be at least one `interval` ({interval} s) after the "
+            f"`until` ({until} s) must be at least one `interval` ({interval} s) after the "
             f"problem's t0 ({problem.t0} s)"
         )
     steps, h = _steps(interval, dt, "interval")

@@ -64,14 +64,14 @@ class Comparison:
         studies: The convergence studies (for :func:`~visviva.viz.plots.plot_convergence`);
             :func:`~visviva.viz.plots.comparison_figures` draws both.
         dt: Step of the full runs [s].
-        t_end: End of the full runs [s].
+        until: End of the full runs [s].
     """
 
     results: list[MethodResult]
     runs: dict[str, Recording]
     studies: list[ConvergenceStudy]
     dt: float
-    t_end: float
+    until: float
 
     def table(self) -> str:
         """The results as an aligned plain-text table."""
@@ -100,7 +100,7 @@ class Comparison:
         """The results for ``summary.json``."""
         return {
             "dt_s": self.dt,
-            "t_end_s": self.t_end,
+            "until_s": self.until,
             "methods": [asdict(r) for r in self.results],
         }
 
@@ -114,8 +114,8 @@ def compare_methods(
     methods: Sequence[str],
     *,
     dt: float,
-    t_end: float,
-    convergence_t_end: float | None = None,
+    until: float,
+    convergence_until: float | None = None,
     levels: int = 6,
     record_every: int = 1,
 ) -> Comparison:
@@ -125,8 +125,8 @@ def compare_methods(
         problem: Any first- or second-order problem (with an energy for the energy columns).
         methods: Integrator names.
         dt: Step of the full runs [s].
-        t_end: End of the full runs [s] (long, to show drift).
-        convergence_t_end: End of the order measurement [s]; default ``min(t_end, t0 + 1)``.
+        until: End of the full runs [s] (long, to show drift).
+        convergence_until: End of the order measurement [s]; default ``min(until, t0 + 1)``.
             Keep it short for chaotic systems, whose reference is only trustworthy briefly.
         levels: Step sizes in each order measurement (halved from ``(span)/8``; at least 3).
         record_every: Record every k-th step of the full runs.
@@ -135,22 +135,22 @@ def compare_methods(
         A :class:`Comparison`.
     """
     dt = real_number("dt", dt, positive=True, unit=" s")
-    t_end = real_number("t_end", t_end, unit=" s")
+    until = real_number("until", until, unit=" s")
     levels = whole_number("levels", levels, minimum=3)
-    span_end = min(t_end, problem.t0 + 1.0) if convergence_t_end is None else convergence_t_end
-    span_end = real_number("convergence_t_end", span_end, unit=" s")
+    span_end = min(until, problem.t0 + 1.0) if convergence_until is None else convergence_until
+    span_end = real_number("convergence_until", span_end, unit=" s")
     integrators = [get(name) for name in methods]
     results, runs, studies = [], {}, []
     from ..simulation.solution import solve
 
     for integrator in integrators:
         started = time.perf_counter()
-        solution = solve(problem, integrator, dt=dt, t_end=t_end, record_every=record_every)
+        solution = solve(problem, integrator, dt=dt, until=until, record_every=record_every)
         elapsed = time.perf_counter() - started
         recording = solution.recording
         runs[integrator.name] = recording
         try:
-            study = convergence_order(problem, integrator, t_end=span_end, levels=levels)
+            study = convergence_order(problem, integrator, until=span_end, levels=levels)
         except SimulationError:
             study = None
         if study is not None:
@@ -168,4 +168,4 @@ def compare_methods(
                 message=str(recording.attrs.get("message", "")),
             )
         )
-    return Comparison(results, runs, studies, dt, t_end)
+    return Comparison(results, runs, studies, dt, until)

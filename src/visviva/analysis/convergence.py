@@ -3,7 +3,7 @@
 A method of order ``p`` has global error ``≈ C·dt^p`` at a fixed time once ``dt`` is small
 enough (seed 000: "halving Δt should reduce the error by a factor of 2" for a first-order
 method). :func:`convergence_order` runs a method at successively halved steps, measures the
-error at ``t_end`` against a reference solution, and fits the slope over the *asymptotic range*:
+error at ``until`` against a reference solution, and fits the slope over the *asymptotic range*:
 points above the round-off floor whose local slopes agree, found by starting from the finest
 steps and adding coarser ones while they stay on the same line.
 """
@@ -39,7 +39,7 @@ class ConvergenceStudy:
         method: Method name.
         declared_order: The order the method declares.
         dt: Step sizes [s], decreasing.
-        error: Max-norm error at ``t_end`` for each step size.
+        error: Max-norm error at ``until`` for each step size.
         used: Mask of the points in the asymptotic fit.
         order: Fitted slope of ``log(error)`` against ``log(dt)`` (``nan`` if fewer than three
             points are usable).
@@ -60,15 +60,15 @@ class ConvergenceStudy:
             return np.log(self.error[:-1] / self.error[1:]) / np.log(self.dt[:-1] / self.dt[1:])
 
 
-def _reference_parts(reference: Any, problem: Problem, t_end: float) -> tuple[np.ndarray, ...]:
-    value = reference(t_end) if callable(reference) else reference
+def _reference_parts(reference: Any, problem: Problem, until: float) -> tuple[np.ndarray, ...]:
+    value = reference(until) if callable(reference) else reference
     parts = (
         tuple(np.asarray(v) for v in value) if isinstance(value, tuple) else (np.asarray(value),)
     )
     names = problem.initial_state().names()
     if len(parts) != len(names):
         shown = names[0] if len(names) == 1 else f"({', '.join(names)})"
-        raise ModelError(f"`reference` must give {shown} at t_end for this problem")
+        raise ModelError(f"`reference` must give {shown} at `until` for this problem")
     return parts
 
 
@@ -76,7 +76,7 @@ def convergence_order(
     problem: Problem,
     method: str | Integrator,
     *,
-    t_end: float,
+    until: float,
     dt: Sequence[float] | None = None,
     reference: Callable[[float], Any] | Any = None,
     levels: int = 8,
@@ -86,9 +86,9 @@ def convergence_order(
     Args:
         problem: The problem to integrate.
         method: Method name or instance (adaptive methods run with fixed steps here).
-        t_end: Time at which the error is measured [s].
-        dt: Step sizes to try; default ``(t_end − t0)/8`` halved ``levels − 1`` times.
-        reference: The exact solution at ``t_end``: a callable ``reference(t)`` or the value,
+        until: Time at which the error is measured [s].
+        dt: Step sizes to try; default ``(until − t0)/8`` halved ``levels − 1`` times.
+        reference: The exact solution at ``until``: a callable ``reference(t)`` or the value,
             ``y`` or ``(q, v)``. Default: a Dormand–Prince solution at ``rtol = 1e-13``, which
             limits the measurable error to about 1e-10.
         levels: Number of step sizes when ``dt`` is not given (at least 3).
@@ -99,7 +99,7 @@ def convergence_order(
     Example:
         >>> import numpy as np, visviva as vv
         >>> decay = vv.ode.FirstOrderProblem(lambda t, y: -y, [1.0])
-        >>> study = vv.analysis.convergence_order(decay, "heun", t_end=1.0,
+        >>> study = vv.analysis.convergence_order(decay, "heun", until=1.0,
         ...                                       reference=lambda t: np.exp(-t))
         >>> round(study.order, 1)
         2.0
@@ -107,10 +107,10 @@ def convergence_order(
     from ..simulation.solution import solve
 
     integrator = get(method)
-    t_end = real_number("t_end", t_end, unit=" s")
-    span = t_end - problem.t0
+    until = real_number("until", until, unit=" s")
+    span = until - problem.t0
     if not span > 0:
-        raise ModelError(f"`t_end` must be after t0 (got t_end={t_end!r}, t0={problem.t0!r})")
+        raise ModelError(f"`until` must be after t0 (got until={until!r}, t0={problem.t0!r})")
     if dt is None:
         levels = whole_number("levels", levels, minimum=3)
         steps = np.array([span / (8 * 2**k) for k in range(levels)], dtype=np.float64)
@@ -123,16 +123,16 @@ def convergence_order(
     floor_scale = 1.0
     names = problem.initial_state().names()
     if reference is None:
-        accurate = solve(problem, "dopri5", t_end=t_end, rtol=1e-13, atol=1e-13).raise_for_status()
+        accurate = solve(problem, "dopri5", until=until, rtol=1e-13, atol=1e-13).raise_for_status()
         exact = tuple(accurate.recording[name][-1] for name in names)
         floor_scale = 1000.0  # the reference itself is only good to ~1e-11
     else:
-        exact = _reference_parts(reference, problem, t_end)
+        exact = _reference_parts(reference, problem, until)
     scale = max(1.0, max(float(np.max(np.abs(p))) for p in exact))
     errors = np.empty(steps.size)
     for i, h in enumerate(steps):
         solution = solve(
-            problem, integrator, t_end=t_end, dt=float(h), adaptive=False, record_every=10**9
+            problem, integrator, until=until, dt=float(h), adaptive=False, record_every=10**9
         )
         if not solution.success:
             errors[i] = np.inf

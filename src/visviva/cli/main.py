@@ -117,7 +117,7 @@ def convergence_command(
     problem: Annotated[
         str, typer.Option(help="Reference problem: pendulum, forced, damped or first-order.")
     ] = "pendulum",
-    t_end: Annotated[float, typer.Option(help="Time of the error measurement [s].")] = 2.0,
+    until: Annotated[float, typer.Option(help="Time of the error measurement [s].")] = 2.0,
     levels: Annotated[int, typer.Option(help="Number of halved step sizes (at least 3).")] = 8,
     output: Annotated[
         Path | None, typer.Option("--output", "-o", help="Write the log-log plot (PNG).")
@@ -139,10 +139,10 @@ def convergence_command(
             "step and doubles the time, and beyond 14 levels round-off hides the truncation "
             "error of every method of order 2 or more"
         )
-    t_end = real_number("t_end", t_end, positive=True, unit=" s")
-    if t_end > MAX_CONVERGENCE_TIME:
+    until = real_number("until", until, positive=True, unit=" s")
+    if until > MAX_CONVERGENCE_TIME:
         raise ModelError(
-            f"`--t-end` must be at most {MAX_CONVERGENCE_TIME:g} s (got {t_end!r}): the "
+            f"`--until` must be at most {MAX_CONVERGENCE_TIME:g} s (got {until!r}): the "
             "measured error then mixes in chaos and round-off"
         )
     if output is not None:
@@ -154,9 +154,9 @@ def convergence_command(
         convergence_order(
             test.problem,
             m,
-            t_end=t_end,
+            until=until,
             reference=test.exact,
-            dt=[t_end / (10 * 2**k) for k in range(levels)],
+            dt=[until / (10 * 2**k) for k in range(levels)],
         )
         for m in instances
     ]
@@ -176,9 +176,9 @@ def convergence_command(
         for s in studies
     ]
     if as_json:
-        print_json({"problem": problem, "t_end": t_end, "methods": rows})
+        print_json({"problem": problem, "until": until, "methods": rows})
         return
-    typer.echo(f"problem: {test.description}, error at t = {t_end:g} s")
+    typer.echo(f"problem: {test.description}, error at t = {until:g} s")
     for row in rows:
         typer.echo(
             f"{row['method']:34s} declared {row['declared_order']}  measured "
@@ -246,7 +246,7 @@ def compare_command(
     duration: Annotated[
         float | None, typer.Option(help="Length of the runs [s] (default: the scene's, or 10 s).")
     ] = None,
-    convergence_time: Annotated[
+    convergence_duration: Annotated[
         float, typer.Option(help="Span of the order measurement [s].")
     ] = 1.0,
     output: Annotated[Path | None, typer.Option("--output", "-o", help="Output directory.")] = None,
@@ -292,8 +292,8 @@ def compare_command(
         problem,
         list(methods or COMPARED),
         dt=step,
-        t_end=end,
-        convergence_t_end=problem.t0 + min(convergence_time, end - problem.t0),
+        until=end,
+        convergence_until=problem.t0 + min(convergence_duration, end - problem.t0),
         record_every=max(1, round(span / step / 2000)),
     )
     job.recordings.update(comparison.runs)

@@ -141,7 +141,7 @@ def plot_command(
     """Plot a recording: energy or momenta over time (default: energy if it was recorded)."""
     from ..errors import ModelError
     from ..io.recording import load_recording, read_recordings
-    from ..viz.plots import plot_energy, plot_momentum
+    from ..viz.plots import has_momenta, plot_energy, plot_momentum
 
     if energy and momentum:
         raise ModelError("choose one of --energy and --momentum per plot")
@@ -162,10 +162,10 @@ def plot_command(
                 "--run NAME for --momentum"
             )
         (chosen,) = runs.values()
-        if not {"points", "velocities"} <= set(chosen.fields) or "mass" not in chosen.static:
+        if not has_momenta(chosen):
             raise ModelError(
                 f"{recording} has neither energy nor momenta to plot (fields: {_fields(runs)}); "
-                "momenta need the points, velocities and masses of a particle recording"
+                "momenta need the positions, velocities and masses of a particle recording"
             )
     target = output or recording.with_name(f"{kind}.png")
     check_figure_file(target, force)

@@ -10,10 +10,11 @@ from ..simulation.recording import Recording
 
 def drawn_system(system: LagrangianSystem, recording: Recording) -> Recording:
     """``recording`` of one run of ``system`` (fields ``q`` and ``v``) with the positions of
-    its ``points`` [m] per frame, ``(frames, P, 3)``, and its ``edges``, so that the video,
-    the viewer and the exporters can show it."""
-    fields = dict(recording.fields) | {"points": system.points(recording["q"], recording.time)}
-    units = dict(recording.units) | {"points": "m"}
+    its drawn points [m] per frame, ``system_points`` ``(frames, P, 3)``, and its ``edges``, so
+    that the video, the viewer and the exporters can show it."""
+    points = system.points(recording["q"], recording.time)
+    fields = dict(recording.fields) | {"system_points": points}
+    units = dict(recording.units) | {"system_points": "m"}
     static = dict(recording.static)
     if system.edges:
         static["edges"] = np.array(system.edges, dtype=np.int64)
@@ -27,18 +28,19 @@ def drawn_bodies(
     display_radius: np.ndarray | None = None,
 ) -> Recording:
     """``recording`` of an n-body problem (fields ``q`` and ``v``, the bodies' coordinates
-    flattened) with each quantity once: ``points`` [m] and ``velocities`` [m/s], ``(frames, N,
-    3)``, plus the recorded energy; optionally each body's sRGB ``color`` ``(N, 3)`` and
-    ``display_radius`` [m] ``(N,)`` (see :mod:`visviva.io.recording`)."""
+    flattened) with each quantity once: the bodies drawn as ``system_points`` [m] moving at
+    ``system_velocity`` [m/s], ``(frames, N, 3)``, plus the recorded energy; optionally each
+    body's sRGB ``system_color`` ``(N, 3)`` and ``display_radius`` [m] ``(N,)`` (see
+    :mod:`visviva.simulation.recording`)."""
     x, v = body_states(recording)
-    fields = {"points": x, "velocities": v}
-    units = {"points": "m", "velocities": "m/s", "display_radius": "m"}
+    fields = {"system_points": x, "system_velocity": v}
+    units = {"system_points": "m", "system_velocity": "m/s", "display_radius": "m"}
     if "energy" in recording:
         fields["energy"] = recording["energy"]
         units["energy"] = recording.units.get("energy", "J")
     static = {
         name: np.asarray(value, dtype=np.float64)
-        for name, value in (("color", color), ("display_radius", display_radius))
+        for name, value in (("system_color", color), ("display_radius", display_radius))
         if value is not None
     }
     return Recording(recording.time, fields, units=units, attrs=recording.attrs, static=static)
@@ -46,7 +48,7 @@ def drawn_bodies(
 
 def body_states(recording: Recording) -> tuple[np.ndarray, np.ndarray]:
     """Positions and velocities per body, ``(frames, N, 3)`` each."""
-    if "points" in recording:
-        return recording["points"], recording["velocities"]
+    if "system_points" in recording:
+        return recording["system_points"], recording["system_velocity"]
     q, v = recording["q"], recording["v"]
     return q.reshape(q.shape[0], -1, 3), v.reshape(v.shape[0], -1, 3)

@@ -96,8 +96,10 @@ def load_on_pins(model: Model, x: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def kinetic_energy(recording: Recording) -> np.ndarray:
     """``½ Σ m v²`` [J] of each recorded frame, ``(frames,)``."""
-    mass = recording.static["mass"]
-    return 0.5 * np.einsum("i,fij,fij->f", mass, recording["velocities"], recording["velocities"])
+    mass = recording.static["particle_mass"]
+    return 0.5 * np.einsum(
+        "i,fij,fij->f", mass, recording["particle_velocity"], recording["particle_velocity"]
+    )
 
 
 def strain(model: Model, points: np.ndarray, pairs: np.ndarray) -> np.ndarray:

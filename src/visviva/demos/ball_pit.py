@@ -152,8 +152,8 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     recording = simulation.record(until=duration)
     output.recordings["symplectic_euler"] = recording
     t = recording.time
-    v = recording["velocities"]
-    x = recording["points"]
+    v = recording["particle_velocity"]
+    x = recording["particle_position"]
     kinetic = 0.5 * np.einsum("i,fij,fij->f", mass, v, v)
     # While every ball is clear of the box (two radii from each plane), only gravity changes
     # the balls' momentum: by M g t, to round-off.
@@ -180,7 +180,11 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     last = x[-1]
     cut = np.abs(last[:, 2]) < RADIUS
     widths = 2.0 * np.sqrt(RADIUS**2 - last[cut, 2] ** 2)
-    colors = np.asarray(recording.static["color"])[cut] if "color" in recording.static else None
+    colors = (
+        np.asarray(recording.static["particle_color"])[cut]
+        if "particle_color" in recording.static
+        else None
+    )
     side.add_collection(
         EllipseCollection(
             widths, widths, 0.0, units="xy", offsets=last[cut][:, :2],

@@ -101,7 +101,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     simulation = Simulation(build_scene(duration=duration).build())
     recording = simulation.record(until=duration)
     output.recordings["symplectic_euler"] = recording
-    t, x, v = recording.time, recording["points"], recording["velocities"]
+    t, x, v = recording.time, recording["particle_position"], recording["particle_velocity"]
     phi = np.array([polarisation(frame) for frame in v])
     gap = np.linalg.norm(x - np.asarray(OBSTACLE), axis=2) - OBSTACLE_RADIUS
     nearest = nearest_distances(x[-1])

@@ -44,7 +44,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     problem = circular_problem()
     final_radius = {}
     for name in METHODS:
-        solution = solve(problem, name, dt=DT, t_end=duration)
+        solution = solve(problem, name, dt=DT, until=duration)
         output.recordings[name] = solution.recording
         final_radius[name] = float(np.hypot(solution.q[-1, 0], solution.v[-1, 0]))
 

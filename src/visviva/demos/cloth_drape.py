@@ -144,7 +144,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     return {
         "method": METHOD,
         "dt": DT,
-        "deepest_inside_ball_m": float(max(0.0, -clearance(recording["points"]).min())),
+        "deepest_inside_ball_m": float(max(0.0, -clearance(recording["particle_position"]).min())),
         "inside_tolerance_m": INSIDE_TOLERANCE,
         "largest_energy_rise_per_step_J": largest_rise(energy),
         "energy_rise_tolerance_J": ENERGY_RISE_TOLERANCE,
@@ -186,7 +186,7 @@ def _figure(
     total.set_title("The energy never rises (contact and friction in the solve)")
     total.legend(fontsize=8)
     side.add_patch(Circle(BALL_CENTER[:2], BALL_RADIUS, color="0.85", zorder=0))
-    grid = recording["points"][-1].reshape(POINTS, POINTS, 3)
+    grid = recording["particle_position"][-1].reshape(POINTS, POINTS, 3)
     for row in grid:
         side.plot(row[:, 0], row[:, 1], color="C0", lw=0.6)
     side.set_aspect("equal")

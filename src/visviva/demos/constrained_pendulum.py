@@ -34,8 +34,8 @@ def _drawn(recording: Recording) -> Recording:
     points[..., 1] += 1.2 * LENGTH  # swing above the video's ground plane
     return Recording(
         recording.time,
-        dict(recording.fields) | {"points": points},
-        units=dict(recording.units) | {"points": "m"},
+        dict(recording.fields) | {"system_points": points},
+        units=dict(recording.units) | {"system_points": "m"},
         attrs=recording.attrs,
         static={"edges": np.array([[0, 1]])},
     )
@@ -45,7 +45,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     from matplotlib.figure import Figure
 
     reduced = solve(
-        classic.pendulum(length=LENGTH).problem([THETA0], [0.0]), "rk4", dt=DT, t_end=duration
+        classic.pendulum(length=LENGTH).problem([THETA0], [0.0]), "rk4", dt=DT, until=duration
     )
     figure = Figure(figsize=(13, 4.5), layout="constrained")
     angle, drift, tension = figure.subplots(1, 3)
@@ -57,7 +57,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
         problem, multiplier = classic.constrained_pendulum(
             THETA0, length=LENGTH, stabilization_rate=alpha
         )
-        particle = solve(problem, "rk4", dt=DT, t_end=duration)
+        particle = solve(problem, "rk4", dt=DT, until=duration)
         label = "particle + λ(r − c)" + (f", Baumgarte α = {alpha:g}/s" if alpha else "")
         output.recordings["constrained" if alpha == 0 else "stabilized"] = _drawn(
             particle.recording

@@ -156,7 +156,9 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     times = simulation.raw_state["crowd_exit_time"]
     t = recording.time
     centres, flow = exit_flow(times, WINDOW)
-    density, x_edges, z_edges = density_map(recording["points"], recording["alive"], ROOM)
+    density, x_edges, z_edges = density_map(
+        recording["particle_position"], recording["particle_alive"], ROOM
+    )
 
     figure = Figure(figsize=(13, 4.6), layout="constrained")
     out, rate, heat = figure.subplots(1, 3)

@@ -42,7 +42,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     for row, name in enumerate(METHODS):
         amplification[name] = {}
         for column, h in enumerate(STEPS):
-            solution = solve(problem, name, dt=h, t_end=duration)
+            solution = solve(problem, name, dt=h, until=duration)
             output.recordings[f"{name}_h{h:g}"] = solution.recording
             factor = float(stability_function(name, h * LAMBDA).real)
             amplification[name][f"{h:g}"] = factor

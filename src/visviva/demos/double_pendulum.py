@@ -39,11 +39,11 @@ def _together(system: Any, pair: Solution) -> Recording:
     edges = np.array(system.edges, dtype=np.int64)
     static = {
         "edges": np.concatenate([edges, edges + 3]),
-        "color": np.array(PIVOT_AND_BOBS[0] + PIVOT_AND_BOBS[1]),
+        "system_color": np.array(PIVOT_AND_BOBS[0] + PIVOT_AND_BOBS[1]),
     }
-    fields = {"q": pair.q[:, 0], "v": pair.v[:, 0], "points": points}
+    fields = {"q": pair.q[:, 0], "v": pair.v[:, 0], "system_points": points}
     attrs = pair.recording.attrs
-    return Recording(pair.t, fields, units={"points": "m"}, attrs=attrs, static=static)
+    return Recording(pair.t, fields, units={"system_points": "m"}, attrs=attrs, static=static)
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
@@ -53,16 +53,16 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     output.stage("equations.txt").write_text(system.text() + "\n")
     output.stage("equations.tex").write_text(system.latex() + "\n")
     problem = system.problem(np.stack([Q0, Q0 + [0.0, DELTA]]), np.zeros((2, 2)))
-    pair = solve(problem, "rk4", dt=DT, t_end=duration, record_every=10)
+    pair = solve(problem, "rk4", dt=DT, until=duration, record_every=10)
     output.recordings["rk4"] = _together(system, pair)
     difference = np.concatenate([pair.q[:, 1] - pair.q[:, 0], pair.v[:, 1] - pair.v[:, 0]], axis=1)
     separation = np.linalg.norm(difference, axis=1)
     estimate = lyapunov_exponent(
-        system.problem(Q0, [0.0, 0.0]), t_end=max(duration, 20.0), dt=2e-3, interval=0.5
+        system.problem(Q0, [0.0, 0.0]), until=max(duration, 20.0), dt=2e-3, interval=0.5
     )
 
     canonical = solve(
-        system.canonical_problem(Q0, [0.0, 0.0]), "implicit_midpoint", dt=10 * DT, t_end=duration
+        system.canonical_problem(Q0, [0.0, 0.0]), "implicit_midpoint", dt=10 * DT, until=duration
     )
     output.recordings["implicit_midpoint_qp"] = canonical.recording
 

@@ -182,7 +182,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     simulation = Simulation(model)
     recording = simulation.record(until=duration)
     output.recordings["symplectic_euler"] = recording
-    t, alive, points = recording.time, recording["alive"], recording["points"]
+    t, alive, points = recording.time, recording["particle_alive"], recording["particle_position"]
     sparks = {spec.name: spec for spec in model.emitters if spec.name.endswith("sparks")}
 
     figure = Figure(figsize=(12, 4.8), layout="constrained")
@@ -219,7 +219,9 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     k = min(k, t.shape[0] - 1)
     shown = alive[k]
     sky.set_facecolor("black")
-    sky.scatter(points[k, shown, 0], points[k, shown, 1], s=1.5, c=recording["color"][k][shown])
+    sky.scatter(
+        points[k, shown, 0], points[k, shown, 1], s=1.5, c=recording["particle_color"][k][shown]
+    )
     sky.set_aspect("equal")
     sky.set_xlabel("x [m]")
     sky.set_ylabel("height y [m]")

@@ -120,12 +120,12 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     model, simulation, recording = record_alone(build_scene(duration), duration)
     output.recordings[METHOD] = recording
     t = recording.time
-    angle = deflection(model, recording["points"])
+    angle = deflection(model, recording["particle_position"])
     settled = t >= 0.5 * t[-1]
     state = simulation.state
     pull = load_on_pins(model, state["particle_position"], state["particle_velocity"])
     predicted = predicted_angles(model)
-    output.figures["flag"] = _figure(t, angle, recording["points"][-1], predicted)
+    output.figures["flag"] = _figure(t, angle, recording["particle_position"][-1], predicted)
     return {
         "method": METHOD,
         "dt": DT,

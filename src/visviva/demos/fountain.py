@@ -109,8 +109,8 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     simulation = Simulation(build_scene(duration).build())
     recording = simulation.record(until=duration)
     output.recordings["symplectic_euler"] = recording
-    t, alive = recording.time, recording["alive"]
-    heights = np.where(alive, recording["points"][..., 1], -np.inf)
+    t, alive = recording.time, recording["particle_alive"]
+    heights = np.where(alive, recording["particle_position"][..., 1], -np.inf)
     live = alive.sum(axis=1)
     steady = t >= LIFETIME[1]
     steady_expected = RATE * 0.5 * (LIFETIME[0] + LIFETIME[1])
@@ -128,8 +128,8 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     count.set_title("Filling up to the steady state")
     count.legend(fontsize=8, loc="lower right")
     last = alive[-1]
-    end = recording["points"][-1][last]
-    side.scatter(end[:, 0], end[:, 1], s=1.0, c=recording["color"][-1][last])
+    end = recording["particle_position"][-1][last]
+    side.scatter(end[:, 0], end[:, 1], s=1.0, c=recording["particle_color"][-1][last])
     top = NOZZLE[1]
     side.axhline(top + drag_free, color="C3", linestyle="--", label="v²/(2g), no drag")
     side.axhline(top + with_drag, color="k", linestyle=":", label="linear drag, closed form")

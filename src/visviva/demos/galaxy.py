@@ -49,7 +49,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     problem = bodies.problem(
         softening=SOFTENING, method="barnes_hut", theta=THETA, name="colliding galaxies"
     )
-    solution = solve(problem, "velocity_verlet", dt=DT, t_end=duration, record_every=5)
+    solution = solve(problem, "velocity_verlet", dt=DT, until=duration, record_every=5)
     output.recordings["velocity_verlet"] = drawn_bodies(solution.recording)
     x, _ = body_states(solution.recording)
     figure = Figure(figsize=(14, 3.8), layout="constrained")

@@ -225,7 +225,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     with one_thread():
         recording = simulation.record(until=duration)
     output.recordings[METHOD] = recording
-    t, points = recording.time, recording["points"]
+    t, points = recording.time, recording["particle_position"]
     roots = points[:, model.particle_pinned]
     pairs, _ = spring_pairs(model)
     stretch = strain(model, points, pairs[np.abs(pairs[:, 1] - pairs[:, 0]) == 1])

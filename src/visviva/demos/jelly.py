@@ -138,7 +138,7 @@ def static_energy(model: Model, u: np.ndarray) -> float:
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
     model, _, recording = record_alone(build_scene(duration), duration)
     output.recordings["symplectic_euler"] = recording
-    t, points, energy = recording.time, recording["points"], recording["energy"]
+    t, points, energy = recording.time, recording["particle_position"], recording["energy"]
     clearance = points[..., 1] - RADIUS
     lowest = clearance.min(axis=1)
     touched = np.flatnonzero(lowest <= 1e-6)

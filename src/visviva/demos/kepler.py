@@ -51,7 +51,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     )
     figures = {}
     for name in METHODS:
-        solution = solve(problem, name, dt=dt, t_end=duration, record_every=10)
+        solution = solve(problem, name, dt=dt, until=duration, record_every=10)
         output.recordings[name] = drawn_bodies(solution.recording, color=COLORS)
         x, v = body_states(solution.recording)
         relative_energy = solution.energy / orbit.energy - 1.0

@@ -52,9 +52,9 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     for name in names():
         method = get(name)
         if method.adaptive:
-            solution = solve(problem, method, t_end=duration, rtol=1e-6, atol=1e-9)
+            solution = solve(problem, method, until=duration, rtol=1e-6, atol=1e-9)
         else:
-            solution = solve(problem, method, dt=DT, t_end=duration, record_every=every)
+            solution = solve(problem, method, dt=DT, until=duration, record_every=every)
         output.recordings[name] = solution.recording
     output.figures["energy"] = plot_energy(
         output.recordings, title=f"Undamped oscillator, ωh = {OMEGA * DT:.3f}: energy change"

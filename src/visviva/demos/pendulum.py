@@ -31,7 +31,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     from matplotlib.figure import Figure
 
     system = classic.pendulum(length=LENGTH)
-    solution = solve(system.problem([THETA0], [0.0]), "rk4", dt=DT, t_end=duration)
+    solution = solve(system.problem([THETA0], [0.0]), "rk4", dt=DT, until=duration)
     output.recordings["rk4"] = drawn_system(system, solution.recording)
     output.stage("equations.txt").write_text(system.text() + "\n")
     output.stage("equations.tex").write_text(system.latex() + "\n")
@@ -60,7 +60,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
             system.problem([amplitude], [0.0]),
             "rk4",
             dt=DT,
-            t_end=4 * classic.pendulum_period(amplitude, length=LENGTH) + 0.5,
+            until=4 * classic.pendulum_period(amplitude, length=LENGTH) + 0.5,
         )
         swing.append(classic.oscillation_period(swing_run.t, swing_run.q[:, 0], swing_run.v[:, 0]))
     periods.plot(AMPLITUDES, swing, "o", label="measured (RK4)")

@@ -34,7 +34,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     path, error = figure.subplots(1, 2)
     errors = {}
     for name in METHODS:
-        solution = solve(problem, name, dt=DT, t_end=duration)
+        solution = solve(problem, name, dt=DT, until=duration)
         output.recordings[name] = drawn_system(system, solution.recording)
         exact = classic.rock_trajectory(solution.t, Q0, V0)
         height_error = solution.q[:, 1] - exact[:, 1]

@@ -166,9 +166,9 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     simulation = Simulation(model)
     recording = simulation.record(until=duration)
     output.recordings["symplectic_euler"] = recording
-    t, alive = recording.time, recording["alive"]
-    points, radius = recording["points"], recording["radius"]
-    speed = np.linalg.norm(recording["velocities"], axis=-1)
+    t, alive = recording.time, recording["particle_alive"]
+    points, radius = recording["particle_position"], recording["particle_radius"]
+    speed = np.linalg.norm(recording["particle_velocity"], axis=-1)
     resting = alive & (speed < REST_SPEED)
     born = alive.sum(axis=1)
     fraction = np.divide(resting.sum(axis=1), born, out=np.zeros(t.shape), where=born > 0)

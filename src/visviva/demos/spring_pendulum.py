@@ -35,7 +35,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
         system.problem([hanging + 0.05, 0.3], [0.0, 0.0]),
         "rk4",
         dt=DT,
-        t_end=duration,
+        until=duration,
         record_every=10,
     )
     output.recordings["rk4"] = drawn_system(system, solution.recording)

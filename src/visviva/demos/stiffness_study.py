@@ -129,7 +129,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
                     "energy_lost_fraction": float((energy[0] - energy[-1]) / energy[0]),
                     "largest_energy_rise_per_step_J": largest_rise(energy),
                     "largest_stretch_at_end": float(
-                        strain(implicit.model, recording["points"][-1], edges).max()
+                        strain(implicit.model, recording["particle_position"][-1], edges).max()
                     ),
                     "newton_iterations": int(implicit.system.counters.newton_iterations),
                     "krylov_iterations": int(implicit.system.counters.krylov_iterations),

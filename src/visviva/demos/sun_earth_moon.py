@@ -54,7 +54,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 
     bodies = sun_earth_moon()
     solution = solve(
-        bodies.problem(name="Sun-Earth-Moon"), "velocity_verlet", dt=DT, t_end=duration
+        bodies.problem(name="Sun-Earth-Moon"), "velocity_verlet", dt=DT, until=duration
     )
     output.recordings["velocity_verlet"] = drawn_bodies(
         solution.recording, color=COLORS, display_radius=DISPLAY_RADIUS

@@ -4,7 +4,7 @@ A :class:`~visviva.simulation.recording.Recording` (the frames of a run in memor
 with :func:`save_recording` (one run) or :func:`write_recordings` (several runs in one file, a
 comparison of methods) and read with :func:`load_recording` / :func:`read_recordings`.
 
-File layout (format ``visviva.recording``, version 1), one HDF5 group per run::
+File layout (format ``visviva.recording``, version 2), one HDF5 group per run::
 
     /                       attrs: format, format_version, visviva_version, created_utc,
                                    runs (JSON list of run names, in order)
@@ -15,9 +15,17 @@ File layout (format ``visviva.recording``, version 1), one HDF5 group per run::
     /<run>/fields/<name>    (frames, ...) float64 or complex128, attr units, chunked per frame
     /<run>/static/<name>    arrays without a frame axis (topology, radii), attr units
 
-The drawable-geometry names (``points``, ``radius``, ``edges``, ...) are those of
+The field names (``particle_position``, ``system_points``, ``edges``, ...) are those of
 :mod:`visviva.simulation.recording`. Files are written to a temporary name next to the target
 and renamed when complete, so a crash never leaves a truncated file under the real name.
+
+Version 1 named a scene's drawn points ``points`` (its particles, then its systems' points)
+with ``velocities``, ``alive``, ``radius`` and ``color`` over them and the particles' ``mass``;
+version 2 names them as the state parts (``particle_position``, ``particle_velocity``,
+``particle_alive``, ``particle_radius``, ``particle_color``, ``particle_mass``) beside the
+systems' ``system_points``, ``system_velocity``, ``system_radius`` and ``system_color``. A
+version-1 file is read with the new names (:func:`upgraded_names`): the first ``N`` points,
+``N`` the length of ``mass`` (none without it), are the particles.
 """
 
 from __future__ import annotations
@@ -47,7 +55,7 @@ __all__ = [
 ]
 
 FORMAT = "visviva.recording"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 
 
 def save_recording(recording: Recording, path: str | os.PathLike[str], *, run: str = "run") -> Path:
@@ -151,7 +159,7 @@ def read_recordings(path: str | os.PathLike[str]) -> dict[str, Recording]:
                 f"{FORMAT_VERSION} (upgrade visviva)"
             )
         try:
-            return _read_runs(file)
+            return _read_runs(file, int(version))
         except _DAMAGE as exc:
             raise ModelError(
                 f"{os.fspath(path)} is a damaged visviva recording ({type(exc).__name__}: "
@@ -163,7 +171,7 @@ def read_recordings(path: str | os.PathLike[str]) -> dict[str, Recording]:
 _DAMAGE = (KeyError, ValueError, TypeError, IndexError, AttributeError, OSError)
 
 
-def _read_runs(file: Any) -> dict[str, Recording]:
+def _read_runs(file: Any, version: int) -> dict[str, Recording]:
     names = json.loads(file.attrs["runs"])
     if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
         raise ValueError(f"the list of runs is {describe(names)}")
@@ -184,5 +192,55 @@ def _read_runs(file: Any) -> dict[str, Recording]:
             if part in group
             for k, d in group[part].items()
         }
+        if version == 1:
+            fields, static, units = upgraded_names(fields, static, units)
         runs[name] = Recording(group["time"][()], fields, units=units, attrs=attrs, static=static)
     return runs
+
+
+#: Version 1's names of the drawn points' arrays: the old name, the particles' new name and
+#: the systems' points' new name (``None``: they have none).
+_DRAWN_NAMES_1 = (
+    ("points", "particle_position", "system_points"),
+    ("velocities", "particle_velocity", "system_velocity"),
+    ("alive", "particle_alive", None),
+    ("radius", "particle_radius", "system_radius"),
+    ("color", "particle_color", "system_color"),
+)
+#: Arrays of the systems' points that stay fields (the others do not change over a run).
+_SYSTEM_FIELDS = ("system_points", "system_velocity")
+
+
+def upgraded_names(
+    fields: dict[str, np.ndarray], static: dict[str, np.ndarray], units: dict[str, str]
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], dict[str, str]]:
+    """The fields, static arrays and units of a version-1 recording under the names of
+    version 2 (see the module docstring); other names are kept."""
+    fields, static, units = dict(fields), dict(static), dict(units)
+    n = 0
+    if "mass" in static:
+        n = static["mass"].shape[0]
+        static["particle_mass"] = static.pop("mass")
+        units["particle_mass"] = units.pop("mass", "kg")
+    count = fields["points"].shape[1] if "points" in fields else n
+    for old, own, theirs in _DRAWN_NAMES_1:
+        per_frame = old in fields
+        value = fields.pop(old) if per_frame else static.pop(old, None)
+        unit = units.pop(old, "")
+        if value is None:
+            continue
+        axis = 1 if per_frame else 0
+        particles = value[:, :n] if per_frame else value[:n]
+        systems = value[:, n:] if per_frame else value[n:]
+        if value.shape[axis] != count:  # velocities of the particles alone
+            systems = systems[:, :0] if per_frame else systems[:0]
+        if per_frame and theirs is not None and theirs not in _SYSTEM_FIELDS:
+            systems = systems[0]  # the systems' radii and colours never change
+        parts = [(own, particles, per_frame)]
+        if theirs is not None:
+            parts.append((theirs, systems, theirs in _SYSTEM_FIELDS))
+        for name, part, varying in parts:
+            if part.shape[1 if varying else 0]:
+                (fields if varying else static)[name] = part
+                units[name] = unit
+    return fields, static, units

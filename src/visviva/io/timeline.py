@@ -47,7 +47,7 @@ def frames_at_rate(time: np.ndarray, fps: float, *, speed: float = 1.0) -> np.nd
         speed: Simulated seconds per second of playback.
 
     Returns:
-        ``int64`` array of length ``floor((t_end − t0)·fps/speed) + 1``: for output frame ``k``,
+        ``int64`` array of length ``floor((until − t0)·fps/speed) + 1``: for output frame ``k``,
         the index of the recorded frame nearest ``t0 + k·speed/fps``.
 
     Raises:

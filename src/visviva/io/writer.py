@@ -1,7 +1,7 @@
 """Streaming a run's frames into a recording file while it runs.
 
 :class:`RecordingWriter` writes the same layout as :func:`~visviva.io.write_recordings` (format
-``visviva.recording`` v1, one run), but frame by frame into resizable datasets, flushing every
+``visviva.recording`` v2, one run), but frame by frame into resizable datasets, flushing every
 ``flush_every`` frames: if the process dies, the file holds every flushed frame and reads back
 with :func:`~visviva.io.read_recordings` (its ``success`` attribute is then false and its
 ``message`` says the run did not finish). The HDF5 file is opened without SWMR/``libver``
@@ -45,11 +45,11 @@ class RecordingWriter:
     Example:
         >>> import tempfile, numpy as np, visviva as vv
         >>> path = tempfile.mkdtemp() + "/run.h5"
-        >>> with RecordingWriter(path, units={"points": "m"}) as writer:
+        >>> with RecordingWriter(path, units={"particle_position": "m"}) as writer:
         ...     for k in range(3):
-        ...         writer.append(0.1 * k, {"points": np.full((2, 3), float(k))})
+        ...         writer.append(0.1 * k, {"particle_position": np.full((2, 3), float(k))})
         ...     writer.finish({"success": True})
-        >>> vv.io.load_recording(path)["points"].shape
+        >>> vv.io.load_recording(path)["particle_position"].shape
         (3, 2, 3)
     """
 

@@ -167,7 +167,7 @@ def kepler_orbit(
         >>> import numpy as np, visviva as vv
         >>> orbit = vv.mechanics.kepler_orbit(1.0, 0.5, masses=(1.0, 1e-3), G=1.0)
         >>> sol = vv.solve(orbit.bodies().problem(), "leapfrog", dt=orbit.period / 1000,
-        ...                t_end=orbit.period)
+        ...                until=orbit.period)
         >>> bool(np.abs(sol.q[-1] - sol.q[0]).max() < 1e-3)  # back at periapsis
         True
     """

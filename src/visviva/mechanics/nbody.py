@@ -240,7 +240,7 @@ def nbody_problem(
         >>> problem = vv.mechanics.nbody_problem(
         ...     [[-0.5, 0, 0], [0.5, 0, 0]], [[0, 0, -0.5], [0, 0, 0.5]], [0.5, 0.5], G=1.0
         ... )
-        >>> sol = vv.solve(problem, "velocity_verlet", dt=0.01, t_end=2 * np.pi)
+        >>> sol = vv.solve(problem, "velocity_verlet", dt=0.01, until=2 * np.pi)
         >>> bool(np.abs(sol.q[-1] - sol.q[0]).max() < 1e-3)  # one circular orbit
         True
     """

@@ -1,24 +1,32 @@
-"""What a recording keeps of a scene's state: drawable points, and the parts worth plotting.
+"""What a recording keeps of a scene's state: its parts, under the state's names, and what
+to draw.
 
 Per frame (:func:`frame_fields`), following the recording convention of
-:mod:`visviva.simulation.recording`:
+:mod:`visviva.simulation.recording` (a field that is a part of the state has the part's name):
 
-    points                (P, 3) [m]   particles, then each named system's picture
-    velocities            (N, 3) [m/s] particle velocities (and gravitating bodies')
+    particle_position     (N, 3) [m]   the particles' positions
+    particle_velocity     (N, 3) [m/s] their velocities
+    particle_alive        (N,) bool    with emitters, or stages that remove particles (a
+                                       crowd's exits): which slots hold a live particle
+    particle_radius       (N,) [m]     with emitters: radii as they grow and shrink
+    particle_color        (N, 3)       with colour ramps: sRGB colours in [0, 1]
+    system_points         (S, 3) [m]   each named system's picture (a pendulum's pivot and
+                                       bob, gravitating bodies), drawn after the particles
+    system_velocity       (S, 3) [m/s] the velocities of those points, when every system
+                                       drawn is of gravitating bodies (their coordinates)
     generalized_position  (m,)         the named systems' coordinates (and velocities), unless
                                        every system is of gravitating bodies, whose coordinates
                                        are already their points
     y                     (n,)         a first-order system's state
-    alive                 (P,) bool    with emitters, or stages that remove particles (a
-                                       crowd's exits): which points hold a live particle
-    radius                (P,) [m]     with emitters: radii as they grow and shrink
-    color                 (P, 3)       with colour ramps: sRGB colours in [0, 1]
     body_origin           (B, 3) [m]   each rigid body's own origin (its surface's coordinates
                                        start there), not its centre of mass as in the state
     body_orientation      (B, 4)       unit quaternions (w, x, y, z), body to world
 
-Once (:func:`static_fields`): the radii and colours that do not change, particle masses, and
-what to draw between points (point indices, the systems' shifted past the particles):
+Once (:func:`static_fields`): the particles' masses (``particle_mass``), the radii and colours
+that do not change (``particle_radius``, ``particle_color``, and ``system_radius`` and
+``system_color`` for the systems' points beside them), and what to draw between the drawn
+points (the particles, then the systems' points; point indices, the systems' shifted past the
+particles):
 
     faces   (F, 3) int64  the surfaces of cloth and soft bodies (see
                           :mod:`visviva.deformables.surfaces`)
@@ -82,7 +90,8 @@ def _system_points(model: Model, state: State) -> list[np.ndarray]:
 
 
 def _kills(model: Model) -> bool:
-    """True if a stage may remove particles (a crowd's exits): ``alive`` is then recorded."""
+    """True if a stage may remove particles (a crowd's exits): ``particle_alive`` is then
+    recorded."""
     return any(stage.kills_particles for stage in model.stages)
 
 
@@ -93,35 +102,30 @@ def _varying_color(model: Model) -> bool:
 def frame_fields(model: Model, state: State) -> dict[str, np.ndarray]:
     """One frame of ``state`` as recorded fields (see the module docstring)."""
     fields: dict[str, np.ndarray] = {}
+    if model.particle_count:
+        fields["particle_position"] = state["particle_position"]
+        fields["particle_velocity"] = state["particle_velocity"]
+        if model.emitters or _kills(model):
+            fields["particle_alive"] = state["particle_alive"]
+        if model.emitters:
+            fields["particle_radius"] = state["particle_radius"]
+            if _varying_color(model):
+                fields["particle_color"] = _colors(model, state).astype(np.float32)
     pictures = _system_points(model, state)
-    count = model.particle_count
-    if count or pictures:
-        particles = [state["particle_position"]] if count else []
-        fields["points"] = np.concatenate(particles + pictures) if pictures else particles[0]
-    velocities = [state["particle_velocity"]] if count else []
+    if pictures:
+        fields["system_points"] = np.concatenate(pictures) if len(pictures) > 1 else pictures[0]
     if model.systems and "y" not in state.names():
         v = state["generalized_velocity"]
-        velocities += [
-            v[s.offset : s.offset + s.size].reshape(-1, 3) for s in model.systems if s.gravitating
-        ]
+        drawn = [s for s in model.systems if s.drawn]
+        if drawn and all(s.gravitating for s in drawn):
+            fields["system_velocity"] = np.concatenate(
+                [v[s.offset : s.offset + s.size].reshape(-1, 3) for s in drawn]
+            )
         if not all(s.gravitating for s in model.systems):
             fields["generalized_position"] = state["generalized_position"]
             fields["generalized_velocity"] = v
-    if velocities:
-        fields["velocities"] = np.concatenate(velocities) if len(velocities) > 1 else velocities[0]
     if "y" in state.names():
         fields["y"] = state["y"]
-    extra = sum(p.shape[0] for p in pictures)
-    if model.emitters or _kills(model):
-        fields["alive"] = np.concatenate([state["particle_alive"], np.ones(extra, dtype=bool)])
-    if model.emitters:
-        fields["radius"] = np.concatenate(
-            [state["particle_radius"], np.full(extra, _system_radius(model))]
-        )
-        if _varying_color(model):
-            fields["color"] = np.concatenate([_colors(model, state), np.ones((extra, 3))]).astype(
-                np.float32
-            )
     if model.bodies is not None:
         orientation = state["body_orientation"]
         center = quaternion_rotate(orientation, model.bodies.center)
@@ -156,13 +160,15 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
     extra = sum(p.shape[0] for p in _system_points(model, start))
     count = model.particle_count
     if count:
-        static["mass"] = np.array(model.particle_mass)
+        static["particle_mass"] = np.array(model.particle_mass)
         if not model.emitters:
-            static["radius"] = np.concatenate(
-                [model.particle_radius, np.full(extra, _system_radius(model))]
-            )
+            static["particle_radius"] = np.array(model.particle_radius)
+        if extra:  # the systems' points beside particles are drawn at their median radius
+            static["system_radius"] = np.full(extra, _system_radius(model))
         if not _varying_color(model) and (model.emitters or np.any(model.particle_color != 1.0)):
-            static["color"] = np.concatenate([_colors(model, start), np.ones((extra, 3))])
+            static["particle_color"] = _colors(model, start)
+        if extra and (_varying_color(model) or "particle_color" in static):
+            static["system_color"] = np.ones((extra, 3))
     edges, faces = list(model.edges), list(model.faces)
     first = count
     for system, points in zip(

@@ -6,7 +6,8 @@ the entities as structure-of-arrays data with entity-prefixed names (``particle_
 particles (world gravity included), the post-step stages (collisions, emission) and the
 settings. Its arrays are read-only. :meth:`Model.system` is the view an integrator steps,
 :meth:`Model.initial_state` the state a run starts from, and :meth:`Model.frame` turns a state
-into what a recording keeps (``points`` [m] for the video, the viewer and the exporters).
+into what a recording keeps (its parts under the state's names, ``particle_position`` [m] and
+the systems' ``system_points`` [m] drawn by the video, the viewer and the exporters).
 """
 
 from __future__ import annotations
@@ -183,7 +184,8 @@ class Model:
 
     @property
     def has_geometry(self) -> bool:
-        """True if runs of this model record something to draw: ``points`` or rigid bodies."""
+        """True if runs of this model record something to draw: particles, systems' points or
+        rigid bodies."""
         return self.particle_count > 0 or self.body_count > 0 or any(s.drawn for s in self.systems)
 
     def system(self) -> System:
@@ -249,14 +251,17 @@ class Model:
     def units(self) -> dict[str, str]:
         """Units of the recorded fields and static arrays."""
         return {
-            "points": "m",
+            "particle_position": "m",
+            "particle_velocity": "m/s",
+            "particle_radius": "m",
+            "particle_mass": "kg",
+            "system_points": "m",
+            "system_velocity": "m/s",
+            "system_radius": "m",
             "body_origin": "m",
             "body_vertices": "m",
             "body_center": "m",
             "scenery_vertices": "m",
-            "velocities": "m/s",
-            "radius": "m",
-            "mass": "kg",
             "energy": "J",
             "generalized_position": "",
             "generalized_velocity": "",

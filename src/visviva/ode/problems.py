@@ -48,7 +48,7 @@ class FirstOrderProblem:
     Example:
         >>> import numpy as np, visviva as vv
         >>> decay = vv.ode.FirstOrderProblem(lambda t, y: -2.0 * y, y0=[1.0])
-        >>> sol = vv.solve(decay, method="rk4", dt=0.01, t_end=1.0)
+        >>> sol = vv.solve(decay, method="rk4", dt=0.01, until=1.0)
         >>> bool(abs(sol.y[-1, 0] - np.exp(-2.0)) < 1e-9)
         True
     """
@@ -119,7 +119,7 @@ class SecondOrderProblem:
     Example:
         >>> import numpy as np, visviva as vv
         >>> spring = vv.ode.SecondOrderProblem(lambda t, q: -q, q0=[1.0], v0=[0.0])
-        >>> sol = vv.solve(spring, method="velocity_verlet", dt=0.01, t_end=np.pi)
+        >>> sol = vv.solve(spring, method="velocity_verlet", dt=0.01, until=np.pi)
         >>> bool(abs(sol.q[-1, 0] + 1.0) < 1e-4)
         True
     """

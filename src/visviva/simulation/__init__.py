@@ -8,7 +8,7 @@ from .._lazy import lazy_names
 
 if TYPE_CHECKING:
     from .adaptive import DenseOutput
-    from .loop import Schedule, simulate
+    from .loop import Schedule
     from .recording import Geometry, Recording
     from .simulation import Simulation, SimulationState
     from .solution import Solution, solve
@@ -24,7 +24,6 @@ __all__ = [
     "Simulation",
     "SimulationState",
     "Solution",
-    "simulate",
     "solve",
 ]
 
@@ -36,7 +35,6 @@ __getattr__, __dir__ = lazy_names(
     {
         "DenseOutput": "adaptive",
         "Schedule": "loop",
-        "simulate": "loop",
         "Geometry": "recording",
         "Recording": "recording",
         "Simulation": "simulation",

@@ -38,7 +38,7 @@ MAX_FACTOR = 10.0
 
 
 class DenseOutput:
-    """The continuous solution of an adaptive run: ``sol(t)`` for ``t0 ≤ t ≤ t_end``.
+    """The continuous solution of an adaptive run: ``sol(t)`` for ``t0 ≤ t ≤ until``.
 
     Calling it with a scalar time returns the state parts at that time: ``(y,)`` or ``(q, v)``.
     """
@@ -76,7 +76,7 @@ def _error_norm(
 
 
 def _initial_step(
-    method: DormandPrince5, system: Any, state: State, t_end: float, rtol: float, atol: float
+    method: DormandPrince5, system: Any, state: State, until: float, rtol: float, atol: float
 ) -> float:
     """Starting step from the sizes of y, f and a finite-difference estimate of f'.
 
@@ -91,19 +91,19 @@ def _initial_step(
 
     d0, d1 = norm(parts), norm(rates)
     h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
-    h0 = min(h0, t_end - state.t)
+    h0 = min(h0, until - state.t)
     probe = tuple(y + h0 * r for y, r in zip(parts, rates, strict=True))
     rates1 = system.derivative(state.t + h0, probe)
     d2 = norm(tuple(r1 - r0 for r1, r0 in zip(rates1, rates, strict=True))) / h0
     largest = max(d1, d2)
     exponent = 1.0 / (method.error_estimator_order + 1)
     h1 = max(1e-6, 1e-3 * h0) if largest <= 1e-15 else (0.01 / largest) ** exponent
-    return min(100.0 * h0, h1, t_end - state.t)
+    return min(100.0 * h0, h1, until - state.t)
 
 
-def _check_step_size(h: float, t: float, t_end: float, step: int) -> None:
+def _check_step_size(h: float, t: float, until: float, step: int) -> None:
     """Fail when ``h`` has shrunk to the round-off level of ``t``."""
-    if h <= 10.0 * np.spacing(abs(t) + abs(t_end)):
+    if h <= 10.0 * np.spacing(abs(t) + abs(until)):
         raise SimulationError(
             f"the step size became too small ({h:.3g} s) at t={t:.6g} s: the problem is too "
             "stiff for an explicit method at this tolerance, or has a singularity; try "
@@ -117,7 +117,7 @@ def integrate_adaptive(
     problem: Problem,
     method: DormandPrince5,
     *,
-    t_end: float,
+    until: float,
     rtol: float,
     atol: float,
     first_step: float | None,
@@ -145,7 +145,7 @@ def integrate_adaptive(
     h = (
         first_step
         if first_step is not None
-        else (_initial_step(method, system, state, t_end, rtol, atol) if t_end > t0 else 0.0)
+        else (_initial_step(method, system, state, until, rtol, atol) if until > t0 else 0.0)
     )
     watch = DivergenceWatch(system, method, h or 1.0, state, divergence_limit)
     steps: list[Step] = []
@@ -153,19 +153,19 @@ def integrate_adaptive(
     exponent = -1.0 / (method.error_estimator_order + 1)
     started = time.perf_counter()
     step_index = 0
-    with Progress(t_end - t0, method.name, progress) as bar:
+    with Progress(until - t0, method.name, progress) as bar:
         try:
-            while state.t < t_end:
+            while state.t < until:
                 if step_index >= max_steps:
                     raise SimulationError(
-                        f"reached max_steps={max_steps} at t={state.t:.6g} s before t_end="
-                        f"{t_end:.6g} s; raise max_steps, loosen rtol/atol, or use an implicit "
+                        f"reached max_steps={max_steps} at t={state.t:.6g} s before `until` = "
+                        f"{until:.6g} s; raise max_steps, loosen rtol/atol, or use an implicit "
                         "method if the problem is stiff",
                         t=state.t,
                         step=step_index,
                     )
-                h = min(h, t_end - state.t)
-                _check_step_size(h, state.t, t_end, step_index)
+                h = min(h, until - state.t)
+                _check_step_size(h, state.t, until, step_index)
                 rejected = False
                 while True:
                     attempt = method.attempt(system, state, h)
@@ -175,10 +175,10 @@ def integrate_adaptive(
                     system.counters.rejected_steps += 1
                     rejected = True
                     h *= max(MIN_FACTOR, SAFETY * err**exponent) if np.isfinite(err) else MIN_FACTOR
-                    _check_step_size(h, state.t, t_end, step_index)
+                    _check_step_size(h, state.t, until, step_index)
                 end = attempt.end
-                if t_end - end.t <= 10.0 * np.spacing(abs(t_end)):
-                    end = end.at_time(t_end)
+                if until - end.t <= 10.0 * np.spacing(abs(until)):
+                    end = end.at_time(until)
                 if not watch.healthy(end):
                     raise watch.diverged(end, step_index, state)
                 system.counters.accepted_steps += 1
@@ -206,7 +206,7 @@ def integrate_adaptive(
         "rtol": rtol,
         "atol": atol,
         "t0": t0,
-        "t_end": t_end,
+        "until": until,
         "problem": problem.name,
         "kind": problem.kind,
         "batch_size": problem.batch_size,

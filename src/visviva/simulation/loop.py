@@ -1,11 +1,13 @@
 """The one fixed-step simulation loop every model runs through.
 
-``simulate`` advances a problem from ``t0`` to ``t_end`` in steps of ``dt``, each made of
-``substeps`` integrator steps of ``h = dt/substeps``. Time is never accumulated: step ``n``
-ends at ``t0 + (n + 1)·dt`` and its substep ``j`` at ``t0 + n·dt + (j + 1)·h``, computed from
-integer counters, so a million steps land on the same times as one would by hand (``t += dt``
-drifts by ``~n·ε``). If ``t_end − t0`` is not a
-whole number of steps, the last step is shortened to end exactly at ``t_end``.
+:func:`run_fixed_steps` (the fixed-step road of :func:`~visviva.simulation.solve`) advances a
+problem from ``t0`` to ``until`` in steps of ``dt``, each made of ``substeps`` integrator steps
+of ``h = dt/substeps``; :class:`~visviva.simulation.Simulation` runs a scene through the same
+:func:`advance`. Time is never accumulated: step ``n`` ends at ``t0 + (n + 1)·dt`` and its
+substep ``j`` at ``t0 + n·dt + (j + 1)·h``, computed from integer counters, so a million steps
+land on the same times as one would by hand (``t += dt`` drifts by ``~n·ε``). If
+``until − t0`` is not a whole number of steps, the last step is shortened to end exactly at
+``until``.
 
 Every ``record_every``-th step (and the last) becomes a frame of the :class:`Recording`. After
 every integrator step the divergence watch checks the state; a blow-up stops the run with
@@ -47,7 +49,7 @@ if TYPE_CHECKING:
     from ..ode.state import State
     from ..ode.system import System
 
-__all__ = ["Schedule", "advance", "simulate"]
+__all__ = ["Schedule", "advance", "run_fixed_steps"]
 
 #: System-steps per compiled chunk: large enough to hide the call overhead, small enough for the
 #: progress bar to move and the frame buffer to stay small.
@@ -65,16 +67,16 @@ class Schedule:
 
     Attributes:
         t0: The grid's origin [s].
-        t_end: End time [s].
+        until: End time [s].
         dt: Step [s].
         substeps: Integrator steps per step.
         first: Steps of ``dt`` already taken from ``t0`` before this run.
         full_steps: Number of steps of exactly ``dt`` in this run.
-        last_dt: Length of the final shortened step [s], or 0 if ``t_end`` is on the grid.
+        last_dt: Length of the final shortened step [s], or 0 if ``until`` is on the grid.
     """
 
     t0: float
-    t_end: float
+    until: float
     dt: float
     substeps: int
     full_steps: int
@@ -82,15 +84,15 @@ class Schedule:
     first: int = 0
 
     @classmethod
-    def build(cls, t0: float, t_end: float, dt: float, substeps: int, first: int = 0) -> Schedule:
-        """Plan the steps from ``t0 + first·dt`` to ``t_end`` on the grid of origin ``t0`` (a
+    def build(cls, t0: float, until: float, dt: float, substeps: int, first: int = 0) -> Schedule:
+        """Plan the steps from ``t0 + first·dt`` to ``until`` on the grid of origin ``t0`` (a
         remainder below 1e-9 steps is rounding)."""
-        ratio = (t_end - t0) / dt
+        ratio = (until - t0) / dt
         nearest = round(ratio)
         if nearest >= first + 1 and abs(ratio - nearest) <= 1e-9 * max(1.0, ratio):
-            return cls(t0, t_end, dt, substeps, int(nearest) - first, 0.0, first)
+            return cls(t0, until, dt, substeps, int(nearest) - first, 0.0, first)
         full = max(math.floor(ratio), first)
-        return cls(t0, t_end, dt, substeps, full - first, (t_end - t0) - full * dt, first)
+        return cls(t0, until, dt, substeps, full - first, (until - t0) - full * dt, first)
 
     @property
     def steps(self) -> int:
@@ -112,20 +114,20 @@ class Schedule:
             # A step ends on the grid of dt whatever its substeps: a run split into pieces
             # passes through the same times as one long run.
             last = step + 1 == self.steps
-            return self.h, self.t_end if last else self.t0 + (n + 1) * self.dt
+            return self.h, self.until if last else self.t0 + (n + 1) * self.dt
         h_last = self.last_dt / self.substeps
         if sub + 1 == self.substeps:
-            return h_last, self.t_end
+            return h_last, self.until
         start = self.t0 + (self.first + self.full_steps) * self.substeps * self.h
         return h_last, start + (sub + 1) * h_last
 
 
-def simulate(
+def run_fixed_steps(
     problem: Problem,
     method: str | Integrator = "rk4",
     *,
     dt: float,
-    t_end: float,
+    until: float,
     substeps: int = 1,
     record_every: int = 1,
     progress: bool | None = None,
@@ -133,14 +135,16 @@ def simulate(
     compiled: bool | None = None,
     on_frame: FrameCallback | None = None,
 ) -> Recording:
-    """Run ``problem`` with fixed steps and return the recorded frames.
+    """Run ``problem`` with fixed steps and return the recorded frames: the fixed-step road
+    of :func:`~visviva.simulation.solve` (which users call; it returns a
+    :class:`~visviva.simulation.Solution` instead of raising on a numerical failure).
 
     Args:
         problem: A :class:`~visviva.ode.FirstOrderProblem` or
             :class:`~visviva.ode.SecondOrderProblem`.
         method: Integrator name or instance (see ``vv.integrators.names()``).
         dt: Step [s]; must be positive.
-        t_end: End time [s]; must not be before the problem's ``t0``.
+        until: End time [s]; must not be before the problem's ``t0``.
         substeps: Integrator steps per step (each of ``dt/substeps``).
         record_every: Record every k-th step (the initial and the final state always).
         progress: Show a progress bar on long runs (default: only if stderr is a terminal).
@@ -166,17 +170,17 @@ def simulate(
     check_problem(problem)
     integrator = get(method)
     dt = real_number("dt", dt, positive=True, unit=" s")
-    t_end = check_end_time(problem, t_end)
-    span = t_end - problem.t0
+    until = check_end_time(problem, until)
+    span = until - problem.t0
     if dt > span > 0.0:
         raise ModelError(
-            f"`dt` ({dt!r} s) is longer than the run (t_end - t0 = {span!r} s); use dt <= {span!r}"
+            f"`dt` ({dt!r} s) is longer than the run (until - t0 = {span!r} s); use dt <= {span!r}"
         )
     substeps = whole_number("substeps", substeps, minimum=1)
     if span / dt * substeps > MAX_STEPS:
         raise ModelError(
             f"`dt` ({dt!r} s) with {substeps} substep(s) would take "
-            f"{span / dt * substeps:.3g} integrator steps to reach t_end; the limit is "
+            f"{span / dt * substeps:.3g} integrator steps to reach `until`; the limit is "
             f"{MAX_STEPS:.0e} (use a larger dt or fewer substeps)"
         )
     record_every = whole_number("record_every", record_every, minimum=1)
@@ -186,7 +190,7 @@ def simulate(
     integrator.check(system)
     compiled_step = _compiled_step(integrator, problem, compiled)
 
-    schedule = Schedule.build(problem.t0, t_end, dt, substeps)
+    schedule = Schedule.build(problem.t0, until, dt, substeps)
     state = problem.initial_state()
     recorder = FrameRecorder(system, state, on_frame=on_frame)
     watch = DivergenceWatch(system, integrator, dt, state, divergence_limit)
@@ -197,7 +201,7 @@ def simulate(
         "substeps": substeps,
         "record_every": record_every,
         "t0": problem.t0,
-        "t_end": t_end,
+        "until": until,
         "problem": problem.name,
         "kind": problem.kind,
         "batch_size": problem.batch_size,
@@ -249,12 +253,12 @@ def check_problem(problem: Any) -> None:
         )
 
 
-def check_end_time(problem: Problem, t_end: Any) -> float:
-    """``t_end`` as a float, not before the problem's ``t0``."""
-    t_end = real_number("t_end", t_end, unit=" s")
-    if t_end < problem.t0:
-        raise ModelError(f"`t_end` ({t_end!r}) must not be before t0 ({problem.t0!r})")
-    return t_end
+def check_end_time(problem: Problem, until: Any) -> float:
+    """``until`` as a float, not before the problem's ``t0``."""
+    until = real_number("until", until, unit=" s")
+    if until < problem.t0:
+        raise ModelError(f"`until` ({until!r}) must not be before t0 ({problem.t0!r})")
+    return until
 
 
 def _compiled_step(
@@ -369,7 +373,7 @@ def _run_compiled(
         valid = min(frames, done // every)
         times = origin + (first + every * np.arange(1, valid + 1)) * h
         if valid and offset + valid * every == schedule.steps * substeps:
-            times[-1] = schedule.t_end
+            times[-1] = schedule.until
         recorder.extend(times, buffer[:valid], batch)
         if done < count:
             bad = state.from_parts(origin + (first + done + 1) * h, _unstack(y, state))

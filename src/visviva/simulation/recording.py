@@ -1,34 +1,47 @@
 """Recordings in memory: the frames a run keeps, with units and the run's attributes.
 
 A :class:`Recording` holds the times of the recorded frames and one array per recorded field
-(``y``, or ``q`` and ``v``, a scene's ``points``, plus derived series such as ``energy``), each
-with its unit, the arrays that do not change over the run (``static``), and the attributes that
-make the run reproducible (method, step, substeps, library version, work). Files hold the same
-content (:mod:`visviva.io.recording`: ``vv.io.save_recording`` and ``vv.io.load_recording``).
+(``y``, or ``q`` and ``v``, a scene's ``particle_position``, plus derived series such as
+``energy``), each with its unit, the arrays that do not change over the run (``static``), and
+the attributes that make the run reproducible (method, step, substeps, library version, work).
+A field that is a part of the state has the part's name (``particle_position``,
+``particle_velocity``, ``particle_alive``, ``generalized_position``, ``body_orientation``; see
+:mod:`visviva.model.frames`). Files hold the same content (:mod:`visviva.io.recording`:
+``vv.io.save_recording`` and ``vv.io.load_recording``, which reads files written with the
+names of format 1 too).
 
 Drawable geometry (what the video, the web viewer and the exporters show) follows one
-convention, read back by :meth:`Recording.geometry`:
+convention, read back by :meth:`Recording.geometry`. The drawn points are the ``N`` particles,
+then the ``S`` points of named systems' pictures (a pendulum's pivot and bob), ``P = N + S``:
 
-    fields/points           float64 (frames, P, 3) [m]: point positions, world frame, Y up
-    static/radius           float64 (P,) [m]: point radii (optional)
-    static/edges            int64 (E, 2): pairs of point indices drawn as lines (optional)
+    fields/particle_position float64 (frames, N, 3) [m]: particle positions, world frame, Y up
+    fields/system_points    float64 (frames, S, 3) [m]: the systems' drawn points
+    static/particle_radius  float64 (N,) [m]: particle radii (optional), with
+                            static/system_radius (S,) when there are both
+    static/particle_color   float64 (N, 3): sRGB colour of each particle, in [0, 1]
+                            (optional), with static/system_color (S, 3) when there are both
+    static/edges            int64 (E, 2): pairs of point indices (of the P drawn points) drawn
+                            as lines (optional)
     static/faces            int64 (F, 3): triangles of point indices, counter-clockwise seen
                             from outside (optional); their points are drawn as the surface's
                             vertices, not as spheres (:meth:`Geometry.off_faces`)
-    static/color            float64 (P, 3): sRGB colour of each point, in [0, 1] (optional)
     static/display_radius   float64 (P,) [m]: the radius to draw instead of the physical one,
                             where true sizes would be invisible (planets at the scale of their
                             orbits); outputs then say "sizes not to scale" (optional)
 
-Points that are born and die (particles of emitters) are recorded with a fixed capacity ``P``
+Particles that are born and die (those of emitters) are recorded with a fixed capacity ``N``
 and, per frame:
 
-    fields/alive            bool (frames, P): which points exist in each frame; the others
-                            are not drawn (optional: all exist)
-    fields/radius           float64 (frames, P) [m]: radii that change over time (instead of
-                            static/radius)
-    fields/color            float32 (frames, P, 3): colours that change over time, sRGB in
-                            [0, 1] (instead of static/color)
+    fields/particle_alive   bool (frames, N): which particles exist in each frame; the others
+                            are not drawn (optional: all exist; systems' points always do)
+    fields/particle_radius  float64 (frames, N) [m]: radii that change over time (instead of
+                            static/particle_radius)
+    fields/particle_color   float32 (frames, N, 3): colours that change over time, sRGB in
+                            [0, 1] (instead of static/particle_color)
+
+The velocities of the drawn points, where recorded, colour them by speed
+(:meth:`Recording.drawn_velocity`): ``fields/particle_velocity`` (frames, N, 3) [m/s], then
+``fields/system_velocity`` (frames, S, 3) [m/s].
 
 Rigid bodies keep their surfaces once and a transform per frame (the full list is in
 :mod:`visviva.simulation.body_geometry`; a recording may hold bodies without points):
@@ -60,6 +73,9 @@ from .body_geometry import BodyGeometry, read_bodies
 from .scenery import Scenery, read_scenery
 
 __all__ = ["Geometry", "Recording"]
+
+#: The fields of the drawn points, in drawing order: particles, then the systems' points.
+_DRAWN = ("particle_position", "system_points")
 
 #: Default point radius, as a fraction of the scene's bounding-box diagonal.
 _RADIUS_FRACTION = 0.01
@@ -221,46 +237,53 @@ class Recording:
         return name in self.fields
 
     def geometry(self) -> Geometry:
-        """The drawable geometry (see the module docstring), checked for consistent shapes.
+        """The drawable geometry (see the module docstring), checked for consistent shapes:
+        the particles, then the systems' points, with their radii, colours and liveness.
 
         A recording of rigid bodies alone has ``points`` of shape ``(frames, 0, 3)``.
 
         Raises:
-            ModelError: If the recording has neither a ``points`` field nor rigid bodies, or
-                its static arrays do not fit the points or the bodies.
+            ModelError: If the recording has neither drawn points (``particle_position``,
+                ``system_points``) nor rigid bodies, or its arrays do not fit them.
         """
         bodies = read_bodies(self.fields, self.static, self.attrs)
-        if "points" not in self.fields and bodies is None:
+        if not any(name in self.fields for name in _DRAWN) and bodies is None:
             raise ModelError(
-                "this recording has no geometry to show (no `points` field, no bodies): it "
-                "comes from a run of an abstract system; record a scene with particles or "
-                "bodies instead"
+                "this recording has no geometry to show (no `particle_position` or "
+                "`system_points` field, no bodies): it comes from a run of an abstract "
+                "system; record a scene with particles or bodies instead"
             )
-        points = self.fields.get("points", np.zeros((self.frames, 0, 3)))
-        if points.ndim != 3 or points.shape[2] != 3:
-            raise ModelError(f"`points` must have shape (frames, P, 3) (got {points.shape})")
+        groups = []
+        for name, size in zip(_DRAWN, ("N", "S"), strict=True):
+            group = self.fields.get(name, np.zeros((self.frames, 0, 3)))
+            if group.ndim != 3 or group.shape[2] != 3:
+                raise ModelError(
+                    f"`{name}` must have shape (frames, {size}, 3) (got {group.shape})"
+                )
+            groups.append(group)
+        particles, systems = groups
+        n, extra = particles.shape[1], systems.shape[1]
+        points = np.concatenate(groups, axis=1) if n and extra else particles if n else systems
         frames, count = points.shape[:2]
-        per_point = {}
-        for name, shape, varying in (
-            ("radius", (count,), (frames, count)),
-            ("display_radius", (count,), None),
-            ("color", (count, 3), (frames, count, 3)),
-        ):
-            value = self.fields.get(name) if name in self.fields else self.static.get(name)
-            allowed = [shape] if varying is None or name not in self.fields else [varying]
-            if value is not None and value.shape not in allowed:
-                raise ModelError(f"`{name}` must have shape {allowed[0]} (got {value.shape})")
-            per_point[name] = value
-        color = per_point["color"]
+        radius = self._per_point("radius", n, extra, ())
+        color = self._per_point("color", n, extra, (3,))
         if color is not None and not (np.all(color >= 0.0) and np.all(color <= 1.0)):
-            raise ModelError("`color` must hold sRGB values between 0 and 1")
-        alive = self.fields.get("alive")
-        if alive is not None and (alive.shape != (frames, count) or alive.dtype != np.bool_):
+            raise ModelError("`particle_color` and `system_color` must hold sRGB values in [0, 1]")
+        display_radius = self.static.get("display_radius")
+        if display_radius is not None and display_radius.shape != (count,):
             raise ModelError(
-                f"`alive` must be a boolean array of shape {(frames, count)} (got {alive.dtype} "
-                f"{alive.shape})"
+                f"`display_radius` must have shape {(count,)} (got {display_radius.shape})"
             )
-        topology = {}
+        alive = self.fields.get("particle_alive")
+        if alive is not None:
+            if alive.shape != (frames, n) or alive.dtype != np.bool_:
+                raise ModelError(
+                    f"`particle_alive` must be a boolean array of shape {(frames, n)} (got "
+                    f"{alive.dtype} {alive.shape})"
+                )
+            if extra:  # the systems' points always exist
+                alive = np.concatenate([alive, np.ones((frames, extra), dtype=bool)], axis=1)
+        topology: dict[str, np.ndarray | None] = {}
         for name, width in (("edges", 2), ("faces", 3)):
             value = self.static.get(name)
             if value is not None:
@@ -271,8 +294,63 @@ class Recording:
             topology[name] = value
         scenery = read_scenery(self.static, self.attrs)
         return Geometry(
-            points, **per_point, **topology, alive=alive, bodies=bodies, scenery=scenery
+            points,
+            radius=radius,
+            color=color,
+            display_radius=display_radius,
+            alive=alive,
+            bodies=bodies,
+            scenery=scenery,
+            **topology,
         )
+
+    def _per_point(self, quantity: str, n: int, extra: int, tail: tuple[int, ...]) -> Any:
+        """The drawn points' ``quantity`` (``radius`` or ``color``): the particles'
+        (``particle_<quantity>``, static ``(N, *tail)`` or per frame ``(frames, N, *tail)``),
+        then the systems' points' (static ``system_<quantity>``, ``(S, *tail)``); ``None`` if
+        neither is recorded."""
+        own, theirs = f"particle_{quantity}", f"system_{quantity}"
+        particles = self.fields.get(own) if own in self.fields else self.static.get(own)
+        systems = self.static.get(theirs)
+        varying = own in self.fields
+        for name, value, shapes in (
+            (own, particles, [(self.frames, n, *tail)] if varying else [(n, *tail)]),
+            (theirs, systems, [(extra, *tail)]),
+        ):
+            if value is not None and value.shape not in shapes:
+                raise ModelError(f"`{name}` must have shape {shapes[0]} (got {value.shape})")
+        parts = [(particles, own, n), (systems, theirs, extra)]
+        given = [name for value, name, size in parts if size and value is not None]
+        if not given:
+            return None
+        missing = [name for value, name, size in parts if size and value is None]
+        if missing:
+            raise ModelError(
+                f"`{given[0]}` needs `{missing[0]}` beside it: every drawn point has a "
+                f"{quantity} or none does"
+            )
+        if particles is None or systems is None:  # one group: the other holds no point
+            return particles if n else systems
+        if varying:
+            systems = np.broadcast_to(systems, (self.frames, *systems.shape)).astype(
+                particles.dtype
+            )
+        return np.concatenate([particles, systems], axis=1 if varying else 0)
+
+    def drawn_velocity(self) -> np.ndarray | None:
+        """Velocities [m/s] of the first ``k`` drawn points, ``(frames, k, 3)``: the
+        particles' (``particle_velocity``), then the systems' points' (``system_velocity``)
+        where recorded; ``None`` if the first drawn points have none."""
+        parts = []
+        if "particle_position" in self.fields and self.fields["particle_position"].shape[1]:
+            if "particle_velocity" not in self.fields:
+                return None
+            parts.append(self.fields["particle_velocity"])
+        if "system_velocity" in self.fields:
+            parts.append(self.fields["system_velocity"])
+        if not parts:
+            return None
+        return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
 
     def __repr__(self) -> str:
         shapes = ", ".join(f"{k}{tuple(v.shape)}" for k, v in self.fields.items())

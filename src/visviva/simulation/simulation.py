@@ -374,7 +374,7 @@ class Simulation:
                 self._steps = schedule.first + stopped.steps_done
                 raise
         if schedule.last_dt > 0.0:
-            self._origin, self._steps = schedule.t_end, 0
+            self._origin, self._steps = schedule.until, 0
         else:
             self._steps = schedule.first + schedule.full_steps
 

@@ -1,10 +1,13 @@
 """``vv.solve``: integrate a problem with any registered method and get a :class:`Solution`.
 
-Fixed-step methods run through the one simulation loop (:func:`~visviva.simulation.simulate`);
-adaptive ones (``dopri5``) through the adaptive driver unless ``adaptive=False``. A numerical
-failure does not raise here: the solution reports ``success=False`` with a message and keeps
-the frames computed before it (call :meth:`Solution.raise_for_status` to turn that into the
-exception). Invalid arguments always raise :class:`~visviva.errors.ModelError` before any step.
+``solve`` is the one function that runs a problem (it was ``solve`` and ``simulate``; the latter
+is gone: ``vv.solve(...).recording`` is the recording it returned, and
+``vv.solve(...).raise_for_status()`` raises the error it raised). Fixed-step methods run through
+the one simulation loop (:func:`~visviva.simulation.loop.run_fixed_steps`); adaptive ones
+(``dopri5``) through the adaptive driver unless ``adaptive=False``. A numerical failure does
+not raise here: the solution reports ``success=False`` with a message and keeps the frames
+computed before it (call :meth:`Solution.raise_for_status` to turn that into the exception).
+Invalid arguments always raise :class:`~visviva.errors.ModelError` before any step.
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from .._validation import describe, real_number, whole_number
 from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get, names
 from .adaptive import DenseOutput, integrate_adaptive
-from .loop import check_end_time, check_problem, simulate
+from .loop import check_end_time, check_problem, run_fixed_steps
 
 if TYPE_CHECKING:
     from ..ode.problems import Problem
@@ -107,7 +110,7 @@ def solve(
     problem: Problem,
     method: str | Integrator = "rk4",
     *,
-    t_end: float,
+    until: float,
     dt: float | None = None,
     record_every: int = 1,
     substeps: int = 1,
@@ -121,13 +124,14 @@ def solve(
     divergence_limit: float | None = None,
     compiled: bool | None = None,
 ) -> Solution:
-    """Integrate ``problem`` from its ``t0`` to ``t_end``.
+    """Integrate ``problem`` from its ``t0`` to the time ``until`` (an absolute time: the run
+    lasts ``until − t0``).
 
     Args:
         problem: A :class:`~visviva.ode.FirstOrderProblem` or
             :class:`~visviva.ode.SecondOrderProblem`.
         method: Integrator name (``vv.integrators.names()``) or instance.
-        t_end: End time [s], not before ``problem.t0``.
+        until: End time [s], not before ``problem.t0``.
         dt: Step [s] for fixed-step methods (required); for adaptive ones, the first step
             (chosen automatically if omitted).
         record_every: Fixed-step methods: record every k-th step (first and last always).
@@ -139,12 +143,14 @@ def solve(
         dense_output: Adaptive methods: keep the continuous solution in ``Solution.sol``.
         max_steps: Adaptive methods: give up after this many accepted steps.
         progress: Progress bar on long runs (default: only when stderr is a terminal).
-        divergence_limit: Largest allowed ``|component|``; see :func:`simulate`.
+        divergence_limit: Largest allowed ``|component|`` before the run counts as diverged
+            (default ``1e10 × max(1, max |initial state|)``).
         compiled: Fixed-step methods: ``None`` compiles the whole loop when the problem's
             functions are Numba functions, ``False`` never, ``True`` requires it.
 
     Returns:
-        A :class:`Solution`.
+        A :class:`Solution`: its ``recording`` holds the frames; a numerical failure is
+        reported in it (``success=False``), and :meth:`Solution.raise_for_status` raises it.
 
     Raises:
         ModelError: For invalid arguments, before any step.
@@ -152,7 +158,7 @@ def solve(
     Example:
         >>> import visviva as vv
         >>> spring = vv.ode.SecondOrderProblem(lambda t, q: -q, q0=[1.0], v0=[0.0])
-        >>> sol = vv.solve(spring, "symplectic_euler", dt=0.1, t_end=10.0, record_every=10)
+        >>> sol = vv.solve(spring, "symplectic_euler", dt=0.1, until=10.0, record_every=10)
         >>> sol.success, sol.q.shape, sol.counters["f_evaluations"]
         (True, (11, 1), 100)
     """
@@ -164,13 +170,13 @@ def solve(
             f"method {integrator.name!r} has no error control; adaptive methods: "
             + ", ".join(n for n in names() if get(n).adaptive)
         )
-    t_end = check_end_time(problem, t_end)
+    until = check_end_time(problem, until)
     try:
         if use_adaptive:
             return _solve_adaptive(
                 problem,
                 integrator,
-                t_end,
+                until,
                 dt,
                 rtol,
                 atol,
@@ -193,11 +199,11 @@ def solve(
             raise ModelError("`dense_output` applies to adaptive methods only")
         if dt is None:
             raise ModelError(f"`dt` is required for the fixed-step method {integrator.name!r}")
-        recording = simulate(
+        recording = run_fixed_steps(
             problem,
             integrator,
             dt=dt,
-            t_end=t_end,
+            until=until,
             substeps=substeps,
             record_every=record_every,
             progress=progress,
@@ -212,7 +218,7 @@ def solve(
 def _solve_adaptive(
     problem: Problem,
     integrator: Integrator,
-    t_end: float,
+    until: float,
     dt: float | None,
     rtol: float | None,
     atol: float | None,
@@ -243,11 +249,11 @@ def _solve_adaptive(
     max_steps = whole_number("max_steps", max_steps, minimum=1)
     if divergence_limit is not None:
         divergence_limit = real_number("divergence_limit", divergence_limit, positive=True)
-    times = None if t_eval is None else _check_times(t_eval, problem.t0, t_end)
+    times = None if t_eval is None else _check_times(t_eval, problem.t0, until)
     recording, dense = integrate_adaptive(
         problem,
         integrator,  # type: ignore[arg-type]
-        t_end=t_end,
+        until=until,
         rtol=rtol,
         atol=atol,
         first_step=first_step,
@@ -260,8 +266,8 @@ def _solve_adaptive(
     return Solution(recording, True, "completed", sol=dense)
 
 
-def _check_times(t_eval: Any, t0: float, t_end: float) -> np.ndarray:
-    """``t_eval`` as a strictly increasing float array within ``[t0, t_end]``."""
+def _check_times(t_eval: Any, t0: float, until: float) -> np.ndarray:
+    """``t_eval`` as a strictly increasing float array within ``[t0, until]``."""
     try:
         times = np.asarray(t_eval, dtype=np.float64).ravel()
     except (TypeError, ValueError):
@@ -279,9 +285,9 @@ def _check_times(t_eval: Any, t0: float, t_end: float) -> np.ndarray:
             f"`t_eval` must be strictly increasing; entry {i} ({describe(times[i])}) follows "
             f"{describe(times[i - 1])}"
         )
-    if times[0] < t0 or times[-1] > t_end:
+    if times[0] < t0 or times[-1] > until:
         raise ModelError(
-            f"`t_eval` must lie within [t0, t_end] = [{describe(t0)}, {describe(t_end)}] "
+            f"`t_eval` must lie within [t0, until] = [{describe(t0)}, {describe(until)}] "
             f"(got [{describe(times[0])}, {describe(times[-1])}])"
         )
     return times

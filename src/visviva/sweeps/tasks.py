@@ -257,7 +257,7 @@ class _Figures:
 
     def of(self, member: int) -> RunFigures:
         """Member ``member``'s figures, as its own run would have them."""
-        from ..scenes import RunFigures, final_values
+        from ..scenes import RunFigures, drawn_points, final_values
 
         if member in self.individual:
             return self.individual[member]
@@ -267,7 +267,7 @@ class _Figures:
         figure = RunFigures(
             t_reached=float(self.t_reached[member]),
             frames=int(self.frames[member]),
-            points=fields["points"].shape[0] if "points" in fields else 0,
+            points=drawn_points(fields),
             final=final_values(fields),
         )
         if self.has_energy:

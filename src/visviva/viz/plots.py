@@ -24,6 +24,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "comparison_figures",
+    "has_momenta",
     "plot_convergence",
     "plot_energy",
     "plot_phase",
@@ -213,7 +214,7 @@ def plot_convergence(studies: Sequence[ConvergenceStudy]) -> Figure:
             markerfacecolor="none",
         )
     ax.set_xlabel("dt [s]")
-    ax.set_ylabel("error at t_end (max norm)")
+    ax.set_ylabel("error at `until` (max norm)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title("Convergence: circled points are in the fitted asymptotic range")
@@ -235,27 +236,32 @@ def comparison_figures(comparison: Comparison, *, title: str | None = None) -> d
     }
 
 
+def has_momenta(recording: Recording) -> bool:
+    """True if ``recording`` holds what :func:`plot_momentum` needs: the particles' positions,
+    velocities and masses."""
+    fields = {"particle_position", "particle_velocity"}
+    return fields <= set(recording.fields) and "particle_mass" in recording.static
+
+
 def plot_momentum(recording: Recording, *, title: str = "Momenta") -> Figure:
     """Linear momentum ``P = Σ m v`` and angular momentum ``L = Σ m x × v`` over time.
 
-    Needs a particle recording: fields ``points`` [m] and ``velocities`` [m/s] and the static
-    ``mass`` [kg]. Each component is drawn against time [s].
+    Needs a particle recording: fields ``particle_position`` [m] and ``particle_velocity``
+    [m/s] and the static ``particle_mass`` [kg]. Each component is drawn against time [s].
     """
     from ..analysis.invariants import angular_momentum, linear_momentum
     from ..errors import ModelError
 
-    missing = [n for n in ("points", "velocities") if n not in recording]
-    if missing or "mass" not in recording.static:
+    if not has_momenta(recording):
         raise ModelError(
-            "momentum plots need a particle recording (points, velocities and mass); "
-            f"this one has fields {', '.join(recording.fields)}"
+            "momentum plots need a particle recording (particle_position, particle_velocity "
+            f"and particle_mass); this one has fields {', '.join(recording.fields)}"
         )
-    mass = recording.static["mass"]
+    mass = recording.static["particle_mass"]
+    x, v = recording["particle_position"], recording["particle_velocity"]
     series = {
-        "linear momentum P [kg·m/s]": linear_momentum(mass, recording["velocities"]),
-        "angular momentum L [kg·m²/s]": angular_momentum(
-            mass, recording["points"], recording["velocities"]
-        ),
+        "linear momentum P [kg·m/s]": linear_momentum(mass, v),
+        "angular momentum L [kg·m²/s]": angular_momentum(mass, x, v),
     }
     figure = _figure(2, width=6.0, height=3.6, columns=2)
     for ax, (label, values) in zip(figure.axes, series.items(), strict=True):

@@ -7,9 +7,9 @@ the whole clip, so a colour means the same speed in every frame: from 0 to the 9
 percentile of the live points' speeds over all frames (a few outliers, a bird that was just
 born at full speed, do not wash out the rest), the points above it drawn in the top colour.
 
-The speeds are the recorded ``velocities`` (a scene's particles, then its gravitating bodies);
-points without a recorded velocity (the drawings of named systems beside them) keep their
-own colours.
+The speeds are the recorded velocities of the drawn points (``particle_velocity``, then the
+gravitating bodies' ``system_velocity``); points without a recorded velocity (the drawings of
+named systems beside them) keep their own colours.
 """
 
 from __future__ import annotations
@@ -62,8 +62,10 @@ def colored_by_speed(recording: Recording, geometry: Geometry) -> tuple[Geometry
     """``geometry`` with every point coloured by its speed in each frame, and the scale.
 
     Args:
-        recording: The recording ``geometry`` comes from; its ``velocities`` field
-            ``(frames, N, 3)`` [m/s] gives the speeds of the first ``N`` points.
+        recording: The recording ``geometry`` comes from; its velocities of the drawn points
+            (:meth:`Recording.drawn_velocity`: ``particle_velocity``, then
+            ``system_velocity``; ``(frames, k, 3)`` [m/s]) give the speeds of the first ``k``
+            points, the others keep their colours.
         geometry: :meth:`Recording.geometry` of it.
 
     Returns:
@@ -72,19 +74,20 @@ def colored_by_speed(recording: Recording, geometry: Geometry) -> tuple[Geometry
     Raises:
         ModelError: If the recording has no velocities, or non-finite ones.
     """
-    velocities = recording.fields.get("velocities")
+    velocities = recording.drawn_velocity()
     frames, count = geometry.points.shape[:2]
     if velocities is None or velocities.ndim != 3 or velocities.shape[0] != frames:
         raise ModelError(
-            '`color_by = "speed"` needs the recording\'s `velocities` field (frames, N, 3): '
-            'recordings of scenes with particles have it; use color_by = "scene" for this one'
+            '`color_by = "speed"` needs the velocities of the drawn points (the recording\'s '
+            "`particle_velocity`, frames × N × 3): recordings of scenes with particles have "
+            'them; use color_by = "scene" for this one'
         )
     moving = min(velocities.shape[1], count)
     speed = np.sqrt(np.einsum("fij,fij->fi", velocities[:, :moving], velocities[:, :moving]))
     alive = None if geometry.alive is None else geometry.alive[:, :moving]
     live = speed if alive is None else speed[alive]
     if not np.isfinite(live).all():
-        raise ModelError("the recording's `velocities` are not all finite: they cannot be coloured")
+        raise ModelError("the recording's velocities are not all finite: they cannot be coloured")
     top = float(np.percentile(live, TOP_PERCENTILE)) if live.size else 0.0
     scale = SpeedScale(top if top > 0.0 else 1.0)
     table = _viridis()

@@ -241,7 +241,8 @@ def render_video(
         >>> import tempfile, pathlib, numpy as np, visviva as vv
         >>> t = np.arange(10) / 10.0
         >>> points = np.zeros((10, 1, 3)); points[:, 0, 1] = 1.0 - 4.9 * t**2
-        >>> rec = vv.Recording(t, {"points": points}, static={"radius": np.array([0.1])})
+        >>> radius = {"particle_radius": np.array([0.1])}
+        >>> rec = vv.Recording(t, {"particle_position": points}, static=radius)
         >>> out = render_video(rec, pathlib.Path(tempfile.mkdtemp()) / "drop.gif",
         ...                    fps=10, size=(64, 48))
         >>> out.name, out.stat().st_size > 0

@@ -56,7 +56,8 @@ class SystemType:
         draw: Maps recorded frames to points, or ``None`` if the system has no picture.
         edges: Point-index pairs drawn as lines, or ``None``.
         bodies: The coordinates are the positions of bodies, ``(x, y, z)`` per body, and so
-            are the picture: recordings keep them once, as ``points`` and ``velocities``.
+            are the picture: recordings keep them once, as ``system_points`` and
+            ``system_velocity``.
         dissipation: Name of the parameter that makes the system lose energy when it is not
             zero (a damping coefficient), or ``None`` if it always conserves energy.
     """

@@ -182,7 +182,7 @@ def export_recording(
         >>> from visviva.io.export import export_recording
         >>> t = np.arange(5) / 10.0                          # 5 frames at 10 Hz
         >>> pts = np.zeros((5, 2, 3)); pts[:, 1, 1] = t      # point 1 rises at 1 m/s
-        >>> rec = vv.Recording(t, {"points": pts}, units={"points": "m"})
+        >>> rec = vv.Recording(t, {"particle_position": pts}, units={"particle_position": "m"})
         >>> folder = tempfile.mkdtemp()
         >>> [p.name for p in export_recording(rec, f"{folder}/rise.pc2", fps=20.0)]
         ['rise.pc2']

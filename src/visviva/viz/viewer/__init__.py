@@ -92,7 +92,8 @@ def default_fps(recording: Recording, speed: float = 1.0) -> float:
 
     Example:
         >>> import numpy as np, visviva as vv
-        >>> rec = vv.Recording(np.arange(1001) * 1e-3, {"points": np.zeros((1001, 1, 3))})
+        >>> time, points = np.arange(1001) * 1e-3, np.zeros((1001, 1, 3))
+        >>> rec = vv.Recording(time, {"particle_position": points})
         >>> round(default_fps(rec), 3)          # 1000 Hz shown every 17th frame
         58.824
     """
@@ -206,7 +207,7 @@ def write_viewer(
 ) -> Path:
     """Write ``recording``'s animation as one self-contained HTML file.
 
-    The page plays the points (spheres of ``static["radius"]``), edges (lines), faces
+    The page plays the points (spheres of their radii), edges (lines), faces
     (a shaded surface) and rigid bodies (their surfaces, moved by their transforms) of
     :meth:`Recording.geometry` in real time (points that are born and
     die only while alive, at each frame's radius and colour), with an orbit camera, a
