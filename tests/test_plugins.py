@@ -280,7 +280,9 @@ def test_kinds_and_classes_are_refused_with_what_to_fix():
     class Nameless(BaseModel):
         type: Literal["nameless"]
 
-    with pytest.raises(ModelError, match=re.escape("must have the field `name: str | None`")):
+    with pytest.raises(
+        ModelError, match=re.escape("must have the field `name: str | None = None`")
+    ):
         vv.entities.register_entity_kind(EntityKind("nameless", Nameless, "x", KindBuild()))
     with pytest.raises(ModelError, match="lower-case letters"):
         vv.entities.register_entity_kind(EntityKind("Bad Name", _Table, "x", KindBuild()))

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import inspect
 import json
 import subprocess
 import sys
@@ -14,7 +13,6 @@ import pytest
 import visviva as vv
 from visviva.io.scene_files import dump_scene, load_scene, parse_scene
 from visviva.io.writer import RecordingWriter
-from visviva.model.scene import ENTITY_TYPES
 from visviva.scenes import dry_run
 
 EXAMPLES_DIR = Path(__file__).parents[1] / "examples" / "scenes"
@@ -63,17 +61,6 @@ def test_builder_and_file_give_the_same_model():
         np.testing.assert_array_equal(getattr(from_python, name), getattr(from_file, name))
     assert from_python.integration == from_file.integration
     np.testing.assert_array_equal(from_python.gravity, from_file.gravity)
-
-
-@pytest.mark.parametrize("kind", list(ENTITY_TYPES))
-def test_each_builder_method_takes_exactly_its_tables_fields(kind):
-    """One home per field: ``add_<kind>``'s keywords are the fields of the kind's table (its
-    ``type`` aside), typed, with no ``**kwargs``, so a renamed field is renamed in both."""
-    signature = inspect.signature(getattr(vv.SceneBuilder, f"add_{kind}"))
-    parameters = {n: p for n, p in signature.parameters.items() if n != "self"}
-    assert all(p.kind is not p.VAR_KEYWORD for p in parameters.values())
-    assert all(p.annotation is not p.empty for p in parameters.values())
-    assert set(parameters) == set(ENTITY_TYPES[kind].model_fields) - {"type"}
 
 
 def test_model_is_frozen():

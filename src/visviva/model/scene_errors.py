@@ -76,8 +76,9 @@ def scene_problems(
         elif error["type"] == "missing":
             got = None
         elif error["type"] == "union_tag_invalid":
-            message = f"unknown entity type; valid types: {', '.join(entity_kinds())}"
             tag = error["input"].get("type") if isinstance(error["input"], dict) else None
+            hint = did_you_mean(tag, entity_kinds()) if isinstance(tag, str) else ""
+            message = f"unknown entity type.{hint} Valid types: {', '.join(entity_kinds())}"
             got = describe(tag)
         elif error["type"] == "finite_number":
             message = "must be a finite number (numbers beyond ±1.8e308 overflow to inf)"
