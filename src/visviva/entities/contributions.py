@@ -19,7 +19,7 @@ error).
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 from pydantic import BaseModel
 
@@ -28,6 +28,10 @@ from ..ode.stage import Phase
 from .checks import check_names
 from .context import BuildContext, Located
 from .kind import EntityKind, KindBuild
+
+if TYPE_CHECKING:
+    from ..forces.base import Force
+    from ..ode.stage import Stage
 
 __all__ = ["force_kind", "force_problem", "stage_kind", "stage_problem"]
 
@@ -52,7 +56,7 @@ def force_problem(force: type) -> str | None:
         if not callable(getattr(force, method, None)):
             return f"{name} must define `{method}` (visviva.forces.Force)"
     if not callable(getattr(force, "potential", None)):
-        if force.conservative is True:
+        if getattr(force, "conservative", None) is True:
             return (
                 f"{name} claims to be conservative but reports no energy: define "
                 "`potential(t, x, alive=None)` returning U [J], or set conservative = False"
@@ -118,7 +122,7 @@ def force_kind(
             raise Located(where, str(error)) from None
         if not isinstance(made, force):
             raise Located(where, f"the {name} kind made a {type(made).__name__}, not a {force}")
-        context.forces.append(made)
+        context.forces.append(cast("Force", made))
 
     return EntityKind(
         name=name,
@@ -154,7 +158,7 @@ def stage_kind(
             raise Located(where, str(error)) from None
         if not isinstance(made, stage):
             raise Located(where, f"the {name} kind made a {type(made).__name__}, not a {stage}")
-        context.stages.append(made)
+        context.stages.append(cast("Stage", made))
 
     return EntityKind(
         name=name,

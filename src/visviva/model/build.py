@@ -216,6 +216,7 @@ def _lay_out_particles(context: BuildContext) -> None:
     }
     start = 0
     for index, where, entity, hooks, _ in holders:
+        assert hooks.rows is not None  # the holders are the kinds with rows
         rows: ParticleRows = hooks.rows(entity, where, context)
         count = rows.count
         columns["position"].append(np.asarray(rows.position, dtype=np.float64))
@@ -246,7 +247,7 @@ def _build(context: BuildContext) -> None:
     forces, then the handles' stage."""
     kinds = entity_kinds()
     if context.particle_count and context.gravity.any():
-        context.forces.append(UniformGravity(context.gravity, context.arrays["mass"]))
+        context.forces.append(UniformGravity(context.scene.world.gravity, context.arrays["mass"]))
     for index, entity in enumerate(context.scene.entities):
         build = kinds.get(entity.type).hooks.build
         if build is not None:

@@ -144,7 +144,9 @@ class Entities:
         cls, schema: CoreSchema, handler: GetJsonSchemaHandler
     ) -> dict[str, Any]:
         tables = tuple(kind.schema for kind in entity_kinds().values())
-        union = TypeAdapter(Annotated[Union[tables], Field(discriminator="type")])  # noqa: UP007
+        union: TypeAdapter[Any] = TypeAdapter(
+            Annotated[Union[tables], Field(discriminator="type")]  # type: ignore[arg-type]  # noqa: UP007
+        )
         return {"type": "array", "items": handler(union.core_schema)}
 
 
@@ -156,7 +158,8 @@ def _entities(value: Any) -> list[BaseModel]:
     entities: list[BaseModel] = []
     errors: list[Any] = []
     for index, item in enumerate(value):
-        if isinstance(item, BaseModel) and item.__class__ is kinds.get(item.type).schema:
+        tag = getattr(item, "type", None)  # an entity table already validated keeps its schema
+        if isinstance(item, BaseModel) and tag in kinds and type(item) is kinds.get(tag).schema:
             entities.append(item)
             continue
         raw = item.model_dump() if isinstance(item, BaseModel) else item

@@ -73,7 +73,7 @@ def _bodies(
     dynamic = np.array([e.motion == "dynamic" for _, e in chosen])
     forces: list[BodyForce] = []
     if context.gravity.any() and dynamic.any():
-        forces.append(BodyGravity(context.gravity, np.where(dynamic, bodies.mass, 0.0)))
+        forces.append(BodyGravity(context.scene.world.gravity, np.where(dynamic, bodies.mass, 0.0)))
     if bodies.linear_damping_rate.any() or bodies.angular_damping_rate.any():
         forces.append(BodyDamping(bodies.linear_damping_rate, bodies.angular_damping_rate))
     pushes = [(b, p) for b, (_, e) in enumerate(chosen) for p in e.push]
@@ -189,7 +189,8 @@ def _start(where: str, entity: RigidBody) -> BodyStart:
 def _prepare(entity: RigidBody, where: str) -> RigidBody:
     """The body with its mesh file read (a body's mesh is checked as a solid when the scene is
     built)."""
-    return with_mesh_file(entity, where)  # type: ignore[no-any-return]
+    prepared: RigidBody = with_mesh_file(entity, where)
+    return prepared
 
 
 BUILD = KindBuild(prepare=_prepare, finish=_finish)

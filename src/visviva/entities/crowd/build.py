@@ -98,9 +98,7 @@ def _finish(entries: Sequence[tuple[str, CrowdEntity]], context: BuildContext) -
     context.stages.append(stage)
 
 
-def _check_walls(
-    crowd: CrowdEntity, where: str, names: list[str], entities: Sequence[object]
-) -> None:
+def _check_walls(crowd: CrowdEntity, where: str, names: list[str], entities: Sequence[Any]) -> None:
     if crowd.walls is None:
         return
     colliders = [names[i] for i, e in enumerate(entities) if e.type == "collider"]
@@ -117,7 +115,7 @@ def _agents(
     crowd: CrowdEntity,
     where: str,
     names: list[str],
-    entities: Sequence[object],
+    entities: Sequence[Any],
     groups: Sequence[ParticleGroup],
     owner: dict[int, str],
     name: str,

@@ -64,7 +64,7 @@ def _finish(
             friction=entity.friction,
             iterations=entity.iterations,
             resting_speed=resting,
-            gravity=context.gravity,
+            gravity=context.scene.world.gravity,
             colliders=colliders,
         )
     except ModelError as error:

@@ -45,7 +45,7 @@ def _check(entity: System, where: str, scene: Any) -> list[SceneProblem]:
 
 def _check_parameters(entity: System, where: str) -> list[SceneProblem]:
     kind = SYSTEMS[entity.system]
-    renamed = RENAMED_PARAMETERS.get(entity.system, {})
+    renamed: Mapping[str, str] = RENAMED_PARAMETERS.get(entity.system, {})
     problems = []
     for key, value in entity.parameters.items():
         path = f"{where}.parameters.{key}"

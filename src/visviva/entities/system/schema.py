@@ -15,7 +15,7 @@ from ..fields import (
     Name,
     Strict,
 )
-from ..methods import given
+from ..methods import Builds, given
 
 __all__ = ["RENAMED_PARAMETERS", "System"]
 
@@ -53,7 +53,11 @@ class SystemMethods:
     """The builder's method of this kind (:mod:`visviva.entities.methods`)."""
 
     def add_system(
-        self, system: str, parameters: Mapping[str, float] | None = None, *, name: str | None = None
+        self: Builds,
+        system: str,
+        parameters: Mapping[str, float] | None = None,
+        *,
+        name: str | None = None,
     ) -> int:
         """Add a named system (``visviva schema`` lists them: ``pendulum``, ``kepler``, ...)
         with parameter values (omitted ones take their defaults)."""
