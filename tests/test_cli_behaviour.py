@@ -170,7 +170,7 @@ def test_export_plays_at_the_speed_its_run_was_made_with(monkeypatch, capsys, tm
         tmp_path / "slow.gif",
     )
     assert "output frames" in line and "speed" in line
-    from visviva.io.outputs import playback
+    from visviva.viz.outputs import playback
 
     assert playback(recording, None, None) == (week, 8 * week, "scene")
     assert playback(recording, 1.0, 0.0, "speed") == (1.0, 0.0, "speed")

@@ -15,10 +15,10 @@ from visviva.viz.plots import comparison_figures
 
 
 @pytest.fixture(scope="module")
-def comparison() -> vv.analysis.Comparison:
+def comparison() -> vv.studies.Comparison:
     problem = classic.pendulum(length=1.0).problem([1.0], [0.0], backend="numpy")
     methods = ["explicit_euler", "symplectic_euler", "velocity_verlet", "rk4"]
-    return vv.analysis.compare_methods(problem, methods, dt=0.01, until=20.0, levels=5)
+    return vv.studies.compare_methods(problem, methods, dt=0.01, until=20.0, levels=5)
 
 
 def test_measured_orders_match_the_declared_ones(comparison):

@@ -203,7 +203,7 @@ def test_a_demo_that_fails_midway_leaves_nothing(tmp_path):
 
 
 def test_an_output_that_fails_after_the_run_keeps_the_recording(tmp_path, monkeypatch):
-    import visviva.io.outputs as outputs
+    import visviva.viz.outputs as outputs
 
     def fail(recording, path, fps, *playback):
         raise vv.ModelError("cannot frame this scene")

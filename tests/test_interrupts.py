@@ -128,7 +128,7 @@ def _short_scene(tmp_path: Path) -> vv.Model:
 
 
 def test_ctrl_c_while_writing_outputs_keeps_the_finished_ones(tmp_path, monkeypatch):
-    import visviva.io.outputs as outputs
+    import visviva.viz.outputs as outputs
 
     real = outputs.write_output
     calls = []

@@ -38,7 +38,7 @@ def _cases():
 def test_declared_order_is_measured(method, problem):
     """Fitted slope within ±0.1 of the declared order, over at least three step sizes."""
     reference = reference_problem(problem)
-    study = vv.analysis.convergence_order(
+    study = vv.studies.convergence_order(
         reference.problem,
         method,
         until=2.0,
@@ -54,7 +54,7 @@ def test_declared_order_is_measured(method, problem):
 def test_errors_halve_for_first_order_methods():
     """Seed 000: halving dt halves explicit Euler's error (ratio → 2 as dt → 0)."""
     reference = reference_problem("forced")
-    study = vv.analysis.convergence_order(
+    study = vv.studies.convergence_order(
         reference.problem,
         "explicit_euler",
         until=1.0,

@@ -29,8 +29,8 @@ import visviva as vv
 from test_export import gltf_accessor, read_obj, read_pc2
 from test_viewer import CHROMIUM, CHROMIUM_FLAGS, Opened
 from visviva.io.export import export_recording
+from visviva.simulation.lifetimes import held_frames, life_starts
 from visviva.viz.frame import FramePainter, drawn_bounds
-from visviva.viz.lifetimes import held_frames, life_starts
 from visviva.viz.video import Camera, render_video
 from visviva.viz.viewer import write_viewer
 

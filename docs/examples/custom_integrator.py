@@ -37,8 +37,6 @@ def register() -> vv.integrators.Integrator:
 if __name__ == "__main__":
     register()
     decay = vv.ode.FirstOrderProblem(lambda t, y: -y, [1.0])
-    study = vv.analysis.convergence_order(
-        decay, "kutta3", until=1.0, reference=lambda t: np.exp(-t)
-    )
+    study = vv.studies.convergence_order(decay, "kutta3", until=1.0, reference=lambda t: np.exp(-t))
     print(f"kutta3: measured order {study.order:.2f}")
     print("real stability interval:", vv.analysis.stability_interval("kutta3"))

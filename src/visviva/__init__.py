@@ -47,6 +47,7 @@ if TYPE_CHECKING:
         particles,
         rigid,
         simulation,
+        studies,
         sweeps,
         viz,
     )
@@ -89,6 +90,7 @@ __all__ = [
     "run_scene",
     "simulation",
     "solve",
+    "studies",
     "sweep",
     "sweeps",
     "viz",

@@ -187,8 +187,8 @@ def write_run(
     summary, the extra outputs and the error handling are those of :func:`run_scene`.
     """
     from .io.job import JobOutput
-    from .io.outputs import write_output
     from .simulation.interrupt import Interrupted, StopOnSignal
+    from .viz.outputs import write_output
 
     planned = _planned(model, formats, seconds)
     if not record:
@@ -517,7 +517,7 @@ def _duration(model: Model, duration: float | None) -> float:
 
 def _planned(model: Model, formats: Iterable[str], seconds: float) -> list[str]:
     """The files a run writes, after checking that its outputs can be written."""
-    from .io.outputs import output_names
+    from .viz.outputs import output_names
 
     names = output_names([*model.output_formats, *formats])
     problems = output_problems(model, formats, seconds)

@@ -1,4 +1,7 @@
-"""Analysis of integrators and runs: stability, convergence order, invariants, chaos measures."""
+"""Analysis of integrators and runs: stability functions and regions, the largest stable step
+from a spectrum (the advisor the divergence watch asks), invariants, chaos measures. Studies
+that run the solver to measure methods — convergence orders, comparisons — are
+:mod:`visviva.studies`, a layer above the simulation loop."""
 
 from __future__ import annotations
 
@@ -9,8 +12,6 @@ from .._lazy import lazy_names
 if TYPE_CHECKING:
     from .advisor import largest_stable_step, matrix_free_eigenvalues
     from .chaos import LyapunovEstimate, lyapunov_exponent, separation
-    from .compare import Comparison, MethodResult, compare_methods
-    from .convergence import ConvergenceStudy, convergence_order
     from .invariants import (
         angular_momentum,
         center_of_mass,
@@ -29,14 +30,9 @@ if TYPE_CHECKING:
     )
 
 __all__ = [
-    "Comparison",
-    "ConvergenceStudy",
     "LyapunovEstimate",
-    "MethodResult",
     "angular_momentum",
     "center_of_mass",
-    "compare_methods",
-    "convergence_order",
     "energy_drift",
     "largest_stable_step",
     "linear_momentum",
@@ -54,7 +50,7 @@ __all__ = [
 ]
 
 # Names load on first use (visviva._lazy): a run's summary needs `invariants` without the
-# stability and convergence studies' integrators.
+# stability functions' integrators.
 __getattr__, __dir__ = lazy_names(
     __name__,
     __all__,
@@ -64,11 +60,6 @@ __getattr__, __dir__ = lazy_names(
         "LyapunovEstimate": "chaos",
         "lyapunov_exponent": "chaos",
         "separation": "chaos",
-        "Comparison": "compare",
-        "MethodResult": "compare",
-        "compare_methods": "compare",
-        "ConvergenceStudy": "convergence",
-        "convergence_order": "convergence",
         "angular_momentum": "invariants",
         "center_of_mass": "invariants",
         "energy_drift": "invariants",

@@ -127,10 +127,10 @@ def convergence_command(
 ) -> None:
     """Measure each method's order of accuracy against an exact solution."""
     from .._validation import real_number, whole_number
-    from ..analysis.convergence import convergence_order
     from ..analysis.reference_problems import reference_problem
     from ..errors import ModelError
     from ..integrators import get, names
+    from ..studies.convergence import convergence_order
 
     levels = whole_number("levels", levels, minimum=3)
     if levels > MAX_LEVELS:
@@ -255,12 +255,12 @@ def compare_command(
     """Run one system under several integrators: energy plot, convergence plot and a table."""
     from .._registry import did_you_mean
     from .._validation import real_number
-    from ..analysis.compare import compare_methods
     from ..entities.system.systems import SYSTEMS
     from ..errors import ModelError
     from ..io.job import JobOutput
     from ..model.builder import SceneBuilder
     from ..scenes import load_model
+    from ..studies.compare import compare_methods
     from ..viz.plots import comparison_figures
 
     if dt is not None:

@@ -195,8 +195,8 @@ def view_command(
 ) -> None:
     """Write the single-file web viewer of a recording (open it in any browser)."""
     from ..io.files import check_new_file
-    from ..io.outputs import playback
     from ..io.recording import load_recording
+    from ..viz.outputs import playback
     from ..viz.viewer import write_viewer
 
     target = output or recording.with_name("viewer.html")
@@ -236,8 +236,8 @@ def export_command(
     from .._registry import did_you_mean
     from ..errors import ModelError
     from ..io.files import check_new_file
-    from ..io.outputs import OUTPUT_FILES, playback
     from ..io.recording import load_recording
+    from ..viz.outputs import OUTPUT_FILES, playback
 
     formats = ("usd", "glb", "obj", "pc2", "mp4", "gif")
     if to not in formats:

@@ -11,8 +11,8 @@ from typing import Any
 from .._validation import real_number
 from ..errors import ModelError
 from ..io.job import JobOutput, JobReport, python_warnings, run_summary
-from ..io.outputs import output_names, write_output
 from ..simulation.interrupt import Interrupted, StopOnSignal
+from ..viz.outputs import output_names, write_output
 from . import Demo, demos, find_demo
 
 __all__ = ["MAX_DURATION_FACTOR", "run_demo"]

@@ -17,10 +17,10 @@ one (:class:`~visviva.viz.body_layer.BodyLayer`: each body's surface placed by i
 shaded like the faces, in its colour), the static colliders another
 (:class:`~visviva.viz.body_layer.SceneryLayer`); the framing and the ground include them.
 
-Points that are born and die (:mod:`visviva.viz.lifetimes`): each frame draws and shadows only
-its live points, at that frame's radius and colour; a trail goes back no further than the start
-of its point's current life; the framing and the ground come from live points only. Edges and
-faces are drawn between their points in every frame (emitters' particles have none).
+Points that are born and die (:mod:`visviva.simulation.lifetimes`): each frame draws and shadows
+only its live points, at that frame's radius and colour; a trail goes back no further than the start
+of its point's current life; the framing and the ground come from live points only. Edges and faces
+are drawn between their points in every frame (emitters' particles have none).
 """
 
 from __future__ import annotations
@@ -31,10 +31,10 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
+from ..simulation.lifetimes import Appearance, life_starts
 from ..simulation.recording import Geometry
 from . import ground, raster
 from .body_layer import BodyLayer, SceneryLayer
-from .lifetimes import Appearance, life_starts
 from .shading import LIGHT, MATERIAL, lit_sides
 from .timescale import format_time
 

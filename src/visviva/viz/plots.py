@@ -18,9 +18,9 @@ from ..analysis.invariants import relative_change
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from ..analysis.compare import Comparison
-    from ..analysis.convergence import ConvergenceStudy
     from ..simulation.recording import Recording
+    from ..studies.compare import Comparison
+    from ..studies.convergence import ConvergenceStudy
 
 __all__ = [
     "comparison_figures",
@@ -222,12 +222,12 @@ def plot_convergence(studies: Sequence[ConvergenceStudy]) -> Figure:
 
 
 def comparison_figures(comparison: Comparison, *, title: str | None = None) -> dict[str, Figure]:
-    """The figures of :func:`~visviva.analysis.compare_methods`, by name: ``"energy"``, the
+    """The figures of :func:`~visviva.studies.compare_methods`, by name: ``"energy"``, the
     energy of every full run (:func:`plot_energy`), and ``"convergence"``, error against step
     size with each method's fitted order (:func:`plot_convergence`).
 
     Args:
-        comparison: What :func:`~visviva.analysis.compare_methods` returned.
+        comparison: What :func:`~visviva.studies.compare_methods` returned.
         title: Title of the energy figure; default ``"Energy, h = <dt> s"``.
     """
     return {

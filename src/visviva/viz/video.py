@@ -20,7 +20,7 @@ checkered ground plane at ``y = min(0, lowest point)``, points as shaded spheres
 recorded radius and colour (or the viewer's default radius and blue; a recording's display
 radii, for bodies too small to see, are drawn instead and the label says "sizes not to
 scale"), only the points alive in the frame (particles of emitters are born and die; see
-:mod:`visviva.viz.lifetimes`), optional trails behind the points, edges as lines, faces as
+:mod:`visviva.simulation.lifetimes`), optional trails behind the points, edges as lines, faces as
 Gouraud-shaded triangles, rigid bodies as their surfaces placed by each frame's transform and
 shaded the same way in their colours, shadows from a light above, and the time of the recorded frame
 shown in the unit that reads best, ``t = 1.234 s`` or ``t = 182.6 days``. Output frame ``k``

@@ -9,7 +9,7 @@ format needs a resampled copy of the whole recording unless its layout demands o
 The drawable parts follow the recording's convention (``points``, ``radius``, ``edges``,
 ``faces``; see :mod:`visviva.simulation.recording`). Points that are born and die
 (``alive``, with radii and colours that may change per frame) are read through
-:class:`visviva.viz.lifetimes.Appearance`, as the video and the viewer read them: each writer
+:class:`visviva.simulation.lifetimes.Appearance`, as the video and the viewer read them: each writer
 asks which points are alive in an output frame (:meth:`ExportFrames.alive_at`), their radius
 and colour there, and, if its format keeps every slot in every frame, where a dead slot is held
 (:meth:`ExportFrames.held_points_at`). Rigid bodies (:mod:`visviva.simulation.body_geometry`)
@@ -29,8 +29,8 @@ import numpy as np
 from ..._validation import real_number
 from ...errors import ModelError
 from ...simulation.body_geometry import BodyGeometry, continuous_orientations
+from ...simulation.lifetimes import Appearance, held_frames, held_points
 from ...simulation.recording import Geometry, Recording
-from ...viz.lifetimes import Appearance, held_frames, held_points
 from ..timeline import MAX_OUTPUT_FRAMES, frames_at_rate
 
 __all__ = ["FALLBACK_FPS", "MAX_OUTPUT_FRAMES", "ExportFrames", "default_fps", "prepare"]

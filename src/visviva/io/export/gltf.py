@@ -26,7 +26,7 @@ to a triangle mesh; the points of the mesh layout carry ``COLOR_0`` (§ 3.7.2.1)
 no material worth the name. Neither can change over time: a colour that changes is written as
 the point's colour in the first frame it is alive.
 
-Points that are born and die (particles of emitters; :mod:`visviva.viz.lifetimes`): glTF has
+Points that are born and die (particles of emitters; :mod:`visviva.simulation.lifetimes`): glTF has
 no varying point count. Bodies get a ``STEP`` animation of each node's ``scale``: the point's
 radius while it lives (and as it changes), 0 while it is dead, which collapses its sphere to
 nothing; a dead node's translation holds where the point was last alive (before its first

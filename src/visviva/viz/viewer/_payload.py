@@ -14,7 +14,7 @@ compressed with zlib (deflate), which the page inflates with the browser's own
 ``DecompressionStream``. The galaxy demo's 6002 points × 301 frames take 8.5 MB instead of
 29 MB of float32 base64.
 
-Points that are born and die (:mod:`visviva.viz.lifetimes`) add, only when the recording has
+Points that are born and die (:mod:`visviva.simulation.lifetimes`) add, only when the recording has
 them: ``alive``, which points exist in each frame, as bits (one per point per frame, XOR with
 the previous frame, so a frame costs only its births and deaths before zlib); ``births``, with a
 trail, the bits of points that start a new life in a frame (a reused slot's trail starts
@@ -53,10 +53,10 @@ from typing import Any
 import numpy as np
 
 from ...simulation.body_geometry import BodyGeometry
+from ...simulation.lifetimes import Appearance, held_frames, held_points, life_starts
 from ...simulation.recording import Geometry
 from ...simulation.scenery import Scenery
 from ..frame import drawn_bounds
-from ..lifetimes import Appearance, held_frames, held_points, life_starts
 from ..timescale import time_unit
 
 __all__ = [

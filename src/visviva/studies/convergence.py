@@ -19,6 +19,7 @@ import numpy as np
 from .._validation import describe, real_number, whole_number
 from ..errors import ModelError
 from ..integrators import Integrator, get
+from ..simulation.solution import solve
 
 if TYPE_CHECKING:
     from ..ode.problems import Problem
@@ -99,12 +100,11 @@ def convergence_order(
     Example:
         >>> import numpy as np, visviva as vv
         >>> decay = vv.ode.FirstOrderProblem(lambda t, y: -y, [1.0])
-        >>> study = vv.analysis.convergence_order(decay, "heun", until=1.0,
+        >>> study = vv.studies.convergence_order(decay, "heun", until=1.0,
         ...                                       reference=lambda t: np.exp(-t))
         >>> round(study.order, 1)
         2.0
     """
-    from ..simulation.solution import solve
 
     integrator = get(method)
     until = real_number("until", until, unit=" s")

@@ -55,15 +55,15 @@ def write_output(
     ``color_by`` (``"scene"`` or ``"speed"``)."""
     suffix = path.suffix.lower()
     if suffix in (".mp4", ".gif"):
-        from ..viz.video import render_video
+        from .video import render_video
 
         render_video(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by)
     elif suffix == ".html":
-        from ..viz.viewer import write_viewer
+        from .viewer import write_viewer
 
         write_viewer(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by)
     else:
-        from .export import export_recording
+        from ..io.export import export_recording
 
         to = {".usdc": "usd", ".glb": "glb", ".pc2": "pc2", "": "obj"}[suffix]
         export_recording(recording, path, to=to, fps=fps, speed=speed)

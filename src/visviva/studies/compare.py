@@ -15,10 +15,11 @@ from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
 from .._validation import real_number, whole_number
+from ..analysis.invariants import energy_drift, max_energy_error
 from ..errors import SimulationError
 from ..integrators import get
+from ..simulation.solution import solve
 from .convergence import ConvergenceStudy, convergence_order
-from .invariants import energy_drift, max_energy_error
 
 if TYPE_CHECKING:
     from ..ode.problems import Problem
@@ -141,7 +142,6 @@ def compare_methods(
     span_end = real_number("convergence_until", span_end, unit=" s")
     integrators = [get(name) for name in methods]
     results, runs, studies = [], {}, []
-    from ..simulation.solution import solve
 
     for integrator in integrators:
         started = time.perf_counter()

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..simulation.recording import Geometry
+from .recording import Geometry
 
 __all__ = ["Appearance", "held_frames", "life_starts"]
 
