@@ -190,6 +190,7 @@ print(json.dumps({"kinds": kinds, "warnings": [str(w.message) for w in caught]})
              conservative = True
              velocity_dependent = False
              linear_damping = False
+             compiled = None
              def accumulate(self, t, x, v, out, work=None): ...
              def jacobian_blocks(self): return None
              def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact"): ...

@@ -64,6 +64,8 @@ class PenaltyContact:
     velocity_dependent = True
     #: Its damper ``c (v·n) n`` changes direction with the positions: not a linear damper.
     linear_damping = False
+    #: No compiled form: a scene with penalty contact takes the generic road.
+    compiled = None
 
     def __init__(
         self,

@@ -8,8 +8,8 @@ makes the class from an entity; :func:`force_kind` and :func:`stage_kind` make t
     KIND = force_kind("magnetic_field", MagneticFieldTable, MagneticForce, make, summary="...")
 
 The class is checked when the kind is made — it must declare what the pipeline reads of it
-(:class:`~visviva.forces.Force`: ``conservative``, ``velocity_dependent``, ``linear_damping``
-and its methods; :class:`~visviva.ode.stage.Stage`: ``phase``, ``order``, ``compiled``,
+(:class:`~visviva.forces.Force`: ``conservative``, ``velocity_dependent``, ``linear_damping``,
+``compiled`` and its methods; :class:`~visviva.ode.stage.Stage`: ``phase``, ``order``, ``compiled``,
 ``changes_energy``, ``kills_particles`` and its methods) — so a plugin that would give wrong
 answers is refused with what to fix (a force that claims to be conservative must report its
 potential energy: a change in the energy of a conservative scene measures the integrator's
@@ -55,6 +55,11 @@ def force_problem(force: type) -> str | None:
     for method in _FORCE_METHODS:
         if not callable(getattr(force, method, None)):
             return f"{name} must define `{method}` (visviva.forces.Force)"
+    if not hasattr(force, "compiled"):
+        return (
+            f"{name} must declare `compiled = None` (it has no compiled form the fused particle "
+            "step could take: a scene with it takes the generic road)"
+        )
     if not callable(getattr(force, "potential", None)):
         if getattr(force, "conservative", None) is True:
             return (

@@ -9,6 +9,8 @@ world frame (Y up), ``N`` the particle capacity of the scene. A force:
   changes after it is built);
 * reports its potential energy [J] (0 for forces that have none: drag, wind, vortices), so
   every run can monitor the total energy; ``conservative`` says whether the force is ``−∇U``;
+* declares its compiled form (``compiled``: a field's law, springs' arrays, or ``None``), from
+  which the fused particle step evaluates it with the same compiled laws as ``accumulate``;
 * gives its exact Jacobians ``∂F/∂x`` and ``∂F/∂v`` as 3×3 blocks on a sparsity pattern fixed
   when the force is built (``jacobian_blocks``), which implicit methods and the stability
   advisor assemble into one sparse matrix (:mod:`visviva.forces.assembly`). A force without an
@@ -31,6 +33,8 @@ import numpy as np
 
 if TYPE_CHECKING:
     from ..ode.workspace import Workspace
+    from .laws import FieldLaw
+    from .springs import SpringSet
 
 __all__ = ["Force", "JacobianForm", "Targets", "diagonal_blocks"]
 
@@ -50,6 +54,14 @@ class Force(Protocol):
     conservative: ClassVar[bool]
     #: True if the force depends on the velocities.
     velocity_dependent: ClassVar[bool]
+
+    @property
+    def compiled(self) -> FieldLaw | SpringSet | None:
+        """Its compiled form, from which the fused particle step evaluates it: a field's law
+        and parameters (:class:`~.laws.FieldLaw`), springs' arrays
+        (:class:`~.springs.SpringSet`), or ``None`` — a scene with such a force takes the
+        generic road."""
+        ...
 
     @property
     def linear_damping(self) -> bool:

@@ -13,6 +13,7 @@ to its torque (:func:`wrench_at`); a force through the centre of mass turns noth
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import ClassVar, Protocol
 
 import numpy as np
@@ -20,7 +21,33 @@ import numpy as np
 from ..geometry.quaternions import quaternion_matrix, quaternion_multiply
 from .fields import vector
 
-__all__ = ["BodyAnchor", "BodyDamping", "BodyForce", "BodyGravity", "BodyPush", "wrench_at"]
+__all__ = [
+    "BodyAnchor",
+    "BodyDamping",
+    "BodyForce",
+    "BodyGravity",
+    "BodyLaw",
+    "BodyPush",
+    "wrench_at",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class BodyLaw:
+    """A body force's compiled form: on body ``b``, ``F = M_b g − γ_b P``, ``τ = −γ'_b L``;
+    the fused rigid step (:mod:`visviva.rigid.fused`) sums the forms of a scene's forces.
+
+    Attributes:
+        gravity: ``g`` [m/s²], ``(3,)``.
+        mass: ``(B,)`` the masses ``g`` pulls [kg] (0 for a body gravity does not move).
+        linear: ``(B,)`` γ [1/s].
+        angular: ``(B,)`` γ' [1/s].
+    """
+
+    gravity: np.ndarray
+    mass: np.ndarray
+    linear: np.ndarray
+    angular: np.ndarray
 
 
 class BodyForce(Protocol):
@@ -28,6 +55,11 @@ class BodyForce(Protocol):
 
     conservative: ClassVar[bool]
     velocity_dependent: ClassVar[bool]
+
+    @property
+    def compiled(self) -> BodyLaw | None:
+        """Its compiled form, or ``None``: a scene with such a force takes the generic road."""
+        ...
 
     def accumulate_wrench(
         self,
@@ -76,6 +108,12 @@ class BodyGravity:
         self.mass = np.asarray(mass, dtype=np.float64)
         self._weight = self.mass[:, None] * self.gravity[None, :]
 
+    @property
+    def compiled(self) -> BodyLaw:
+        """``F = M g``."""
+        none = np.zeros_like(self.mass)
+        return BodyLaw(self.gravity, self.mass, none, none)
+
     def accumulate_wrench(self, t, x, q, momentum, angular_momentum, force, torque) -> None:  # type: ignore[no-untyped-def]
         """Add ``M g`` [N] to ``force`` (no torque)."""
         force += self._weight
@@ -100,6 +138,12 @@ class BodyDamping:
     def __init__(self, linear: np.ndarray, angular: np.ndarray) -> None:
         self.linear = np.asarray(linear, dtype=np.float64)[:, None]
         self.angular = np.asarray(angular, dtype=np.float64)[:, None]
+
+    @property
+    def compiled(self) -> BodyLaw:
+        """``F = −γ P``, ``τ = −γ' L``."""
+        linear = self.linear[:, 0]
+        return BodyLaw(np.zeros(3), np.zeros_like(linear), linear, self.angular[:, 0])
 
     def accumulate_wrench(self, t, x, q, momentum, angular_momentum, force, torque) -> None:  # type: ignore[no-untyped-def]
         """Add ``−γ P`` to ``force`` and ``−γ' L`` to ``torque``."""
@@ -134,6 +178,8 @@ class BodyPush:
 
     conservative = False
     velocity_dependent = False
+    #: No compiled form: a scene with it takes the generic road.
+    compiled = None
 
     def __init__(self, body, force, arm, start, stop, world=None) -> None:  # type: ignore[no-untyped-def]
         self.body = np.asarray(body, dtype=np.int64)
@@ -180,6 +226,8 @@ class BodyAnchor:
     """
 
     velocity_dependent = True
+    #: No compiled form: a scene with it takes the generic road.
+    compiled = None
 
     def __init__(self, body, arm, at, stiffness, damping, mass, moments, axes) -> None:  # type: ignore[no-untyped-def]
         self.body = np.asarray(body, dtype=np.int64)

@@ -18,12 +18,17 @@ from .._validation import real_number
 from ..errors import ModelError
 from .base import Targets, diagonal_blocks
 from .laws import (
-    attractor_force,
+    ATTRACTOR,
+    DAMPING,
+    DRAG,
+    GRAVITY,
+    QUADRATIC_DRAG,
+    VORTEX,
+    FieldLaw,
     attractor_jacobian,
     attractor_potential,
-    quadratic_drag_force,
+    field_forces,
     quadratic_drag_jacobian,
-    vortex_air_velocity,
     vortex_jacobian,
 )
 
@@ -49,14 +54,33 @@ def vector(name: str, value: Sequence[float], *, unit: str, nonzero: bool = Fals
 
 
 class _Field:
-    """Common part of the fields: targets, masses and the diagonal block pattern."""
+    """Common part of the fields: targets, masses, the diagonal block pattern, and the force
+    itself, evaluated by the field's law (:func:`~.laws.field_force`, the law the fused particle
+    step evaluates too)."""
 
     conservative: ClassVar[bool] = False
     velocity_dependent: ClassVar[bool] = True
+    #: The code of its law (:mod:`.laws`).
+    law: ClassVar[int]
 
     def __init__(self, mass: np.ndarray, targets: Targets) -> None:
         self.mass = np.asarray(mass, dtype=np.float64)
         self.targets = targets
+
+    def law_parameters(self) -> tuple[float, ...]:
+        """The row of its law's parameters (see :mod:`.laws`)."""
+        raise NotImplementedError
+
+    @property
+    def compiled(self) -> FieldLaw:
+        """Its compiled form: its law, parameters and targets."""
+        return FieldLaw(self.law, self.law_parameters(), self.targets)
+
+    def accumulate(
+        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
+    ) -> None:
+        """Add the field's force [N] on every target to ``out`` ``(N, 3)``."""
+        field_forces(self.law, self.compiled.row(), self.targets.indices, x, v, self.mass, out)
 
     @property
     def linear_damping(self) -> bool:
@@ -83,23 +107,18 @@ class UniformGravity(_Field):
 
     conservative = True
     velocity_dependent = False
+    law = GRAVITY
 
     def __init__(
         self, gravity: Sequence[float], mass: np.ndarray, targets: Targets | None = None
     ) -> None:
         super().__init__(mass, targets or Targets(len(mass)))
         self.gravity = vector("gravity", gravity, unit="m/s²")
-        # m_i g for every target, once: the force does not depend on the state.
+        # m_i g for every target, once (the potential's).
         self._weight = self.mass[self.targets.indices, None] * self.gravity[None, :]
 
-    def accumulate(
-        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
-    ) -> None:
-        """Add ``m_i g`` [N] to ``out`` ``(N, 3)``."""
-        if self.targets.everything:
-            out += self._weight
-        else:
-            out[self.targets.indices] += self._weight
+    def law_parameters(self) -> tuple[float, ...]:
+        return tuple(float(g) for g in self.gravity)
 
     def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
         """``U = −Σ_i m_i g·x_i`` [J] over the targets (alive ones, if given)."""
@@ -146,16 +165,10 @@ class Drag(_AirDrag):
         """In still air the drag is ``D v`` with ``D = −k I`` (see visviva.forces.ForceSum)."""
         return not np.any(self.air_velocity)
 
-    def accumulate(
-        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
-    ) -> None:
-        """Add ``−k (v − w)`` [N] to ``out``."""
-        k, w = self.coefficient, self.air_velocity
-        if self.targets.everything:
-            out -= k * (v - w)
-        else:
-            index = self.targets.indices
-            out[index] -= k * (v[index] - w)
+    law = DRAG
+
+    def law_parameters(self) -> tuple[float, ...]:
+        return (*(float(w) for w in self.air_velocity), self.coefficient)
 
     def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """``∂F/∂v = −k I`` [N·s/m] on each block."""
@@ -177,20 +190,15 @@ class Damping(_Field):
         """``F = D v`` with ``D = −γ m I`` (see visviva.forces.ForceSum)."""
         return True
 
+    law = DAMPING
+
     def __init__(self, rate: float, mass: np.ndarray, targets: Targets | None = None) -> None:
         super().__init__(mass, targets or Targets(len(mass)))
         self.rate = real_number("rate", rate, nonnegative=True, unit=" 1/s")
         self._factor = (self.rate * self.mass[self.targets.indices])[:, None]
 
-    def accumulate(
-        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
-    ) -> None:
-        """Add ``−γ m v`` [N] to ``out``."""
-        if self.targets.everything:
-            out -= self._factor * v
-        else:
-            index = self.targets.indices
-            out[index] -= self._factor * v[index]
+    def law_parameters(self) -> tuple[float, ...]:
+        return (self.rate,)
 
     def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """``∂F/∂v = −γ m I`` [kg/s] on each block."""
@@ -208,11 +216,10 @@ class QuadraticDrag(_AirDrag):
         air_velocity: The air's velocity ``w`` [m/s].
     """
 
-    def accumulate(
-        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
-    ) -> None:
-        """Add the drag [N] to ``out``."""
-        _quadratic_drag(self.targets.indices, v, *self.air_velocity, self.coefficient, out)
+    law = QUADRATIC_DRAG
+
+    def law_parameters(self) -> tuple[float, ...]:
+        return (*(float(w) for w in self.air_velocity), self.coefficient)
 
     def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """``∂F/∂v`` [kg/s] on each block (see :func:`~.laws.quadratic_drag_jacobian`)."""
@@ -246,22 +253,20 @@ class Attractor(_Field):
         self.strength = real_number("strength", strength, unit=" m³/s²")
         self.softening = real_number("softening", softening, positive=True, unit=" m")
 
-    def _parameters(self) -> tuple[float, ...]:
-        return (*self.point, self.strength, self.softening**2)
+    law = ATTRACTOR
 
-    def accumulate(
-        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
-    ) -> None:
-        """Add the attraction [N] to ``out``."""
-        _attractor(self.targets.indices, x, self.mass, *self._parameters(), out)
+    def law_parameters(self) -> tuple[float, ...]:
+        return (*(float(c) for c in self.point), self.strength, self.softening**2)
 
     def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
         """``U = −Σ_i s m_i / ρ_i`` [J] over the targets (alive ones, if given)."""
-        return float(_attractor_energy(self.targets.mask(alive), x, self.mass, *self._parameters()))
+        return float(
+            _attractor_energy(self.targets.mask(alive), x, self.mass, *self.law_parameters())
+        )
 
     def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """``∂F/∂x`` [N/m] on each block (see :func:`~.laws.attractor_jacobian`)."""
-        _attractor_blocks(self.targets.indices, x, self.mass, *self._parameters(), dfdx)
+        _attractor_blocks(self.targets.indices, x, self.mass, *self.law_parameters(), dfdx)
 
 
 class Vortex(_Field):
@@ -296,19 +301,16 @@ class Vortex(_Field):
         self.coefficient = real_number("coefficient", coefficient, nonnegative=True)
         self.core_radius = real_number("core_radius", core_radius, positive=True, unit=" m")
 
-    def _parameters(self) -> tuple[float, ...]:
-        factor = self.circulation / (2.0 * math.pi)
-        return (*self.point, *self.axis, factor, self.core_radius**2, self.coefficient)
+    law = VORTEX
 
-    def accumulate(
-        self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
-    ) -> None:
-        """Add the vortex's drag [N] to ``out``."""
-        _vortex(self.targets.indices, x, v, *self._parameters(), out)
+    def law_parameters(self) -> tuple[float, ...]:
+        factor = self.circulation / (2.0 * math.pi)
+        point, axis = (float(c) for c in self.point), (float(a) for a in self.axis)
+        return (*point, *axis, factor, self.core_radius**2, self.coefficient)
 
     def add_jacobian(self, t, x, v, dfdx, dfdv, form="exact") -> None:  # type: ignore[no-untyped-def]
         """``∂F/∂x = k ∂u/∂x`` and ``∂F/∂v = −k I`` on each block."""
-        _vortex_blocks(self.targets.indices, x, *self._parameters(), dfdx)
+        _vortex_blocks(self.targets.indices, x, *self.law_parameters(), dfdx)
         for axis in range(3):
             dfdv[:, axis, axis] -= self.coefficient
 
@@ -317,28 +319,10 @@ class Vortex(_Field):
 
 
 @njit(cache=True, error_model="numpy")
-def _quadratic_drag(index, v, wx, wy, wz, c, out):  # pragma: no cover - compiled
-    for i in index:
-        fx, fy, fz = quadratic_drag_force(v[i, 0], v[i, 1], v[i, 2], wx, wy, wz, c)
-        out[i, 0] += fx
-        out[i, 1] += fy
-        out[i, 2] += fz
-
-
-@njit(cache=True, error_model="numpy")
 def _quadratic_drag_blocks(index, v, wx, wy, wz, c, dfdv):  # pragma: no cover - compiled
     for b in range(index.shape[0]):
         i = index[b]
         quadratic_drag_jacobian(v[i, 0], v[i, 1], v[i, 2], wx, wy, wz, c, dfdv[b])
-
-
-@njit(cache=True, error_model="numpy")
-def _attractor(index, x, m, cx, cy, cz, s, eps2, out):  # pragma: no cover - compiled
-    for i in index:
-        fx, fy, fz = attractor_force(x[i, 0], x[i, 1], x[i, 2], cx, cy, cz, s, eps2, m[i])
-        out[i, 0] += fx
-        out[i, 1] += fy
-        out[i, 2] += fz
 
 
 @njit(cache=True, error_model="numpy")
@@ -354,17 +338,6 @@ def _attractor_blocks(index, x, m, cx, cy, cz, s, eps2, dfdx):  # pragma: no cov
     for b in range(index.shape[0]):
         i = index[b]
         attractor_jacobian(x[i, 0], x[i, 1], x[i, 2], cx, cy, cz, s, eps2, m[i], dfdx[b])
-
-
-@njit(cache=True, error_model="numpy")
-def _vortex(index, x, v, cx, cy, cz, ax, ay, az, f, core2, k, out):  # pragma: no cover
-    for i in index:
-        ux, uy, uz = vortex_air_velocity(
-            x[i, 0], x[i, 1], x[i, 2], cx, cy, cz, ax, ay, az, f, core2
-        )
-        out[i, 0] += k * (ux - v[i, 0])
-        out[i, 1] += k * (uy - v[i, 1])
-        out[i, 2] += k * (uz - v[i, 2])
 
 
 @njit(cache=True, error_model="numpy")

@@ -49,6 +49,8 @@ class Gravitation:
     conservative: ClassVar[bool] = True
     velocity_dependent: ClassVar[bool] = False
     linear_damping: ClassVar[bool] = False
+    #: No compiled form: a scene with gravitation takes the generic road.
+    compiled: ClassVar[None] = None
 
     def __init__(
         self,

@@ -2,8 +2,12 @@
 
 Each law gives the force [N] on one particle from its own position ``x`` [m], velocity ``v``
 [m/s] and mass ``m`` [kg] (and, where it has them, its potential energy [J] and its 3×3
-Jacobians). The force classes (:mod:`visviva.forces.fields`) loop over particles calling them,
-and so does the fused particle step (:mod:`visviva.particles.fused`): one home per law.
+Jacobians). A field force declares its law and its parameter row (:class:`FieldLaw`, its
+compiled form); :func:`field_force` evaluates any law by its code, and both roads call it: the
+fields' :func:`field_forces` loop on the generic road, and the fused particle step
+(:mod:`visviva.particles.fused`), which folds the laws that are affine in the velocity and free
+of the position (:data:`FOLDED`: gravity, linear drag, damping) into one acceleration for the
+particles they all act on. One home per law.
 
 The laws, with ``d = x − c`` the offset from a field's centre ``c``:
 
@@ -31,19 +35,108 @@ References:
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
 
+if TYPE_CHECKING:
+    from .base import Targets
+
 __all__ = [
+    "ATTRACTOR",
+    "DAMPING",
+    "DRAG",
+    "FOLDED",
+    "GRAVITY",
+    "LAW_PARAMETERS",
+    "QUADRATIC_DRAG",
+    "VORTEX",
+    "FieldLaw",
     "attractor_force",
     "attractor_jacobian",
     "attractor_potential",
+    "field_force",
+    "field_forces",
     "quadratic_drag_force",
     "quadratic_drag_jacobian",
     "vortex_air_velocity",
     "vortex_jacobian",
 ]
+
+#: The codes of the laws (:func:`field_force`), with their parameter rows:
+#: ``GRAVITY``: g [m/s²] (3); ``DRAG``: air velocity w [m/s] (3), k [N·s/m];
+#: ``DAMPING``: γ [1/s]; ``QUADRATIC_DRAG``: w (3), c [kg/m]; ``ATTRACTOR``: centre [m] (3),
+#: s [m³/s²], ε² [m²]; ``VORTEX``: a point of the axis (3), the axis (3), Γ/(2π), r² [m²], k.
+GRAVITY, DRAG, DAMPING, QUADRATIC_DRAG, ATTRACTOR, VORTEX = range(6)
+#: The laws affine in the velocity and free of the position: on particle ``i`` their sum is
+#: ``m_i (g − c_i v) + k w`` with ``c_i = k / m_i + γ``, which the fused step folds.
+FOLDED = (GRAVITY, DRAG, DAMPING)
+#: The longest parameter row of a law.
+LAW_PARAMETERS = 9
+
+
+@dataclass(frozen=True)
+class FieldLaw:
+    """A field force's compiled form: its law's code, its parameter row and its targets.
+
+    Attributes:
+        law: One of the codes above.
+        parameters: The law's row (see the codes), at most :data:`LAW_PARAMETERS` numbers.
+        targets: The particles it acts on.
+    """
+
+    law: int
+    parameters: tuple[float, ...]
+    targets: Targets
+
+    def row(self) -> tuple[float, ...]:
+        """The parameters padded to :data:`LAW_PARAMETERS` numbers (one type for every law)."""
+        return (*self.parameters, *(0.0,) * (LAW_PARAMETERS - len(self.parameters)))
+
+    def folded(self) -> tuple[np.ndarray, float, np.ndarray, float] | None:
+        """A law of :data:`FOLDED` as its terms of ``m (g − c v) + k w`` with ``c = k/m + γ``:
+        ``(g [m/s²], k [N·s/m], k w [N], γ [1/s])``; ``None`` for another law."""
+        p = np.asarray(self.parameters, dtype=np.float64)
+        zero = np.zeros(3)
+        if self.law == GRAVITY:
+            return p[:3], 0.0, zero, 0.0
+        if self.law == DRAG:
+            return zero, float(p[3]), p[3] * p[:3], 0.0
+        if self.law == DAMPING:
+            return zero, 0.0, zero, float(p[0])
+        return None
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def field_force(law, p, x, y, z, vx, vy, vz, m):  # pragma: no cover - compiled
+    """The force [N] of law ``law`` with parameters ``p`` (a :data:`LAW_PARAMETERS`-tuple) on a
+    particle of mass ``m`` [kg] at ``(x, y, z)`` [m] moving at ``(vx, vy, vz)`` [m/s]."""
+    if law == GRAVITY:
+        return m * p[0], m * p[1], m * p[2]
+    if law == DRAG:
+        k = p[3]
+        return -(k * (vx - p[0])), -(k * (vy - p[1])), -(k * (vz - p[2]))
+    if law == DAMPING:
+        c = p[0] * m  # γ m
+        return -(c * vx), -(c * vy), -(c * vz)
+    if law == QUADRATIC_DRAG:
+        return quadratic_drag_force(vx, vy, vz, p[0], p[1], p[2], p[3])
+    if law == ATTRACTOR:
+        return attractor_force(x, y, z, p[0], p[1], p[2], p[3], p[4], m)
+    ux, uy, uz = vortex_air_velocity(x, y, z, p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
+    return p[8] * (ux - vx), p[8] * (uy - vy), p[8] * (uz - vz)
+
+
+@njit(cache=True, error_model="numpy")
+def field_forces(law, p, index, x, v, m, out):  # pragma: no cover - compiled
+    """Add law ``law``'s force [N] on the particles ``index`` into ``out`` ``(N, 3)``."""
+    for i in index:
+        fx, fy, fz = field_force(law, p, x[i, 0], x[i, 1], x[i, 2], v[i, 0], v[i, 1], v[i, 2], m[i])
+        out[i, 0] += fx
+        out[i, 1] += fy
+        out[i, 2] += fz
 
 
 @njit(cache=True, error_model="numpy")

@@ -26,6 +26,7 @@ force (compressed springs included) and ``f = −∇U`` without damping.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
@@ -38,7 +39,24 @@ from .lattice_springs import SpringStencil
 if TYPE_CHECKING:
     from ..ode.workspace import Workspace
 
-__all__ = ["Springs", "spring_forces", "spring_incidence"]
+__all__ = ["SpringSet", "Springs", "spring_forces", "spring_incidence"]
+
+
+@dataclass(frozen=True, eq=False)
+class SpringSet:
+    """Springs' compiled form: what the fused particle step sums them from.
+
+    Attributes:
+        pairs: ``(S, 2)`` particle indices.
+        rest_length, stiffness, damping: ``(S,)`` each [m], [N/m], [N·s/m].
+        stencil: Their stencil, if they are a lattice's (:mod:`.lattice_springs`).
+    """
+
+    pairs: np.ndarray
+    rest_length: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    stencil: SpringStencil | None
 
 
 class Springs:
@@ -111,6 +129,11 @@ class Springs:
 
     def __len__(self) -> int:
         return int(self.pairs.shape[0])
+
+    @property
+    def compiled(self) -> SpringSet:
+        """Its compiled form (the fused particle step sums the springs from it)."""
+        return SpringSet(self.pairs, self.rest_length, self.stiffness, self.damping, self.stencil)
 
     def accumulate(
         self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None

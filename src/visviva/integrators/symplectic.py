@@ -1,7 +1,9 @@
 """Symplectic methods on the split state ``(q, v)``: symplectic Euler, velocity Verlet, leapfrog.
 
-Each alternates *kicks* (``v += h·a``) and *drifts* (``q += h·v``; for a rigid body's
-orientation, a rotation by its angular momentum: ``Kinematics.drift``). For forces
+Each alternates *kicks* (``v += h·a``, :func:`kick`) and *drifts* (``q += h·v``, :func:`drift`;
+for a rigid body's orientation, a rotation by its angular momentum: ``Kinematics.drift``).
+The two are written once, here: the methods below, their compiled kernels and the fused
+particle step (:mod:`visviva.particles.fused`) all call them. For forces
 that depend on position only, every one of these maps is symplectic: it conserves a
 *modified* energy ``H̃ = H + O(h^p)`` exactly, so the true energy oscillates within
 ``O(h^p)`` of its initial value for exponentially long times instead of drifting (seed 001).
@@ -25,6 +27,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numba import njit
 
 from .base import CompiledStep, Integrator
 from .compiled import _memoized, acceleration_adapter, problem_key
@@ -34,7 +37,27 @@ if TYPE_CHECKING:
     from ..ode.state import State
     from ..ode.system import SecondOrderSystem, System
 
-__all__ = ["Leapfrog", "SymplecticEuler", "SymplecticEulerPositionFirst", "VelocityVerlet"]
+__all__ = [
+    "Leapfrog",
+    "SymplecticEuler",
+    "SymplecticEulerPositionFirst",
+    "VelocityVerlet",
+    "drift",
+    "kick",
+]
+
+
+@njit(cache=True, inline="always")
+def kick(v, a, h):  # pragma: no cover - compiled
+    """The velocity after a kick of ``h`` [s] at the acceleration ``a``: ``v + h a``
+    (numbers or arrays)."""
+    return v + h * a
+
+
+@njit(cache=True, inline="always")
+def drift(q, v, h):  # pragma: no cover - compiled
+    """The position after a drift of ``h`` [s] at the velocity ``v``: ``q + h v``."""
+    return q + h * v
 
 
 def start_acceleration(system: SecondOrderSystem, state: State):
@@ -47,7 +70,7 @@ def start_acceleration(system: SecondOrderSystem, state: State):
 def _drift(system: SecondOrderSystem, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
     """``q + h v``, or the system's kinematics' drift (rigid bodies' rotations)."""
     kinematics = system.kinematics
-    return q + h * v if kinematics is None else kinematics.drift(q, v, h)
+    return drift(q, v, h) if kinematics is None else kinematics.drift(q, v, h)
 
 
 def _derivative(system: SecondOrderSystem, q: np.ndarray, v: np.ndarray, a: np.ndarray):
@@ -92,7 +115,7 @@ class SymplecticEuler(_Split):
 
     def step(self, system: System, state: State, dt: float) -> State:
         a = start_acceleration(system, state)
-        v1 = state.v + dt * a
+        v1 = kick(state.v, a, dt)
         return state.from_parts(state.t + dt, (_drift(system, state.q, v1, dt), v1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
@@ -116,7 +139,7 @@ class SymplecticEulerPositionFirst(_Split):
         t1 = state.t + dt
         q1 = _drift(system, state.q, state.v, dt)
         a = system.acceleration(t1, q1, state.v)
-        v1 = state.v + dt * a
+        v1 = kick(state.v, a, dt)
         # For position-only forces `a` is exactly the acceleration of the new state.
         if system.velocity_dependent:
             return state.from_parts(t1, (q1, v1))
@@ -144,13 +167,13 @@ class VelocityVerlet(_Split):
     def step(self, system: System, state: State, dt: float) -> State:
         a0 = start_acceleration(system, state)
         t1 = state.t + dt
-        v_half = state.v + (0.5 * dt) * a0
+        v_half = kick(state.v, a0, 0.5 * dt)
         q1 = _drift(system, state.q, v_half, dt)
         if system.velocity_dependent:
-            a1 = system.acceleration(t1, q1, state.v + dt * a0)
-            return state.from_parts(t1, (q1, v_half + (0.5 * dt) * a1))
+            a1 = system.acceleration(t1, q1, kick(state.v, a0, dt))
+            return state.from_parts(t1, (q1, kick(v_half, a1, 0.5 * dt)))
         a1 = system.acceleration(t1, q1, v_half)
-        v1 = v_half + (0.5 * dt) * a1
+        v1 = kick(v_half, a1, 0.5 * dt)
         return state.from_parts(t1, (q1, v1), _derivative(system, q1, v1, a1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
@@ -177,9 +200,9 @@ class Leapfrog(_Split):
         v_mid = state.v
         if system.velocity_dependent:
             a0 = start_acceleration(system, state)
-            v_mid = state.v + (0.5 * dt) * a0
+            v_mid = kick(state.v, a0, 0.5 * dt)
         a = system.acceleration(t_half, q_half, v_mid)
-        v1 = state.v + dt * a
+        v1 = kick(state.v, a, dt)
         return state.from_parts(state.t + dt, (_drift(system, q_half, v1, 0.5 * dt), v1))
 
     def compiled_step(self, problem: Problem) -> CompiledStep | None:
@@ -198,8 +221,8 @@ def _symplectic_euler_kernel(accel: Callable[..., None], n: int, vd: bool) -> Co
         q, v, a = y[:n], y[n:], work[0, :n]
         accel(t, q, v, a)
         for k in range(n):
-            v[k] += h * a[k]
-            q[k] += h * v[k]
+            v[k] = kick(v[k], a[k], h)
+            q[k] = drift(q[k], v[k], h)
         return 1
 
     return CompiledStep(step, 1)
@@ -214,10 +237,10 @@ def _symplectic_euler_position_first_kernel(
     def step(t, h, y, work, fresh):  # pragma: no cover - compiled
         q, v, a = y[:n], y[n:], work[0, :n]
         for k in range(n):
-            q[k] += h * v[k]
+            q[k] = drift(q[k], v[k], h)
         accel(t + h, q, v, a)
         for k in range(n):
-            v[k] += h * a[k]
+            v[k] = kick(v[k], a[k], h)
         return 1
 
     return CompiledStep(step, 1)
@@ -234,15 +257,15 @@ def _velocity_verlet_kernel(accel: Callable[..., None], n: int, vd: bool) -> Com
             accel(t, q, v, a)
             evaluations = 2
         for k in range(n):
-            predicted[k] = v[k] + h * a[k]
-            v[k] += 0.5 * h * a[k]
-            q[k] += h * v[k]
+            predicted[k] = kick(v[k], a[k], h)
+            v[k] = kick(v[k], a[k], 0.5 * h)
+            q[k] = drift(q[k], v[k], h)
         if vd:
             accel(t + h, q, predicted, a)
         else:
             accel(t + h, q, v, a)
         for k in range(n):
-            v[k] += 0.5 * h * a[k]
+            v[k] = kick(v[k], a[k], 0.5 * h)
         return evaluations
 
     return CompiledStep(step, 2)
@@ -259,16 +282,16 @@ def _leapfrog_kernel(accel: Callable[..., None], n: int, vd: bool) -> CompiledSt
             accel(t, q, v, a)
             evaluations = 2
             for k in range(n):
-                mid[k] = v[k] + 0.5 * h * a[k]
+                mid[k] = kick(v[k], a[k], 0.5 * h)
         else:
             for k in range(n):
                 mid[k] = v[k]
         for k in range(n):
-            q[k] += 0.5 * h * v[k]
+            q[k] = drift(q[k], v[k], 0.5 * h)
         accel(t + 0.5 * h, q, mid, a)
         for k in range(n):
-            v[k] += h * a[k]
-            q[k] += 0.5 * h * v[k]
+            v[k] = kick(v[k], a[k], h)
+            q[k] = drift(q[k], v[k], 0.5 * h)
         return evaluations
 
     return CompiledStep(step, 2)

@@ -15,15 +15,18 @@ it). Then, in two passes:
 1. a pass over every particle that the compiler vectorizes (AVX-512: eight particles at a
    time), since every particle takes the same path, with no loop, no call and no conditional
    store: the acceleration from the fields folded into ``g − c_i v + b_i`` (uniform gravity,
-   linear drag, wind and damping), symplectic Euler ``v += h a``, ``x += h v``
-   (:class:`~visviva.integrators.SymplecticEuler`), the first collider's contact if it is a
+   linear drag, wind and damping: each force's compiled form, :class:`~visviva.forces.laws.
+   FieldLaw`, says whether and how it folds), symplectic Euler's kick and drift (the
+   functions :class:`~visviva.integrators.SymplecticEuler` steps with), the first collider's
+   contact if it is a
    plane (the floor, most often), ageing, the divergence watch's check, and a cheap test of
    whether the particle needs more: it is near another plane, may meet another collider or
    hit a plane within the step (time of impact), a field acts on it by its law (attractors,
    vortices, quadratic drag, forces on some particles only), it dies, its size follows a
    ramp. Such a particle keeps its start values (and a pinned one keeps them for good);
 2. a pass over those few, each by the general path from its start values: the fields by their
-   law (:mod:`visviva.forces.laws`), the collision stage's own per-particle function
+   law (:func:`visviva.forces.laws.field_force`, which the fields' generic road calls too), the
+   collision stage's own per-particle function
    (:func:`visviva.collision.response.resolve`), the emission stage's ageing and death
    (:func:`visviva.particles.emission.age_one`). A kernel of its own, called by pass 1's
    when some particle needs it: pass 1 is compiled once for each scene shape, this pass once
@@ -55,9 +58,9 @@ from numba import njit, prange
 from ..collision.colliders import UNROLLED_PLANES, ColliderSet
 from ..collision.queries import plane_distance
 from ..collision.response import ParticleCollisions, _contact, _tolerance, resolve
-from ..forces.fields import Attractor, Damping, Drag, QuadraticDrag, UniformGravity, Vortex
-from ..forces.laws import attractor_force, quadratic_drag_force, vortex_air_velocity
-from ..forces.springs import Springs, spring_forces, spring_incidence
+from ..forces.laws import LAW_PARAMETERS, FieldLaw, field_force
+from ..forces.springs import SpringSet, spring_forces, spring_incidence
+from ..integrators.symplectic import drift, kick
 from .emission import Emission, age_one
 from .handles import Handles
 
@@ -67,8 +70,6 @@ if TYPE_CHECKING:
 
 __all__ = ["FusedParticles"]
 
-#: Codes of the fields the kernel evaluates by their law.
-_QUADRATIC, _ATTRACTOR, _VORTEX, _DRAG, _DAMPING = 0, 1, 2, 3, 4
 #: Most fields evaluated by their law (each particle keeps which apply as bits of a mask).
 MAX_LAW_FIELDS = 64
 
@@ -85,35 +86,32 @@ class FusedParticles:
         pinned: np.ndarray | None = None,
     ) -> None:
         self.count = count
+        self.mass = np.array(mass, dtype=np.float64)
         self.inverse_mass = 1.0 / mass
         self.gravity = np.zeros(3)
         self.drag = 0.0  # Σ k of linear drags on every particle [N·s/m]
         self.air = np.zeros(3)  # Σ k w [N]
         self.damping = 0.0  # Σ γ of damping on every particle [1/s]
+        forms = [force.compiled for force in forces]
+        springs = [form for form in forms if isinstance(form, SpringSet)]
         laws = []
-        springs = [f for f in forces if isinstance(f, Springs)]
-        for force in forces:
-            if isinstance(force, Springs):
+        for form in forms:
+            if not isinstance(form, FieldLaw):
                 continue
-            if not isinstance(force, _FIELDS):  # pragma: no cover - `of` admits no other
-                raise TypeError(f"the fused step has no {type(force).__name__}")
-            every = force.targets.everything
-            if isinstance(force, UniformGravity) and every:
-                self.gravity += force.gravity
-            elif isinstance(force, Drag) and every:
-                self.drag += force.coefficient
-                self.air += force.coefficient * force.air_velocity
-            elif isinstance(force, Damping) and every:
-                self.damping += force.rate
-            else:
-                laws.append(force)
-        self.kinds = np.zeros(len(laws), dtype=np.int64)
-        self.parameters = np.zeros((len(laws), 12))
+            folded = form.folded() if form.targets.everything else None
+            if folded is None:
+                laws.append(form)
+                continue
+            g, k, air, gamma = folded
+            self.gravity += g
+            self.drag += k
+            self.air += air
+            self.damping += gamma
+        self.kinds = np.array([form.law for form in laws], dtype=np.int64)
+        self.parameters = np.array([form.row() for form in laws]).reshape(-1, LAW_PARAMETERS)
         self.law_masks = np.zeros(count, dtype=np.uint64)
-        for k, force in enumerate(laws):
-            self.kinds[k], row = _law(force)
-            self.parameters[k, : len(row)] = row
-            self.law_masks[force.targets.indices] |= np.uint64(1) << np.uint64(k)
+        for k, form in enumerate(laws):
+            self.law_masks[form.targets.indices] |= np.uint64(1) << np.uint64(k)
         self.collisions = next((s for s in stages if isinstance(s, ParticleCollisions)), None)
         self.emission = next((s for s in stages if isinstance(s, Emission)), None)
         self.handles = next((s for s in stages if isinstance(s, Handles)), None)
@@ -147,14 +145,15 @@ class FusedParticles:
     @classmethod
     def of(cls, model: Any, method: str) -> FusedParticles | None:
         """The fused step of ``model`` for ``method``, or ``None`` if it has none: the method
-        must be symplectic Euler, the scene made only of particles, every force a field or
-        springs (gravitation and penalty contact are not), every stage handles, collisions or
-        emission."""
+        must be symplectic Euler, the scene made only of particles, every force one with a
+        compiled form (fields and springs; not gravitation, penalty contact or a plugin's
+        force), every stage handles, collisions or emission."""
         if method != "symplectic_euler" or model.systems or model.bodies is not None:
             return None
         if not model.particle_count:
             return None
-        if not all(isinstance(f, (*_FIELDS, Springs)) for f in model.forces):
+        forms = [force.compiled for force in model.forces]
+        if any(form is None for form in forms):
             return None
         # A stage that declares no compiled form keeps the generic pipeline; of those that
         # do, the fused step knows how to take the handles', the collisions' and the
@@ -165,9 +164,9 @@ class FusedParticles:
         ):
             return None
         laws = [
-            f
-            for f in model.forces
-            if not ((isinstance(f, _FOLDED) and f.targets.everything) or isinstance(f, Springs))
+            form
+            for form in forms
+            if isinstance(form, FieldLaw) and not (form.targets.everything and form.folded())
         ]
         if len(laws) > MAX_LAW_FIELDS:
             return None
@@ -257,6 +256,7 @@ class FusedParticles:
             self.kinds,
             self.parameters,
             self.law_masks,
+            self.mass,
             *ages,
             *self._colliders,
             self._spring_force,
@@ -322,12 +322,8 @@ def _deinterleave(flat, columns):  # pragma: no cover - compiled
         columns[2, i] = flat[3 * i + 2]
 
 
-_FOLDED = (UniformGravity, Drag, Damping)
-_FIELDS = (*_FOLDED, QuadraticDrag, Attractor, Vortex)
-
-
 def _spring_arguments(
-    springs: list[Springs], count: int
+    springs: list[SpringSet], count: int
 ) -> tuple[tuple[np.ndarray, ...] | None, tuple[np.ndarray, ...]]:
     """The scene's springs as one set for the kernels: ``(first, second, rest, k, c)``
     (``None`` without springs) and each particle's CSR lists of the springs it is the first
@@ -342,21 +338,6 @@ def _spring_arguments(
     )
     lists = (*spring_incidence(pairs[:, 0], count), *spring_incidence(pairs[:, 1], count))
     return (*ends, *values), lists
-
-
-def _law(force: Force) -> tuple[int, list[float]]:
-    """A field's code and parameters for the kernel's law loop."""
-    if isinstance(force, QuadraticDrag):
-        return _QUADRATIC, [*force.air_velocity, force.coefficient]
-    if isinstance(force, Attractor):
-        return _ATTRACTOR, [*force.point, force.strength, force.softening**2]
-    if isinstance(force, Vortex):
-        return _VORTEX, list(force._parameters())
-    if isinstance(force, Drag):
-        return _DRAG, [*force.air_velocity, force.coefficient]
-    if isinstance(force, Damping):
-        return _DAMPING, [force.rate]
-    raise TypeError(f"{type(force).__name__} has no fused law")  # pragma: no cover
 
 
 #: The ageing arrays (age, lifetime, size, slot emitter, size ramps) without emitters.
@@ -412,9 +393,9 @@ def _collision_arguments(
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _law_acceleration(k, kinds, table, x, y, z, vx, vy, vz, inverse_mass):  # pragma: no cover
-    """The acceleration [m/s²] of one particle from field ``k`` (by its law)."""
-    kind = kinds[k]
+def _law_acceleration(k, kinds, table, x, y, z, vx, vy, vz, m, w):  # pragma: no cover
+    """The acceleration [m/s²] of one particle (mass ``m``, its inverse ``w``) from field
+    ``k``, by its law (:func:`~visviva.forces.laws.field_force`)."""
     p = (
         table[k, 0],
         table[k, 1],
@@ -426,18 +407,8 @@ def _law_acceleration(k, kinds, table, x, y, z, vx, vy, vz, inverse_mass):  # pr
         table[k, 7],
         table[k, 8],
     )  # entries, not a row view (an atomic reference count per particle)
-    if kind == _QUADRATIC:
-        fx, fy, fz = quadratic_drag_force(vx, vy, vz, p[0], p[1], p[2], p[3])
-    elif kind == _ATTRACTOR:
-        fx, fy, fz = attractor_force(x, y, z, p[0], p[1], p[2], p[3], p[4], 1.0 / inverse_mass)
-    elif kind == _VORTEX:
-        ux, uy, uz = vortex_air_velocity(x, y, z, p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7])
-        fx, fy, fz = p[8] * (ux - vx), p[8] * (uy - vy), p[8] * (uz - vz)
-    elif kind == _DRAG:
-        fx, fy, fz = -p[3] * (vx - p[0]), -p[3] * (vy - p[1]), -p[3] * (vz - p[2])
-    else:  # damping: −γ m v
-        return -p[0] * vx, -p[0] * vy, -p[0] * vz
-    return fx * inverse_mass, fy * inverse_mass, fz * inverse_mass
+    fx, fy, fz = field_force(kinds[k], p, x, y, z, vx, vy, vz, m)
+    return fx * w, fy * w, fz * w
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -515,19 +486,20 @@ def _fused(
         sx, sy, sz, svx, svy, svz = x[i], y[i], z[i], vx[i], vy[i], vz[i]
         w = inverse_mass[i]
         c = drag * w + damping
-        ux = svx + h * (gx - c * svx + wx * w)
-        uy = svy + h * (gy - c * svy + wy * w)
-        uz = svz + h * (gz - c * svz + wz * w)
+        ax = gx - c * svx + wx * w
+        ay = gy - c * svy + wy * w
+        az = gz - c * svz + wz * w
         if spring_force is not None:
             fx, fy, fz = _spring_sum(spring_force, lists, i)
-            ux += h * w * fx
-            uy += h * w * fy
-            uz += h * w * fz
+            ax += w * fx
+            ay += w * fy
+            az += w * fz
         if point_force is not None:
-            ux += h * w * point_force[0, i]
-            uy += h * w * point_force[1, i]
-            uz += h * w * point_force[2, i]
-        px, py, pz = sx + h * ux, sy + h * uy, sz + h * uz
+            ax += w * point_force[0, i]
+            ay += w * point_force[1, i]
+            az += w * point_force[2, i]
+        ux, uy, uz = kick(svx, ax, h), kick(svy, ay, h), kick(svz, az, h)
+        px, py, pz = drift(sx, ux, h), drift(sy, uy, h), drift(sz, uz, h)
         r = radius[i]
         mask = common_mask if collider_masks is None else collider_masks[i]
         # A particle that may hit a plane within the step needs its time of impact: special
@@ -606,7 +578,7 @@ def _general_pass(
     compares the ages with the generic pipeline's).
     """
     (
-        kinds, parameters, law_masks, lifetime, size, slot_emitter, size_ramps, masks,
+        kinds, parameters, law_masks, mass, lifetime, size, slot_emitter, size_ramps, masks,
         restitution, friction, resting, toi, planes, rows, everything, spring_force, lists,
         point_force,
     ) = general  # fmt: skip
@@ -638,12 +610,14 @@ def _general_pass(
         bits = law_masks[i]
         for k in range(kinds.shape[0]):
             if (bits >> np.uint64(k)) & one:
-                bx, by, bz = _law_acceleration(k, kinds, parameters, sx, sy, sz, svx, svy, svz, w)
+                bx, by, bz = _law_acceleration(
+                    k, kinds, parameters, sx, sy, sz, svx, svy, svz, mass[i], w
+                )
                 ax += bx
                 ay += by
                 az += bz
-        ux, uy, uz = svx + h * ax, svy + h * ay, svz + h * az
-        px, py, pz = sx + h * ux, sy + h * uy, sz + h * uz
+        ux, uy, uz = kick(svx, ax, h), kick(svy, ay, h), kick(svz, az, h)
+        px, py, pz = drift(sx, ux, h), drift(sy, uy, h), drift(sz, uz, h)
         r = radius[i]
         if colliding:
             px, py, pz, ux, uy, uz = resolve(

@@ -35,8 +35,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numba import njit, prange
 
-from ..forces.body_forces import BodyDamping, BodyGravity
 from ..geometry.quaternion_kernels import multiply, normalized, rotate_back
+from ..integrators.symplectic import drift, kick
 from .motion import SMALL_LIMIT, _free_turns, _small_half_angle, drift_body
 from .projection import BodyProjection
 
@@ -56,17 +56,17 @@ class FusedBodies:
         self.inverse_mass = motion.inverse_mass
         self.inverse_inertia = motion.inverse_inertia  # (B, 3), for the general path
         self.axes = motion.axes  # (B, 4)
-        self.mass = np.zeros(self.count)  # the masses gravity pulls (see BodyGravity)
+        self.mass = np.zeros(self.count)  # the masses gravity pulls (see BodyLaw)
         self.gravity = np.zeros(3)
         self.linear = np.zeros(self.count)
         self.angular = np.zeros(self.count)
         for force in model.body_forces:
-            if isinstance(force, BodyGravity):
-                self.gravity += force.gravity
-                self.mass = force.mass
-            else:
-                self.linear += force.linear[:, 0]
-                self.angular += force.angular[:, 0]
+            form = force.compiled
+            if form.gravity.any():
+                self.gravity += form.gravity
+                self.mass = form.mass
+            self.linear += form.linear
+            self.angular += form.angular
         # The working copy, one row per component: x, y, z, qw, qx, qy, qz, then P and L.
         self._work = np.empty((13, self.count))
         self._columns = (
@@ -80,12 +80,14 @@ class FusedBodies:
     @classmethod
     def of(cls, model: Any, method: str) -> FusedBodies | None:
         """The fused step of ``model`` for ``method``, or ``None``: the method must be
-        symplectic Euler, the scene made of rigid bodies only, under gravity and damping."""
+        symplectic Euler, the scene made of rigid bodies only, under forces with a compiled
+        form (gravity and damping: :class:`~visviva.forces.body_forces.BodyLaw`), its only stage
+        the projection onto unit quaternions (which the step's exact rotations make moot)."""
         if method != "symplectic_euler" or model.bodies is None:
             return None
         if model.particle_count or model.systems:
             return None
-        if not all(isinstance(f, (BodyGravity, BodyDamping)) for f in model.body_forces):
+        if any(f.compiled is None for f in model.body_forces):
             return None
         if not all(isinstance(s, BodyProjection) for s in model.stages):
             return None
@@ -164,11 +166,16 @@ def _steps(
     suspects = 0
     odd = 0
     for b in range(first, last):
-        keep, spin, weight = 1.0 - h * linear[b], 1.0 - h * angular[b], h * mass[b]
-        ux = keep * mx[b] + weight * gx
-        uy = keep * my[b] + weight * gy
-        uz = keep * mz[b] + weight * gz
-        kx, ky, kz = spin * lx[b], spin * ly[b], spin * lz[b]
+        # The kick by F = M g − γ P and τ = −γ' L, the forces' compiled forms (BodyLaw).
+        m, gamma, spin = mass[b], linear[b], angular[b]
+        ux = kick(mx[b], m * gx - gamma * mx[b], h)
+        uy = kick(my[b], m * gy - gamma * my[b], h)
+        uz = kick(mz[b], m * gz - gamma * mz[b], h)
+        kx, ky, kz = (
+            kick(lx[b], -spin * lx[b], h),
+            kick(ly[b], -spin * ly[b], h),
+            kick(lz[b], -spin * lz[b], h),
+        )
         r0, r1, r2, r3 = axes[0, b], axes[1, b], axes[2, b], axes[3, b]
         w, x, y, z = normalized(qw[b], qx[b], qy[b], qz[b])
         w, x, y, z = multiply(w, x, y, z, r0, r1, r2, r3)
@@ -181,7 +188,7 @@ def _steps(
         w, x, y, z = multiply(w, x, y, z, r0, -r1, -r2, -r3)
         w, x, y, z = normalized(w, x, y, z)
         im = inverse_mass[b]
-        nx, ny, nz = cx[b] + h * ux * im, cy[b] + h * uy * im, cz[b] + h * uz * im
+        nx, ny, nz = drift(cx[b], ux * im, h), drift(cy[b], uy * im, h), drift(cz[b], uz * im, h)
         # A body that turned too far for the series keeps its start (by selection: a
         # conditional store would keep the loop scalar).
         cx[b] = nx if fits else cx[b]
@@ -252,9 +259,8 @@ def _step_special(
     q, v = np.empty(7), np.empty(6)
     for b in which:
         for a in range(3):
-            force = mass[b] * g[a] - linear[b] * work[7 + a, b]
-            v[a] = work[7 + a, b] + h * force
-            v[3 + a] = (1.0 - h * angular[b]) * work[10 + a, b]
+            v[a] = kick(work[7 + a, b], mass[b] * g[a] - linear[b] * work[7 + a, b], h)
+            v[3 + a] = kick(work[10 + a, b], -angular[b] * work[10 + a, b], h)
             q[a] = work[a, b]
         for a in range(4):
             q[3 + a] = work[3 + a, b]

@@ -44,6 +44,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..geometry.quaternion_kernels import multiply, normalized, rotate, rotate_back
+from ..integrators.symplectic import drift
 
 __all__ = ["BodyMotion"]
 
@@ -89,7 +90,7 @@ class BodyMotion:
         the bodies, the bodies' translation and free rotation (see the module docstring)."""
         out = np.empty_like(q)
         n = self.offset
-        out[:n] = q[:n] + h * v[:n]
+        out[:n] = drift(q[:n], v[:n], h)
         _drift(q[n:], v[n:], h, self.inverse_mass, self.inverse_inertia, self.axes, out[n:])
         return out
 
@@ -235,7 +236,7 @@ def drift_body(q, v, h, inverse_mass, inverse_inertia, axes, out, b, count):  # 
     """Body ``b``'s drift into ``out`` (see the module docstring; ``out`` may be ``q``)."""
     m, k = 3 * count + 3 * b, 3 * count + 4 * b
     for a in range(3):
-        out[3 * b + a] = q[3 * b + a] + h * v[3 * b + a] * inverse_mass[b]
+        out[3 * b + a] = drift(q[3 * b + a], v[3 * b + a] * inverse_mass[b], h)
     w, x, y, z = _principal(q, b, count, axes)
     px, py, pz = rotate_back(w, x, y, z, v[m], v[m + 1], v[m + 2])
     i1, i2, i3 = inverse_inertia[b, 0], inverse_inertia[b, 1], inverse_inertia[b, 2]

@@ -58,6 +58,8 @@ class MagneticField:
     velocity_dependent: ClassVar[bool] = True
     #: Its ``∂F/∂v = −q [B]×`` is skew-symmetric, not a damper's symmetric matrix.
     linear_damping: ClassVar[bool] = False
+    #: No compiled form: the fused particle step leaves a scene with it to the generic road.
+    compiled: ClassVar[None] = None
 
     def __init__(self, field: np.ndarray, charge: float, targets: Targets) -> None:
         self.field = np.asarray(field, dtype=np.float64)
