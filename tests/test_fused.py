@@ -78,7 +78,9 @@ def test_each_field_law_steps_alike_on_both_roads(kind, targets):
     take the same kicks and drifts, so after 200 steps they agree to round-off."""
     builder = vv.SceneBuilder(name=kind)
     builder.set_integration(method="symplectic_euler", dt=1 / 200, duration=1.0)
-    builder.add_particle_cloud(40, center=(0.0, 1.0, 0.0), velocity_jitter=2.0, seed=1, name="light")
+    builder.add_particle_cloud(
+        40, center=(0.0, 1.0, 0.0), velocity_jitter=2.0, seed=1, name="light"
+    )
     builder.add_particle_cloud(
         40, center=(0.5, 1.2, 0.0), velocity_jitter=2.0, mass=3.0, seed=2, name="heavy"
     )

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..geometry.quaternions import quaternion_matrix, quaternion_multiply
 from .fields import vector
+from .laws import GRAVITY, field_forces, law_row
 
 __all__ = [
     "BodyAnchor",
@@ -93,7 +94,7 @@ def wrench_at(
 
 class BodyGravity:
     """Uniform gravity on the bodies: ``F = M g`` through the centre of mass, no torque;
-    ``U = −Σ M g·x``.
+    ``U = −Σ M g·x``. The law is the particles' (:data:`~.laws.GRAVITY`).
 
     Args:
         gravity: ``g`` [m/s²], ``(3,)``.
@@ -106,7 +107,9 @@ class BodyGravity:
     def __init__(self, gravity: Sequence[float], mass: np.ndarray) -> None:
         self.gravity = vector("gravity", gravity, unit="m/s²")
         self.mass = np.asarray(mass, dtype=np.float64)
-        self._weight = self.mass[:, None] * self.gravity[None, :]
+        self._weight = self.mass[:, None] * self.gravity[None, :]  # the potential's
+        self._row = law_row(tuple(self.gravity))
+        self._bodies = np.arange(self.mass.shape[0])
 
     @property
     def compiled(self) -> BodyLaw:
@@ -116,7 +119,7 @@ class BodyGravity:
 
     def accumulate_wrench(self, t, x, q, momentum, angular_momentum, force, torque) -> None:  # type: ignore[no-untyped-def]
         """Add ``M g`` [N] to ``force`` (no torque)."""
-        force += self._weight
+        field_forces(GRAVITY, self._row, self._bodies, x, momentum, self.mass, force)
 
     def potential(self, t: float, x: np.ndarray, q: np.ndarray) -> float:
         """``U = −Σ M g·x`` [J]."""

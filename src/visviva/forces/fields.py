@@ -28,6 +28,7 @@ from .laws import (
     attractor_jacobian,
     attractor_potential,
     field_forces,
+    law_row,
     quadratic_drag_jacobian,
     vortex_jacobian,
 )
@@ -80,7 +81,8 @@ class _Field:
         self, t: float, x: np.ndarray, v: np.ndarray, out: np.ndarray, work: Workspace | None = None
     ) -> None:
         """Add the field's force [N] on every target to ``out`` ``(N, 3)``."""
-        field_forces(self.law, self.compiled.row(), self.targets.indices, x, v, self.mass, out)
+        row = law_row(self.law_parameters())
+        field_forces(self.law, row, self.targets.indices, x, v, self.mass, out)
 
     @property
     def linear_damping(self) -> bool:
@@ -118,7 +120,7 @@ class UniformGravity(_Field):
         self._weight = self.mass[self.targets.indices, None] * self.gravity[None, :]
 
     def law_parameters(self) -> tuple[float, ...]:
-        return tuple(float(g) for g in self.gravity)
+        return tuple(self.gravity)
 
     def potential(self, t: float, x: np.ndarray, alive: np.ndarray | None = None) -> float:
         """``U = −Σ_i m_i g·x_i`` [J] over the targets (alive ones, if given)."""

@@ -59,6 +59,7 @@ __all__ = [
     "attractor_potential",
     "field_force",
     "field_forces",
+    "law_row",
     "quadratic_drag_force",
     "quadratic_drag_jacobian",
     "vortex_air_velocity",
@@ -93,7 +94,7 @@ class FieldLaw:
 
     def row(self) -> tuple[float, ...]:
         """The parameters padded to :data:`LAW_PARAMETERS` numbers (one type for every law)."""
-        return (*self.parameters, *(0.0,) * (LAW_PARAMETERS - len(self.parameters)))
+        return law_row(self.parameters)
 
     def folded(self) -> tuple[np.ndarray, float, np.ndarray, float] | None:
         """A law of :data:`FOLDED` as its terms of ``m (g − c v) + k w`` with ``c = k/m + γ``:
@@ -107,6 +108,11 @@ class FieldLaw:
         if self.law == DAMPING:
             return zero, 0.0, zero, float(p[0])
         return None
+
+
+def law_row(parameters: tuple[float, ...]) -> tuple[float, ...]:
+    """A law's parameters padded to :data:`LAW_PARAMETERS` numbers (one type for every law)."""
+    return (*(float(p) for p in parameters), *(0.0,) * (LAW_PARAMETERS - len(parameters)))
 
 
 @njit(cache=True, error_model="numpy", inline="always")
