@@ -14,7 +14,7 @@ import pytest
 import trimesh
 
 import visviva as vv
-from visviva.deformables.mesh_files import MAX_MESH_BYTES, read_triangle_mesh
+from visviva.io.meshes import MAX_MESH_BYTES, read_triangle_mesh
 
 EXAMPLES = Path(__file__).parents[1] / "examples"
 TABLECLOTH = EXAMPLES / "meshes" / "tablecloth.obj"

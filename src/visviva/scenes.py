@@ -292,9 +292,10 @@ class RunFigures:
     def recorder(self, model: Model, writer: Any) -> Callable[[State, Any], None]:
         """``record(state, energy)``: what a recording keeps of ``state`` (the model's frame
         and the energy) appended to ``writer`` (``writer.append(t, fields)``), and seen here."""
+        from .simulation.frames import frame_fields
 
         def record(state: State, energy: Any) -> None:
-            fields = model.frame(state)
+            fields = frame_fields(model, state)
             if energy is not None:
                 fields["energy"] = np.asarray(energy, dtype=np.float64)
             writer.append(state.t, fields)
@@ -336,6 +337,8 @@ def final_values(fields: Mapping[str, np.ndarray]) -> dict[str, float]:
 
 def recording_attrs(model: Model, seconds: float) -> dict[str, Any]:
     """The attributes a scene run's recording starts with."""
+    from .simulation import frames
+
     settings = model.integration
     return {
         "scene": model.source or dump_scene(model.scene),
@@ -351,7 +354,7 @@ def recording_attrs(model: Model, seconds: float) -> dict[str, Any]:
         "playback_trail": model.output_trail,
         "playback_color_by": model.output_color_by,
         "compiled": False,
-    } | model.recording_attrs()
+    } | frames.recording_attrs(model)
 
 
 def final_attrs(
@@ -385,13 +388,14 @@ def _simulate_streaming(
     """
     from .io.writer import RecordingWriter
     from .simulation import Simulation
+    from .simulation.frames import UNITS, static_fields
     from .simulation.interrupt import Interrupted
 
     run = RunFigures()
     failure: SimulationError | Interrupted | None = None
     simulation = Simulation(model)
     with RecordingWriter(
-        path, units=model.units(), attrs=recording_attrs(model, seconds), static=model.static()
+        path, units=UNITS, attrs=recording_attrs(model, seconds), static=static_fields(model)
     ) as writer:
         record = run.recorder(model, writer)
         started = time.perf_counter()

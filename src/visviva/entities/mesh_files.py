@@ -6,7 +6,7 @@ The ``prepare`` hook of the kinds that take a ``path`` (``cloth_mesh``, ``body``
 everything after it — the checks across entities, the particles, the springs, the recordings'
 surfaces — sees an ordinary mesh entity, and the built model's scene is whole without the
 file. A refusal names the entity's ``path`` and the file
-(:mod:`visviva.deformables.mesh_files`): an unreadable file, one that is not one triangle mesh,
+(:mod:`visviva.io.meshes`): an unreadable file, one that is not one triangle mesh,
 a mesh the kind refuses (``check``: a degenerate triangle in a cloth), or ``pinned`` indices
 past its vertices.
 """
@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 
 from ..deformables import DeformableError
-from ..deformables.mesh_files import MeshFileError, read_triangle_mesh
 from ..errors import SceneError, SceneProblem
+from ..io.meshes import MeshFileError, read_triangle_mesh
 
 __all__ = ["with_mesh_file"]
 

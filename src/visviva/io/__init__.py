@@ -1,4 +1,4 @@
-"""Files in and out: recordings (HDF5), scene files, exports."""
+"""Files in and out: recordings (HDF5), scene files, meshes, exports."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 from .._lazy import lazy_names
 
 if TYPE_CHECKING:
+    from .meshes import MeshFileError, read_triangle_mesh
     from .recording import (
         FORMAT,
         FORMAT_VERSION,
@@ -20,11 +21,13 @@ if TYPE_CHECKING:
 __all__ = [
     "FORMAT",
     "FORMAT_VERSION",
+    "MeshFileError",
     "dump_scene",
     "load_recording",
     "load_scene",
     "parse_scene",
     "read_recordings",
+    "read_triangle_mesh",
     "save_recording",
     "write_recordings",
 ]
@@ -44,5 +47,7 @@ __getattr__, __dir__ = lazy_names(
         "dump_scene": "scene_files",
         "load_scene": "scene_files",
         "parse_scene": "scene_files",
+        "MeshFileError": "meshes",
+        "read_triangle_mesh": "meshes",
     },
 )

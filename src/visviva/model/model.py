@@ -4,10 +4,9 @@ Built once from a validated scene (file or :class:`~visviva.model.SceneBuilder`)
 the entities as structure-of-arrays data with entity-prefixed names (``particle_position``,
 ``particle_mass``, ...), the named systems with their generalized coordinates, the forces on
 particles (world gravity included), the post-step stages (collisions, emission) and the
-settings. Its arrays are read-only. :meth:`Model.system` is the view an integrator steps,
-:meth:`Model.initial_state` the state a run starts from, and :meth:`Model.frame` turns a state
-into what a recording keeps (its parts under the state's names, ``particle_position`` [m] and
-the systems' ``system_points`` [m] drawn by the video, the viewer and the exporters).
+settings. Its arrays are read-only. :meth:`Model.system` is the view an integrator steps and
+:meth:`Model.initial_state` the state a run starts from; what a recording keeps of a state is
+:mod:`visviva.simulation.frames`'.
 """
 
 from __future__ import annotations
@@ -229,40 +228,3 @@ class Model:
                 '"particle_collisions" (SceneBuilder.add_particle_collisions)'
             )
         return stage.pair_contacts(state, gap)
-
-    def frame(self, state: State) -> dict[str, np.ndarray]:
-        """What a recording keeps of ``state`` (one frame; see :mod:`.frames`)."""
-        from .frames import frame_fields
-
-        return frame_fields(self, state)
-
-    def static(self) -> dict[str, np.ndarray]:
-        """Arrays recorded once (see :mod:`.frames`)."""
-        from .frames import static_fields
-
-        return static_fields(self)
-
-    def recording_attrs(self) -> dict[str, Any]:
-        """Attributes a recording keeps of the scene besides its arrays (see :mod:`.frames`)."""
-        from .frames import recording_attrs
-
-        return recording_attrs(self)
-
-    def units(self) -> dict[str, str]:
-        """Units of the recorded fields and static arrays."""
-        return {
-            "particle_position": "m",
-            "particle_velocity": "m/s",
-            "particle_radius": "m",
-            "particle_mass": "kg",
-            "system_points": "m",
-            "system_velocity": "m/s",
-            "system_radius": "m",
-            "body_origin": "m",
-            "body_vertices": "m",
-            "body_center": "m",
-            "scenery_vertices": "m",
-            "energy": "J",
-            "generalized_position": "",
-            "generalized_velocity": "",
-        }

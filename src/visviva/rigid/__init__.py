@@ -7,8 +7,8 @@ coordinates, inertia [kg·m²] about the centre of mass in the shape's axes, and
 * closed forms: :func:`box_mass_properties`, :func:`sphere_mass_properties`,
   :func:`cylinder_mass_properties`, :func:`capsule_mass_properties`,
   :func:`cone_mass_properties`, :func:`ellipsoid_mass_properties`;
-* closed triangle meshes (Mirtich's algorithm): :func:`mesh_mass_properties`, and from a file
-  :func:`mesh_file_mass_properties`;
+* closed triangle meshes (Mirtich's algorithm): :func:`mesh_mass_properties` (a mesh file's
+  arrays are :func:`visviva.io.read_triangle_mesh`'s);
 * a Monte-Carlo estimate with its error bars: :func:`sampled_mass_properties`.
 
 >>> import visviva as vv
@@ -18,7 +18,7 @@ coordinates, inertia [kg·m²] about the centre of mass in the shape's axes, and
 """
 
 from .mass_properties import MassProperties, check_inertia
-from .mesh_integrals import mesh_file_mass_properties, mesh_mass_properties
+from .mesh_integrals import mesh_mass_properties
 from .primitives import (
     box_mass_properties,
     capsule_mass_properties,
@@ -41,7 +41,6 @@ __all__ = [
     "cylinder_mass_properties",
     "ellipsoid_mass_properties",
     "mass_properties",
-    "mesh_file_mass_properties",
     "mesh_mass_properties",
     "sampled_mass_properties",
     "sphere_mass_properties",

@@ -33,20 +33,18 @@ intersect itself (:func:`visviva.geometry.self_intersection.check_self_intersect
 
 from __future__ import annotations
 
-import os
 from typing import Any
 
 import numpy as np
 from numba import njit, prange
 
-from ..deformables.mesh_files import read_triangle_mesh
 from ..errors import ModelError
 from ..geometry.mesh_topology import check_closed_mesh, mesh_arrays
 from ..geometry.self_intersection import check_self_intersections
 from .mass_properties import MassProperties
 from .primitives import dimension
 
-__all__ = ["mesh_file_mass_properties", "mesh_mass_properties", "polyhedral_integrals"]
+__all__ = ["mesh_mass_properties", "polyhedral_integrals"]
 
 #: Triangles per chunk of the parallel sum: large enough to amortize a thread's start, small
 #: enough that a 100k-triangle mesh splits over every core.
@@ -201,19 +199,3 @@ def mesh_mass_properties(
         check_self_intersections(vertices, triangles, edges)
     origin = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
     return _from_integrals(polyhedral_integrals(vertices, triangles, origin), origin, rho)
-
-
-def mesh_file_mass_properties(
-    path: str | os.PathLike[str], density: Any, *, check_intersections: bool = True
-) -> MassProperties:
-    """Mass properties of the closed mesh in an OBJ, STL, PLY, OFF or glTF file.
-
-    The file is read by :func:`visviva.deformables.mesh_files.read_triangle_mesh` (which
-    refuses special, huge or malformed files and merges vertices repeated at one position, as
-    STL repeats them) and its lengths are taken as metres. Then as
-    :func:`mesh_mass_properties`.
-    """
-    vertices, triangles = read_triangle_mesh(path)
-    return mesh_mass_properties(
-        vertices, triangles, density, check_intersections=check_intersections
-    )

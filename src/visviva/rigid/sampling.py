@@ -21,7 +21,6 @@ computing the sample variance", *The American Statistician* 37(3), 1983.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -29,7 +28,6 @@ from typing import Any
 import numpy as np
 
 from .._validation import describe, whole_number, with_article
-from ..deformables.mesh_files import read_triangle_mesh
 from ..errors import ModelError
 from ..geometry.mesh_topology import check_closed_mesh
 from ..geometry.point_in_mesh import InsideTest
@@ -117,10 +115,7 @@ def _region(shape: str, dims: dict[str, Any], check_intersections: bool) -> Regi
             return inside & (p[:, 0] ** 2 + p[:, 2] ** 2 <= radius * radius)
 
         return np.array([-r, 0.0, -r]), np.array([r, h, r]), cone
-    if "path" in dims:
-        vertices, triangles = read_triangle_mesh(dims["path"])
-    else:
-        vertices, triangles = dims["vertices"], dims["triangles"]
+    vertices, triangles = dims["vertices"], dims["triangles"]
     vertices, triangles, edges = check_closed_mesh(vertices, triangles)
     if check_intersections:
         check_self_intersections(vertices, triangles, edges)
@@ -159,7 +154,6 @@ def sampled_mass_properties(
     height: Any = None,
     vertices: Any = None,
     triangles: Any = None,
-    path: str | os.PathLike[str] | None = None,
     check_intersections: bool = True,
 ) -> SampledMassProperties:
     """Monte-Carlo mass properties of a shape of uniform ``density`` [kg/m³], with error bars.
@@ -176,7 +170,7 @@ def sampled_mass_properties(
             :data:`MAX_SAMPLES`).
         rng: The random generator (a seeded ``numpy.random.default_rng(seed)`` makes the result
             reproducible), or an integer seed; ``None`` draws fresh entropy.
-        size, radius, height, vertices, triangles, path, check_intersections: As for
+        size, radius, height, vertices, triangles, check_intersections: As for
             :func:`~visviva.rigid.mass_properties`.
 
     Returns:
@@ -192,7 +186,6 @@ def sampled_mass_properties(
         "height": height,
         "vertices": vertices,
         "triangles": triangles,
-        "path": path,
     }
     dims = shape_dimensions(shape, given).values
     rho = dimension(shape, "density", density, "kg/m³")

@@ -3,12 +3,12 @@
 The names and dimensions are those of the scene builder's bodies: ``"box"`` (``size``, full edge
 lengths), ``"sphere"`` (``radius``), ``"cylinder"``, ``"capsule"`` and ``"cone"`` (``radius``,
 ``height``), ``"ellipsoid"`` (``size``, the three semi-axes) and ``"mesh"`` (``vertices`` and
-``triangles``, or the ``path`` of a mesh file). Lengths in metres, density in kg/m³.
+``triangles``; a mesh file's are :func:`visviva.io.read_triangle_mesh`'s). Lengths in metres,
+density in kg/m³.
 """
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -16,7 +16,7 @@ from .._registry import did_you_mean
 from .._validation import describe, with_article
 from ..errors import ModelError
 from .mass_properties import MassProperties
-from .mesh_integrals import mesh_file_mass_properties, mesh_mass_properties
+from .mesh_integrals import mesh_mass_properties
 from .primitives import (
     box_mass_properties,
     capsule_mass_properties,
@@ -50,7 +50,7 @@ class Dimensions:
 
 def shape_dimensions(shape: Any, given: dict[str, Any]) -> Dimensions:
     """Check that ``shape`` is known and that exactly its dimensions are among ``given``
-    (``None`` values count as not given); a mesh takes ``path`` instead of its arrays."""
+    (``None`` values count as not given)."""
     if not isinstance(shape, str) or shape not in SHAPES:
         hint = did_you_mean(shape, SHAPES) if isinstance(shape, str) else ""
         raise ModelError(
@@ -59,22 +59,18 @@ def shape_dimensions(shape: Any, given: dict[str, Any]) -> Dimensions:
         )
     present = {name: value for name, value in given.items() if value is not None}
     wanted: tuple[str, ...] = SHAPES[shape]
-    if shape == "mesh" and "path" in present:
-        wanted = ("path",)
     extra = sorted(set(present) - set(wanted))
     if extra:
         raise ModelError(
             f"`{extra[0]}` is not a dimension of {with_article(shape)}; "
             f"{with_article(shape)} takes "
             f"{' and '.join(f'`{name}`' for name in wanted)}"
-            + (" (or `path`, a mesh file)" if shape == "mesh" and wanted != ("path",) else "")
         )
     missing = [name for name in wanted if name not in present]
     if missing:
         raise ModelError(
             f"{with_article(shape)} needs `{missing[0]}`; its dimensions are "
             f"{' and '.join(f'`{name}`' for name in wanted)}"
-            + (" (or `path`, a mesh file)" if shape == "mesh" else "")
         )
     return Dimensions(shape, present)
 
@@ -88,7 +84,6 @@ def mass_properties(
     height: Any = None,
     vertices: Any = None,
     triangles: Any = None,
-    path: str | os.PathLike[str] | None = None,
     check_intersections: bool = True,
 ) -> MassProperties:
     """Mass properties of a shape of uniform ``density`` [kg/m³], by its name.
@@ -103,7 +98,6 @@ def mass_properties(
             hemispheres' centres [m].
         vertices: A mesh's ``(V, 3)`` vertices [m].
         triangles: A mesh's ``(T, 3)`` triangles, counter-clockwise seen from outside.
-        path: A mesh file (OBJ, STL, PLY, OFF, glTF) instead of ``vertices`` and ``triangles``.
         check_intersections: For a mesh, refuse one that crosses itself (see
             :func:`~visviva.rigid.mesh_mass_properties`).
 
@@ -120,7 +114,6 @@ def mass_properties(
         "height": height,
         "vertices": vertices,
         "triangles": triangles,
-        "path": path,
     }
     dims = shape_dimensions(shape, given).values
     if shape == "box":
@@ -135,10 +128,6 @@ def mass_properties(
         return capsule_mass_properties(dims["radius"], dims["height"], density)
     if shape == "cone":
         return cone_mass_properties(dims["radius"], dims["height"], density)
-    if "path" in dims:
-        return mesh_file_mass_properties(
-            dims["path"], density, check_intersections=check_intersections
-        )
     return mesh_mass_properties(
         dims["vertices"], dims["triangles"], density, check_intersections=check_intersections
     )

@@ -6,7 +6,7 @@ A :class:`Recording` holds the times of the recorded frames and one array per re
 the attributes that make the run reproducible (method, step, substeps, library version, work).
 A field that is a part of the state has the part's name (``particle_position``,
 ``particle_velocity``, ``particle_alive``, ``generalized_position``, ``body_orientation``; see
-:mod:`visviva.model.frames`). Files hold the same content (:mod:`visviva.io.recording`:
+:mod:`.frames`). Files hold the same content (:mod:`visviva.io.recording`:
 ``vv.io.save_recording`` and ``vv.io.load_recording``, which reads files written with the
 names of format 1 too).
 

@@ -39,6 +39,7 @@ from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get
 from ..model.model import MAX_STEPS
 from ..ode.state import State
+from .frames import UNITS, frame_fields, recording_attrs, static_fields
 from .interrupt import Interrupted
 from .loop import Schedule, advance
 from .progress import Progress
@@ -304,7 +305,9 @@ class Simulation:
         frames: list[dict[str, np.ndarray]] = []
 
         def keep(state: State, energy: np.ndarray | None) -> None:
-            fields = {name: np.array(value) for name, value in self.model.frame(state).items()}
+            fields = {
+                name: np.array(value) for name, value in frame_fields(self.model, state).items()
+            }
             if energy is not None:
                 fields["energy"] = np.asarray(energy, dtype=np.float64)
             times.append(state.t)
@@ -319,13 +322,13 @@ class Simulation:
                 "scene_name": self.model.name,
                 "steps": self.system.counters.accepted_steps,
             }
-            attrs |= self.system.counters.as_dict() | self.model.recording_attrs()
+            attrs |= self.system.counters.as_dict() | recording_attrs(self.model)
             return Recording(
                 np.array(times),
                 fields,
-                units=self.model.units(),
+                units=UNITS,
                 attrs=attrs,
-                static=self.model.static(),
+                static=static_fields(self.model),
             )
 
         state = self._current()

@@ -258,12 +258,13 @@ class _Figures:
     def of(self, member: int) -> RunFigures:
         """Member ``member``'s figures, as its own run would have them."""
         from ..scenes import RunFigures, drawn_points, final_values
+        from ..simulation.frames import frame_fields
 
         if member in self.individual:
             return self.individual[member]
         model, fields = self.models[member], {}
         if self.last is not None and member in self.last.members:
-            fields = model.frame(self.last.state(self.last.members.index(member)))
+            fields = frame_fields(model, self.last.state(self.last.members.index(member)))
         figure = RunFigures(
             t_reached=float(self.t_reached[member]),
             frames=int(self.frames[member]),
@@ -293,6 +294,7 @@ def _write_member(
     """Write a batch member's files, as its own run would have, and conclude it."""
     from ..io.writer import RecordingWriter
     from ..scenes import final_attrs, recording_attrs, write_run
+    from ..simulation.frames import UNITS, static_fields
 
     seconds = model.integration.duration
 
@@ -300,7 +302,7 @@ def _write_member(
         if path is not None and frames is not None:
             attrs = recording_attrs(model, seconds)
             with RecordingWriter(
-                path, units=model.units(), attrs=attrs, static=model.static()
+                path, units=UNITS, attrs=attrs, static=static_fields(model)
             ) as writer:
                 if frames:
                     times = [t for t, _ in frames]

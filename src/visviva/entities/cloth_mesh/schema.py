@@ -24,7 +24,7 @@ RENAMED = MappingProxyType({"stretch": "stiffness", "bend": "bending", "density"
 class ClothMesh(DeformableBody):
     """``type = "cloth_mesh"``: cloth from any triangle mesh, given as ``vertices`` and
     ``triangles`` or read from the mesh file at ``path`` (OBJ, STL, PLY, OFF, glTF: see
-    :mod:`visviva.deformables.mesh_files`; in a scene file, a relative path is relative to the
+    :mod:`visviva.io.meshes`; in a scene file, a relative path is relative to the
     scene file's folder). A particle at each vertex [m], weighing the ``areal_density``
     [kg/m²] times a third of the area of each triangle around it (so the cloth weighs
     areal_density × area); *stretch* springs of ``stiffness`` [N/m] on every edge of the mesh
@@ -114,7 +114,7 @@ class ClothMeshMethods:
 
         Instead of ``vertices`` and ``triangles``, ``path`` names a mesh file (OBJ, STL, PLY,
         OFF, glTF; relative to the working directory), read at once: its vertices are those
-        of :func:`visviva.deformables.mesh_files.read_triangle_mesh`, which ``pinned`` indexes.
+        of :func:`visviva.io.meshes.read_triangle_mesh`, which ``pinned`` indexes.
         """
         fields = given(locals())
         if "path" in fields:

@@ -65,11 +65,29 @@ from ..particles.emitters import ramp_values
 from ..rigid.surfaces import body_surface
 
 if TYPE_CHECKING:
+    from ..model import Model
     from ..ode.state import State
     from ..rigid.bodies import RigidBodies
-    from .model import Model
 
-__all__ = ["frame_fields", "recording_attrs", "static_fields"]
+__all__ = ["UNITS", "frame_fields", "recording_attrs", "static_fields"]
+
+#: The units of the recorded fields and static arrays (those not listed have none).
+UNITS = {
+    "particle_position": "m",
+    "particle_velocity": "m/s",
+    "particle_radius": "m",
+    "particle_mass": "kg",
+    "system_points": "m",
+    "system_velocity": "m/s",
+    "system_radius": "m",
+    "body_origin": "m",
+    "body_vertices": "m",
+    "body_center": "m",
+    "scenery_vertices": "m",
+    "energy": "J",
+    "generalized_position": "",
+    "generalized_velocity": "",
+}
 
 
 def _system_points(model: Model, state: State) -> list[np.ndarray]:

@@ -1,14 +1,15 @@
-"""Triangle meshes read from files (OBJ, STL, PLY, OFF, glTF), for cloth made of any mesh.
+"""Triangle meshes read from files (OBJ, STL, PLY, OFF, glTF): a cloth of any mesh, a rigid
+body's shape.
 
-:func:`read_triangle_mesh` reads one triangle mesh with trimesh and returns the arrays a body
-is built from: the distinct vertex positions and the triangles over them. A file is refused,
-with its path in the message, when it is not a regular file (a directory, a device such as
-``/dev/zero``, a FIFO: checked on the open descriptor, before anything is read, so nothing
+:func:`read_triangle_mesh` reads one triangle mesh with trimesh and returns the arrays a cloth
+or a body is built from: the distinct vertex positions and the triangles over them. A file is
+refused, with its path in the message, when it is not a regular file (a directory, a device such
+as ``/dev/zero``, a FIFO: checked on the open descriptor, before anything is read, so nothing
 blocks), larger than :data:`MAX_MESH_BYTES` (from its size, before reading: a 2 GB sparse file
 costs nothing), empty, not in a format named by its suffix (:data:`MESH_FORMATS`), unreadable in
 that format, or not one triangle mesh — a scene of several meshes, a point cloud, lines, a mesh
-without triangles or with a vertex that is not finite. Nothing is fetched: a glTF file must
-hold its buffers (or be a ``.glb``).
+without triangles or with a vertex that is not finite. Nothing is fetched: a glTF file must hold
+its buffers (or be a ``.glb``).
 
 Vertices at the same position are merged — an STL file repeats each vertex in every triangle
 around it, an OBJ file splits one where its texture coordinates change — so that the cloth's
@@ -16,6 +17,11 @@ triangles share edges (and springs). The vertices keep the order in which trimes
 (for OBJ and PLY, the file's order, less the vertices no triangle uses), each where it first
 appears: the indices a scene's ``pinned`` names are those of :func:`read_triangle_mesh`'s
 ``vertices``.
+
+This module imports nothing of visviva but its errors: the entity kinds that take a ``path``
+(``cloth_mesh``, ``body``) read their file with it when they are added to a builder (see
+:mod:`visviva.entities.mesh_files` and the layer table in docs/architecture.md); the physics
+packages take vertices and triangles, never a path.
 """
 
 from __future__ import annotations
