@@ -19,7 +19,7 @@ error).
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, cast
+from typing import Any
 
 from pydantic import BaseModel
 
@@ -28,10 +28,6 @@ from ..ode.stage import Phase
 from .checks import check_names
 from .context import BuildContext, Located
 from .kind import EntityKind, KindBuild
-
-if TYPE_CHECKING:
-    from ..forces.base import Force
-    from ..ode.stage import Stage
 
 __all__ = ["force_kind", "force_problem", "stage_kind", "stage_problem"]
 
@@ -116,26 +112,10 @@ def force_kind(
     Raises:
         ModelError: If ``force`` lacks what the pipeline needs of a force.
     """
-    problem = force_problem(force)
-    if problem is not None:
-        raise ModelError(problem)
-
-    def build(entity: Any, where: str, context: BuildContext) -> None:
-        try:
-            made = make(entity, context)
-        except ModelError as error:
-            raise Located(where, str(error)) from None
-        if not isinstance(made, force):
-            raise Located(where, f"the {name} kind made a {type(made).__name__}, not a {force}")
-        context.forces.append(cast("Force", made))
-
-    return EntityKind(
-        name=name,
-        schema=schema,
-        summary=summary,
-        build=KindBuild(check=_targets_exist, build=build),
-        holds_particles=holds_particles,
-    )
+    return _contributing(
+        name, schema, force, make, force_problem(force), lambda context: context.forces,
+        summary=summary, holds_particles=holds_particles,
+    )  # fmt: skip
 
 
 def stage_kind(
@@ -152,7 +132,26 @@ def stage_kind(
     Raises:
         ModelError: If ``stage`` lacks what the pipeline needs of a stage.
     """
-    problem = stage_problem(stage)
+    return _contributing(
+        name, schema, stage, make, stage_problem(stage), lambda context: context.stages,
+        summary=summary,
+    )  # fmt: skip
+
+
+def _contributing(
+    name: str,
+    schema: type[BaseModel],
+    kind: type,
+    make: Callable[[Any, BuildContext], Any],
+    problem: str | None,
+    contributions: Callable[[BuildContext], list[Any]],
+    *,
+    summary: str,
+    holds_particles: bool = False,
+) -> EntityKind:
+    """The kind whose entities each add ``make(entity, context)``, an instance of ``kind``, to
+    the list ``contributions(context)`` (the forces or the stages); ``problem`` is what
+    ``kind`` lacks of the contract, or ``None``."""
     if problem is not None:
         raise ModelError(problem)
 
@@ -161,15 +160,16 @@ def stage_kind(
             made = make(entity, context)
         except ModelError as error:
             raise Located(where, str(error)) from None
-        if not isinstance(made, stage):
-            raise Located(where, f"the {name} kind made a {type(made).__name__}, not a {stage}")
-        context.stages.append(cast("Stage", made))
+        if not isinstance(made, kind):
+            raise Located(where, f"the {name} kind made a {type(made).__name__}, not a {kind}")
+        contributions(context).append(made)
 
     return EntityKind(
         name=name,
         schema=schema,
         summary=summary,
         build=KindBuild(check=_targets_exist, build=build),
+        holds_particles=holds_particles,
     )
 
 

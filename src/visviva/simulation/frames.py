@@ -60,6 +60,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..geometry.packing import packed_surfaces
 from ..geometry.quaternions import quaternion_rotate
 from ..particles.emitters import ramp_values
 from ..rigid.surfaces import body_surface
@@ -210,15 +211,7 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
 def _body_surfaces(bodies: RigidBodies) -> dict[str, np.ndarray]:
     """The rigid bodies' drawing surfaces, body after body, and their colours and centres."""
     surfaces = [body_surface(shape) for shape in bodies.shapes]
-    vertex_start = np.cumsum([0] + [v.shape[0] for v, _ in surfaces], dtype=np.int64)
-    triangle_start = np.cumsum([0] + [t.shape[0] for _, t in surfaces], dtype=np.int64)
-    return {
-        "body_vertices": np.concatenate([v for v, _ in surfaces]).astype(np.float64),
-        "body_triangles": np.concatenate(
-            [t + first for (_, t), first in zip(surfaces, vertex_start, strict=False)]
-        ).astype(np.int64),
-        "body_vertex_start": vertex_start,
-        "body_triangle_start": triangle_start,
+    return packed_surfaces(surfaces, "body") | {
         "body_color": np.array(bodies.color, dtype=np.float64),
         "body_center": np.array(bodies.center, dtype=np.float64),
     }

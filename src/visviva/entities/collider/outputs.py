@@ -31,6 +31,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ...geometry.packing import packed_surfaces
 from .schema import DEFAULT_SCENERY_COLOR, Collider
 from .shapes import collider_shape, collider_surface
 
@@ -64,15 +65,7 @@ def scenery_fields(entries: Sequence[tuple[str, Collider]]) -> dict[str, np.ndar
     if not drawn:
         return {}
     surfaces = [surface for _, _, surface in drawn]
-    vertex_start = np.cumsum([0] + [v.shape[0] for v, _ in surfaces], dtype=np.int64)
-    triangle_start = np.cumsum([0] + [t.shape[0] for _, t in surfaces], dtype=np.int64)
-    return {
-        "scenery_vertices": np.concatenate([v for v, _ in surfaces]).astype(np.float64),
-        "scenery_triangles": np.concatenate(
-            [t + first for (_, t), first in zip(surfaces, vertex_start, strict=False)]
-        ).astype(np.int64),
-        "scenery_vertex_start": vertex_start,
-        "scenery_triangle_start": triangle_start,
+    return packed_surfaces(surfaces, "scenery") | {
         "scenery_color": np.array(
             [e.color or DEFAULT_SCENERY_COLOR for _, e, _ in drawn], dtype=np.float64
         ),
