@@ -17,6 +17,7 @@ from ...forces import (
     QuadraticDrag,
     Targets,
     Vortex,
+    laws,
 )
 from ...mechanics.gravity import GRAVITATIONAL_CONSTANT
 from ..checks import check_names, particle_holders
@@ -85,16 +86,23 @@ def _force(e: ForceField, targets: Targets, mass: np.ndarray) -> Force:
     )
 
 
-#: The fields the compiled particle step folds into one acceleration when they act on every
-#: particle (:mod:`visviva.particles.fused`).
-_FOLDED = ("drag", "wind", "damping")
+#: The law of each field kind (:mod:`visviva.forces.laws`).
+_LAWS = {
+    "drag": laws.DRAG,
+    "wind": laws.DRAG,
+    "quadratic_drag": laws.QUADRATIC_DRAG,
+    "damping": laws.DAMPING,
+    "attractor": laws.ATTRACTOR,
+    "vortex": laws.VORTEX,
+}
 
 
 def _replica(entity: ForceField) -> Replica | None:
     """Copied per run where its values differ; gravitation couples particles: no replicas."""
     if entity.kind == "gravitation":
         return None
-    return Replica(room="law", folds=entity.kind in _FOLDED)
+    # The compiled particle step folds some laws into one acceleration (laws.FOLDED).
+    return Replica(room="law", folds=_LAWS[entity.kind] in laws.FOLDED)
 
 
 BUILD = KindBuild(check=_check, build=_build, replica=_replica)
