@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import visviva as vv
-from visviva.collision.contacts import COLLIDING, RESTING, SEPARATING, Contacts
+from visviva.collision.contact_classes import COLLIDING, RESTING, SEPARATING, Contacts
 
 
 def _scene(**particles) -> vv.Model:

@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import visviva as vv
-from visviva.collision.contacts import COLLIDING, RESTING, SEPARATING
+from visviva.collision.contact_classes import COLLIDING, RESTING, SEPARATING
 from visviva.collision.particle_contacts import ParticleContacts
 from visviva.errors import ModelError, SceneError
 from visviva.ode.workspace import Workspace

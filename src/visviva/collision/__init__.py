@@ -32,23 +32,34 @@ from .bvh import MeshBVH
 from .colliders import MAX_COLLIDERS, ColliderSet
 from .particle_contacts import PairContacts, ParticleContacts
 from .penalty import PenaltyContact
+from .proximity import ContactPatch, Separation, contacts, distance
 from .response import ColliderResponse, ParticleCollisions
 from .shapes import Box, Plane, Sphere, TriangleMesh
+from .solids import Capsule, Cone, ConvexHull, Cylinder, Ellipsoid
 from .tables import ColliderKind, collider_table
 
 __all__ = [
     "MAX_COLLIDERS",
     "Box",
+    "Capsule",
     "ColliderKind",
     "ColliderResponse",
     "ColliderSet",
+    "Cone",
+    "ContactPatch",
+    "ConvexHull",
+    "Cylinder",
+    "Ellipsoid",
     "MeshBVH",
     "PairContacts",
     "ParticleCollisions",
     "ParticleContacts",
     "PenaltyContact",
     "Plane",
+    "Separation",
     "Sphere",
     "TriangleMesh",
     "collider_table",
+    "contacts",
+    "distance",
 ]

@@ -62,7 +62,7 @@ from ..geometry.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid
 from ..ode.stage import Phase
 from . import contact_detection as detection
 from . import contact_kernels as kernels
-from .contacts import CLASSES, COLLIDING, DEFAULT_GAP, RESTING, SEPARATING
+from .contact_classes import CLASSES, COLLIDING, DEFAULT_GAP, RESTING, SEPARATING
 
 if TYPE_CHECKING:
     from ..ode.state import State
@@ -118,7 +118,7 @@ class PairContacts:
         depth: ``(k,)`` [m] overlap ``r_first + r_second − distance`` (negative: a gap
             within the tolerance).
         normal_velocity: ``(k,)`` [m/s] ``n · (v_first − v_second)`` (negative: approaching).
-        kind: ``(k,)`` :data:`~visviva.collision.contacts.COLLIDING`, ``RESTING`` or
+        kind: ``(k,)`` :data:`~visviva.collision.contact_classes.COLLIDING`, ``RESTING`` or
             ``SEPARATING`` (Baraff's classes, with the stage's resting speed).
     """
 

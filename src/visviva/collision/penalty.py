@@ -33,7 +33,7 @@ import numpy as np
 from numba import njit
 
 from .colliders import ColliderSet, collider_distance
-from .contacts import DEFAULT_GAP, Contacts, find_contacts
+from .contact_classes import DEFAULT_GAP, Contacts, find_contacts
 
 if TYPE_CHECKING:
     from ..forces.base import JacobianForm
@@ -56,7 +56,7 @@ class PenaltyContact:
         masks: ``(N,)`` uint64: bit ``k`` set where particle ``i`` meets collider ``k``.
         radius: Particle radii [m], ``(N,)`` (the radii at the start: a size ramp does not
             change the contact distance).
-        labels: Each collider's name, for :class:`~visviva.collision.contacts.Contacts`.
+        labels: Each collider's name, for :class:`~visviva.collision.contact_classes.Contacts`.
         resting_speed: Normal speeds [m/s] below which :meth:`contacts` calls a contact
             resting, per collider (default 0).
     """
@@ -93,7 +93,7 @@ class PenaltyContact:
 
     def contacts(self, state: State, gap: float = DEFAULT_GAP) -> Contacts:
         """The contacts of ``state``'s live particles with these colliders (see
-        :mod:`~visviva.collision.contacts`)."""
+        :mod:`~visviva.collision.contact_classes`)."""
         x = state["particle_position"]
         alive = state.carried.get("particle_alive")
         return find_contacts(

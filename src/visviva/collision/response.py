@@ -37,7 +37,7 @@ from numba import njit, prange
 
 from ..ode.stage import Phase
 from .colliders import UNROLLED_PLANES, ColliderSet, collider_distance, collider_first_hit
-from .contacts import DEFAULT_GAP, Contacts, find_contacts
+from .contact_classes import DEFAULT_GAP, Contacts, find_contacts
 from .queries import plane_distance, plane_first_hit
 from .tables import ColliderKind
 
@@ -87,7 +87,7 @@ class ParticleCollisions:
         colliders: The colliders.
         response: Restitution, friction, resting speed and time of impact per collider.
         masks: ``(N,)`` uint64: bit ``k`` set where particle ``i`` meets collider ``k``.
-        labels: Each collider's name, for :class:`~visviva.collision.contacts.Contacts`
+        labels: Each collider's name, for :class:`~visviva.collision.contact_classes.Contacts`
             (default ``collider 0``, ``collider 1``, ...).
 
     The state must carry ``particle_radius`` and ``particle_alive`` and name its particle
@@ -118,7 +118,7 @@ class ParticleCollisions:
 
     def contacts(self, state: State, gap: float = DEFAULT_GAP) -> Contacts:
         """The contacts of ``state``'s live particles with these colliders (classified with
-        each collider's resting speed; see :mod:`~visviva.collision.contacts`)."""
+        each collider's resting speed; see :mod:`~visviva.collision.contact_classes`)."""
         return find_contacts(
             state["particle_position"],
             state["particle_velocity"],

@@ -39,7 +39,7 @@ QUATERNION_TOLERANCE = 1e-6
 Vector3 = tuple[float, float, float]
 
 
-def _numbers(name: str, shape: str, value: Any, count: int, unit: str) -> tuple[float, ...]:
+def numbers(name: str, shape: str, value: Any, count: int, unit: str) -> tuple[float, ...]:
     """``value`` as ``count`` finite floats, or a ModelError naming ``name`` of a ``shape``."""
     try:
         array = np.asarray(value, dtype=np.float64)
@@ -50,6 +50,24 @@ def _numbers(name: str, shape: str, value: Any, count: int, unit: str) -> tuple[
             f"`{name}` of a {shape} must be {count} finite numbers{unit} (got {describe(value)})"
         )
     return tuple(float(x) for x in array)
+
+
+def unit_quaternion(shape: str, value: Any) -> tuple[float, float, float, float]:
+    """``value`` as the unit quaternion (w, x, y, z) of a ``shape``'s ``orientation``, or a
+    ModelError."""
+    q = numbers("orientation", shape, value, 4, ", a quaternion (w, x, y, z)")
+    norm = math.sqrt(sum(x * x for x in q))
+    if norm == 0.0:
+        raise ModelError(
+            f"`orientation` of a {shape} must be a unit quaternion (w, x, y, z) (got "
+            f"{describe(q)}); use (1, 0, 0, 0) for a {shape} aligned with the world axes"
+        )
+    if abs(norm - 1.0) > QUATERNION_TOLERANCE:
+        raise ModelError(
+            f"`orientation` of a {shape} must be a unit quaternion (w, x, y, z) (got "
+            f"{describe(q)}, of length {norm:.9g}); normalize it: divide it by its length"
+        )
+    return q  # type: ignore[return-value]
 
 
 class _Primitive:
@@ -94,8 +112,8 @@ class Plane(_Primitive):
     kind: ClassVar[ColliderKind] = ColliderKind.PLANE
 
     def __post_init__(self) -> None:
-        point = _numbers("point", "plane", self.point, 3, " [m]")
-        normal = _numbers("normal", "plane", self.normal, 3, "")
+        point = numbers("point", "plane", self.point, 3, " [m]")
+        normal = numbers("normal", "plane", self.normal, 3, "")
         if not math.hypot(*normal) > 0.0:
             raise ModelError(
                 f"`normal` of a plane must not be zero (got {describe(normal)}); give the "
@@ -133,7 +151,7 @@ class Sphere(_Primitive):
     kind: ClassVar[ColliderKind] = ColliderKind.SPHERE
 
     def __post_init__(self) -> None:
-        center = _numbers("center", "sphere", self.center, 3, " [m]")
+        center = numbers("center", "sphere", self.center, 3, " [m]")
         radius = real_number("radius", self.radius, positive=True, unit=" m")
         object.__setattr__(self, "center", center)
         object.__setattr__(self, "radius", radius)
@@ -160,25 +178,14 @@ class Box(_Primitive):
     kind: ClassVar[ColliderKind] = ColliderKind.BOX
 
     def __post_init__(self) -> None:
-        center = _numbers("center", "box", self.center, 3, " [m]")
-        size = _numbers("size", "box", self.size, 3, " [m]")
+        center = numbers("center", "box", self.center, 3, " [m]")
+        size = numbers("size", "box", self.size, 3, " [m]")
         if not min(size) > 0.0:
             raise ModelError(
                 f"`size` of a box must be three positive edge lengths [m] (got {describe(size)}); "
                 "it is the full length of each edge, twice the half extent"
             )
-        q = _numbers("orientation", "box", self.orientation, 4, ", a quaternion (w, x, y, z)")
-        norm = math.sqrt(sum(x * x for x in q))
-        if norm == 0.0:
-            raise ModelError(
-                f"`orientation` of a box must be a unit quaternion (w, x, y, z) (got "
-                f"{describe(q)}); use (1, 0, 0, 0) for a box aligned with the world axes"
-            )
-        if abs(norm - 1.0) > QUATERNION_TOLERANCE:
-            raise ModelError(
-                f"`orientation` of a box must be a unit quaternion (w, x, y, z) (got "
-                f"{describe(q)}, of length {norm:.9g}); normalize it: divide it by its length"
-            )
+        q = unit_quaternion("box", self.orientation)
         object.__setattr__(self, "center", center)
         object.__setattr__(self, "size", size)
         object.__setattr__(self, "orientation", q)

@@ -20,7 +20,7 @@ from ..errors import SceneProblem
 from ..forces.base import Targets
 
 if TYPE_CHECKING:
-    from ..collision.contacts import ContactSource
+    from ..collision.contact_classes import ContactSource
     from ..forces.base import Force
     from ..forces.body_forces import BodyForce
     from ..forces.springs import Springs

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..collision.contacts import DEFAULT_GAP, Contacts, ContactSource
+from ..collision.contact_classes import DEFAULT_GAP, Contacts, ContactSource
 from ..collision.particle_contacts import PairContacts, ParticleContacts
 from ..entities.context import ParticleGroup
 from ..entities.system.block import SystemInstance
@@ -210,7 +210,7 @@ class Model:
     def contacts(self, state: State, gap: float = DEFAULT_GAP) -> Contacts:
         """The particle–collider contacts of ``state`` (every collider, impulse and penalty:
         where, how deep, and colliding, resting or separating; see
-        :mod:`visviva.collision.contacts`)."""
+        :mod:`visviva.collision.contact_classes`)."""
         return Contacts.join([source.contacts(state, gap) for source in self.contact_sources])
 
     def pair_contacts(self, state: State, gap: float = DEFAULT_GAP) -> PairContacts:

@@ -342,7 +342,7 @@ def _contact_constraints(model: Model) -> ContactConstraints | None:
     and the next step still finds it touching) and the colliders' friction coefficients μ;
     ``None`` for a scene without impulse colliders or with emitters (whose live particles
     change between steps)."""
-    from ..collision.contacts import DEFAULT_GAP, Contacts, find_contacts
+    from ..collision.contact_classes import DEFAULT_GAP, Contacts, find_contacts
     from ..collision.response import ParticleCollisions
 
     stages = [s for s in model.stages if isinstance(s, ParticleCollisions)]

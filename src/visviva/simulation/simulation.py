@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._validation import real_number, whole_number
-from ..collision.contacts import DEFAULT_GAP, Contacts
+from ..collision.contact_classes import DEFAULT_GAP, Contacts
 from ..collision.particle_contacts import PairContacts
 from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get
@@ -195,7 +195,7 @@ class Simulation:
     def contacts(self, gap: float = DEFAULT_GAP) -> Contacts:
         """The particles' contacts with the colliders now: which particle touches which
         collider (within its radius plus ``gap`` [m]), where, how deep, and whether it is
-        colliding, resting or separating (see :mod:`visviva.collision.contacts`)."""
+        colliding, resting or separating (see :mod:`visviva.collision.contact_classes`)."""
         gap = real_number("gap", gap, unit=" m")
         if gap < 0.0:
             raise ModelError(f"`gap` must be >= 0 (got {gap!r} m)")
