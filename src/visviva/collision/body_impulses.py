@@ -1,0 +1,285 @@
+"""Impulses between rigid bodies at their contact points: seed 003's collision impulse, solved
+for many contacts at once by sequential impulses, and the split position correction.
+
+At a contact point ``p`` between bodies A and B with unit normal ``n`` from A toward B, the
+arms ``r_a = p − x_a`` and ``r_b = p − x_b`` from the centres of mass, the relative velocity
+of the two material points is
+
+    v_rel = (v_b + ω_b × r_b) − (v_a + ω_a × r_a),     v_n = n · v_rel
+
+(negative: approaching). An impulse ``j n`` on B and ``−j n`` on A changes ``v_n`` by
+``j K`` with
+
+    K = 1/M_a + 1/M_b + (r_a × n)·I_a⁻¹(r_a × n) + (r_b × n)·I_b⁻¹(r_b × n),
+
+so that the collision impulse of seed 003 (Baraff, "Rigid body simulation", SIGGRAPH 2001
+course notes, §8), which reverses the approach with restitution ``e``, is
+
+    j = −(1 + e) v_n⁻ / K,    ΔP_b = j n,  ΔL_b = r_b × j n,   ΔP_a = −j n,  ΔL_a = −r_a × j n
+
+(``n·(I⁻¹(r × n)) × r = (r × n)·I⁻¹(r × n)``: the seed's denominator). Both bodies' momenta
+change by opposite amounts and their angular momenta about any fixed point too: linear and
+angular momentum are conserved.
+
+Many contacts at once (a stack, a pile, a box on four corners) are solved by sequential
+impulses, a projected Gauss–Seidel iteration on the contacts' accumulated impulses (E. Catto,
+"Iterative dynamics with temporal coherence", GDC 2005): each sweep gives each contact the
+impulse that brings its ``v_n`` to its target, keeps the accumulated normal impulse ``λ ≥ 0``
+(contacts push, never pull), and a friction impulse in the tangent plane that opposes the
+sliding, its accumulated size at most ``μ λ`` (Coulomb's cone). The target is ``−e v_n⁻`` for
+a contact that approached faster than the resting speed (it collides), 0 for one that rests
+(B. Mirtich, J. Canny, "Impulse-based simulation of rigid bodies", I3D 1995), and
+``−gap/h`` for a speculative contact a gap apart: it may close the gap this step but not more.
+Friction and restitution act through the same impulses as in E. Guendelman, R. Bridson,
+R. Fedkiw, "Nonconvex rigid bodies with stacking", SIGGRAPH 2003: both change the spin.
+
+What overlap is left is removed by moving the bodies, not by speeding them apart (which would
+add energy: Guendelman et al. separate the two). :func:`correct_positions` sweeps the
+penetrating contacts with pseudo-impulses that translate and turn the bodies, each removing a
+fraction of its remaining depth beyond a small allowance; velocities are untouched.
+
+Body index ``-1`` is the static world (infinite mass, at rest).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+__all__ = ["correct_positions", "prepare_contacts", "solve_impulses"]
+
+
+@njit(cache=True, inline="always")
+def _cross(ax, ay, az, bx, by, bz):
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+
+
+@njit(cache=True, inline="always")
+def _times(m, b, x, y, z):
+    """``m[b] @ (x, y, z)`` for a stack of 3×3 matrices."""
+    return (
+        m[b, 0, 0] * x + m[b, 0, 1] * y + m[b, 0, 2] * z,
+        m[b, 1, 0] * x + m[b, 1, 1] * y + m[b, 1, 2] * z,
+        m[b, 2, 0] * x + m[b, 2, 1] * y + m[b, 2, 2] * z,
+    )
+
+
+@njit(cache=True)
+def _point_velocity(b, v, w, rx, ry, rz):
+    """Velocity ``v + ω × r`` of the point at arm ``r`` of body ``b`` (0 for the world)."""
+    if b < 0:
+        return 0.0, 0.0, 0.0
+    cx, cy, cz = _cross(w[b, 0], w[b, 1], w[b, 2], rx, ry, rz)
+    return v[b, 0] + cx, v[b, 1] + cy, v[b, 2] + cz
+
+
+@njit(cache=True)
+def _resistance(b, inverse_mass, inverse_inertia, rx, ry, rz, dx, dy, dz):
+    """``1/M + (r × d)·I⁻¹(r × d)`` of body ``b`` along the unit direction ``d``."""
+    if b < 0:
+        return 0.0
+    cx, cy, cz = _cross(rx, ry, rz, dx, dy, dz)
+    ix, iy, iz = _times(inverse_inertia, b, cx, cy, cz)
+    return inverse_mass[b] + cx * ix + cy * iy + cz * iz
+
+
+@njit(cache=True)
+def _push(b, sign, inverse_mass, inverse_inertia, v, w, rx, ry, rz, jx, jy, jz):
+    """Apply the impulse ``sign·J`` at arm ``r`` of body ``b``: ``Δv = J/M``,
+    ``Δω = I⁻¹ (r × J)``."""
+    if b < 0:
+        return
+    jx, jy, jz = sign * jx, sign * jy, sign * jz
+    m = inverse_mass[b]
+    v[b, 0] += m * jx
+    v[b, 1] += m * jy
+    v[b, 2] += m * jz
+    cx, cy, cz = _cross(rx, ry, rz, jx, jy, jz)
+    ix, iy, iz = _times(inverse_inertia, b, cx, cy, cz)
+    w[b, 0] += ix
+    w[b, 1] += iy
+    w[b, 2] += iz
+
+
+@njit(cache=True)
+def _tangents(nx, ny, nz):
+    """Two unit vectors that make a right-handed frame with the unit ``n``."""
+    if abs(nx) < 0.57735:
+        tx, ty, tz = _cross(nx, ny, nz, 1.0, 0.0, 0.0)
+    else:
+        tx, ty, tz = _cross(nx, ny, nz, 0.0, 1.0, 0.0)
+    length = math.sqrt(tx * tx + ty * ty + tz * tz)
+    tx, ty, tz = tx / length, ty / length, tz / length
+    sx, sy, sz = _cross(nx, ny, nz, tx, ty, tz)
+    return tx, ty, tz, sx, sy, sz
+
+
+@njit(cache=True)
+def prepare_contacts(
+    body_a, body_b, point, normal, depth, restitution, resting_speed, h,
+    position, inverse_mass, inverse_inertia, v, w,
+    arm_a, arm_b, frame, mass_n, mass_t, target,
+):  # fmt: skip
+    """Fill each contact's arms, tangent frame, effective masses and normal-velocity target.
+
+    Args:
+        body_a, body_b: ``(C,)`` the bodies (``-1``: the world).
+        point, normal: ``(C, 3)`` contact points [m] and unit normals from A toward B.
+        depth: ``(C,)`` penetration [m], negative for a speculative contact's gap.
+        restitution: ``(C,)`` coefficient of restitution of each contact's pair.
+        resting_speed: Approach speed [m/s] below which a contact rests rather than bounces.
+        h: The step [s].
+        position: ``(B, 3)`` centres of mass [m]; ``inverse_mass`` ``(B,)`` [1/kg];
+            ``inverse_inertia`` ``(B, 3, 3)`` world frame [1/(kg·m²)]; ``v``, ``w``
+            ``(B, 3)`` velocities [m/s] and angular velocities [rad/s] before the solve.
+        arm_a, arm_b: ``(C, 3)`` outputs, ``p − x``.
+        frame: ``(C, 2, 3)`` output, the two tangents.
+        mass_n: ``(C,)`` output, ``1/K`` along the normal [kg].
+        mass_t: ``(C, 2)`` output, the same along each tangent.
+        target: ``(C,)`` output, the normal velocity each contact is driven to [m/s].
+    """
+    for c in range(body_a.shape[0]):
+        a = body_a[c]
+        b = body_b[c]
+        nx, ny, nz = normal[c, 0], normal[c, 1], normal[c, 2]
+        for k in range(3):
+            arm_a[c, k] = point[c, k] - position[a, k] if a >= 0 else 0.0
+            arm_b[c, k] = point[c, k] - position[b, k] if b >= 0 else 0.0
+        rax, ray, raz = arm_a[c, 0], arm_a[c, 1], arm_a[c, 2]
+        rbx, rby, rbz = arm_b[c, 0], arm_b[c, 1], arm_b[c, 2]
+        k_n = _resistance(a, inverse_mass, inverse_inertia, rax, ray, raz, nx, ny, nz)
+        k_n += _resistance(b, inverse_mass, inverse_inertia, rbx, rby, rbz, nx, ny, nz)
+        mass_n[c] = 1.0 / k_n if k_n > 0.0 else 0.0
+        tx, ty, tz, sx, sy, sz = _tangents(nx, ny, nz)
+        frame[c, 0, 0], frame[c, 0, 1], frame[c, 0, 2] = tx, ty, tz
+        frame[c, 1, 0], frame[c, 1, 1], frame[c, 1, 2] = sx, sy, sz
+        for t in range(2):
+            dx, dy, dz = frame[c, t, 0], frame[c, t, 1], frame[c, t, 2]
+            k_t = _resistance(a, inverse_mass, inverse_inertia, rax, ray, raz, dx, dy, dz)
+            k_t += _resistance(b, inverse_mass, inverse_inertia, rbx, rby, rbz, dx, dy, dz)
+            mass_t[c, t] = 1.0 / k_t if k_t > 0.0 else 0.0
+        vax, vay, vaz = _point_velocity(a, v, w, rax, ray, raz)
+        vbx, vby, vbz = _point_velocity(b, v, w, rbx, rby, rbz)
+        v_n = (vbx - vax) * nx + (vby - vay) * ny + (vbz - vaz) * nz
+        gap = -depth[c]
+        if gap > 0.0 and v_n * h > -gap:
+            # A speculative contact that will not close its gap this step: it may approach
+            # by the gap, no more.
+            target[c] = -gap / h
+        elif v_n < -resting_speed:
+            target[c] = -restitution[c] * v_n
+        else:
+            target[c] = 0.0
+
+
+@njit(cache=True)
+def solve_impulses(
+    body_a, body_b, normal, friction, arm_a, arm_b, frame, mass_n, mass_t, target,
+    inverse_mass, inverse_inertia, v, w, normal_impulse, tangent_impulse, iterations,
+):  # fmt: skip
+    """Sequential impulses: ``iterations`` sweeps over the contacts in order, changing ``v``
+    and ``w`` in place (module docstring).
+
+    ``normal_impulse`` ``(C,)`` [N·s] and ``tangent_impulse`` ``(C, 2)`` [N·s] hold each
+    contact's accumulated impulse; whatever they hold on entry (a warm start) is applied
+    first.
+    """
+    count = body_a.shape[0]
+    for c in range(count):
+        jx = normal_impulse[c] * normal[c, 0]
+        jy = normal_impulse[c] * normal[c, 1]
+        jz = normal_impulse[c] * normal[c, 2]
+        for t in range(2):
+            jx += tangent_impulse[c, t] * frame[c, t, 0]
+            jy += tangent_impulse[c, t] * frame[c, t, 1]
+            jz += tangent_impulse[c, t] * frame[c, t, 2]
+        _apply_pair(c, body_a, body_b, arm_a, arm_b, inverse_mass, inverse_inertia, v, w,
+                    jx, jy, jz)  # fmt: skip
+    for _ in range(iterations):
+        for c in range(count):
+            a = body_a[c]
+            b = body_b[c]
+            nx, ny, nz = normal[c, 0], normal[c, 1], normal[c, 2]
+            rax, ray, raz = arm_a[c, 0], arm_a[c, 1], arm_a[c, 2]
+            rbx, rby, rbz = arm_b[c, 0], arm_b[c, 1], arm_b[c, 2]
+            # Friction first, bounded by the normal impulse of the last sweep (Catto 2005).
+            vax, vay, vaz = _point_velocity(a, v, w, rax, ray, raz)
+            vbx, vby, vbz = _point_velocity(b, v, w, rbx, rby, rbz)
+            rx, ry, rz = vbx - vax, vby - vay, vbz - vaz
+            limit = friction[c] * normal_impulse[c]
+            old0 = tangent_impulse[c, 0]
+            old1 = tangent_impulse[c, 1]
+            new0 = old0 - mass_t[c, 0] * (
+                rx * frame[c, 0, 0] + ry * frame[c, 0, 1] + rz * frame[c, 0, 2]
+            )
+            new1 = old1 - mass_t[c, 1] * (
+                rx * frame[c, 1, 0] + ry * frame[c, 1, 1] + rz * frame[c, 1, 2]
+            )
+            size = math.sqrt(new0 * new0 + new1 * new1)
+            if size > limit:
+                scale = limit / size if size > 0.0 else 0.0
+                new0 *= scale
+                new1 *= scale
+            tangent_impulse[c, 0] = new0
+            tangent_impulse[c, 1] = new1
+            d0 = new0 - old0
+            d1 = new1 - old1
+            jx = d0 * frame[c, 0, 0] + d1 * frame[c, 1, 0]
+            jy = d0 * frame[c, 0, 1] + d1 * frame[c, 1, 1]
+            jz = d0 * frame[c, 0, 2] + d1 * frame[c, 1, 2]
+            _apply_pair(c, body_a, body_b, arm_a, arm_b, inverse_mass, inverse_inertia, v, w,
+                        jx, jy, jz)  # fmt: skip
+            # The normal impulse toward the target, accumulated and kept ≥ 0.
+            vax, vay, vaz = _point_velocity(a, v, w, rax, ray, raz)
+            vbx, vby, vbz = _point_velocity(b, v, w, rbx, rby, rbz)
+            v_n = (vbx - vax) * nx + (vby - vay) * ny + (vbz - vaz) * nz
+            old = normal_impulse[c]
+            new = max(old + mass_n[c] * (target[c] - v_n), 0.0)
+            normal_impulse[c] = new
+            d = new - old
+            _apply_pair(c, body_a, body_b, arm_a, arm_b, inverse_mass, inverse_inertia, v, w,
+                        d * nx, d * ny, d * nz)  # fmt: skip
+
+
+@njit(cache=True)
+def _apply_pair(c, body_a, body_b, arm_a, arm_b, inverse_mass, inverse_inertia, v, w, jx, jy, jz):
+    """``J`` on contact ``c``'s body B, ``−J`` on its body A."""
+    _push(body_b[c], 1.0, inverse_mass, inverse_inertia, v, w,
+          arm_b[c, 0], arm_b[c, 1], arm_b[c, 2], jx, jy, jz)  # fmt: skip
+    _push(body_a[c], -1.0, inverse_mass, inverse_inertia, v, w,
+          arm_a[c, 0], arm_a[c, 1], arm_a[c, 2], jx, jy, jz)  # fmt: skip
+
+
+@njit(cache=True)
+def correct_positions(
+    body_a, body_b, normal, depth, arm_a, arm_b, mass_n,
+    inverse_mass, inverse_inertia, allowance, fraction, iterations, shift, turn,
+):  # fmt: skip
+    """Split position correction: sweeps of pseudo-impulses that move the bodies apart where
+    they overlap by more than ``allowance`` [m], each removing ``fraction`` of a contact's
+    remaining excess depth, the depths updated to first order as the bodies move.
+
+    ``shift`` and ``turn`` ``(B, 3)``, zero on entry, receive each body's translation [m]
+    and small rotation vector [rad] (world frame).
+    """
+    count = body_a.shape[0]
+    for _ in range(iterations):
+        for c in range(count):
+            a = body_a[c]
+            b = body_b[c]
+            nx, ny, nz = normal[c, 0], normal[c, 1], normal[c, 2]
+            rax, ray, raz = arm_a[c, 0], arm_a[c, 1], arm_a[c, 2]
+            rbx, rby, rbz = arm_b[c, 0], arm_b[c, 1], arm_b[c, 2]
+            # The depth now: less how far the bodies' points moved apart along n so far.
+            pax, pay, paz = _point_velocity(a, shift, turn, rax, ray, raz)
+            pbx, pby, pbz = _point_velocity(b, shift, turn, rbx, rby, rbz)
+            now = depth[c] - ((pbx - pax) * nx + (pby - pay) * ny + (pbz - paz) * nz)
+            excess = now - allowance
+            if excess <= 0.0:
+                continue
+            p = fraction * excess * mass_n[c]
+            _push(b, 1.0, inverse_mass, inverse_inertia, shift, turn, rbx, rby, rbz,
+                  p * nx, p * ny, p * nz)  # fmt: skip
+            _push(a, -1.0, inverse_mass, inverse_inertia, shift, turn, rax, ray, raz,
+                  p * nx, p * ny, p * nz)  # fmt: skip
