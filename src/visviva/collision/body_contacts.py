@@ -1,0 +1,336 @@
+"""Rigid bodies that touch: the contact stage of rigid bodies.
+
+After each integrator step (and the projection onto unit quaternions), :class:`BodyContacts`
+stops the bodies' pieces (:mod:`~visviva.collision.body_pieces`) from passing into each other,
+into static convex scenery and into planes:
+
+1. **Detection** at the step's end poses (:mod:`~visviva.collision.body_detection`): bounding
+   boxes grown by each body's speculative reach — what it may travel in a step,
+   ``h (|v| + |ω| r)``, plus :data:`SPECULATIVE` of its size — swept and pruned, then GJK/EPA
+   and the contact manifold per candidate pair, and every moving piece against every plane.
+2. **Impulses** (velocities): sequential impulses with restitution and Coulomb friction
+   (:mod:`~visviva.collision.body_impulses`), warm-started from the impulses of the last step's
+   contacts at the same place on the same pair of pieces (carried in the state).
+3. **Position correction**: what overlap is left beyond :data:`ALLOWANCE` of the smaller
+   piece's size is removed by moving and turning the bodies (velocities untouched).
+
+A pair's coefficients are the larger restitution of the two and the geometric mean of their
+frictions, ``e = max(e_a, e_b)``, ``μ = √(μ_a μ_b)`` (a rubber ball bounces off anything; ice
+makes any pair slippery), unless the stage is given one value for every pair.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, ClassVar
+
+import numpy as np
+from numba import njit
+
+from ..geometry.quaternions import quaternion_matrix
+from ..ode.stage import Phase
+from .body_detection import contact_arrays, pair_contacts, piece_poses, plane_contacts
+from .body_impulses import correct_positions, prepare_contacts, solve_impulses
+from .body_pieces import BodyPieces
+from .broad_phase import overlapping_pairs
+from .manifold import MAX_CONTACTS
+
+if TYPE_CHECKING:
+    from ..ode.state import State
+    from ..ode.workspace import Workspace
+
+__all__ = ["BodyContactSet", "BodyContacts", "Planes"]
+
+#: A body's speculative reach beyond its travel in a step, as a fraction of its pieces' size.
+SPECULATIVE = 0.02
+#: Overlap left alone by the position correction, as a fraction of the smaller piece's size:
+#: a resting contact keeps touching (and is found again next step) instead of bouncing
+#: between touching and not.
+ALLOWANCE = 1e-4
+#: Fraction of the excess overlap each position sweep removes.
+CORRECTION = 0.4
+#: A contact takes the last step's impulses of its pair's contact that lay within this
+#: fraction of the piece's size of it.
+MATCH = 0.05
+#: The carried parts, in order (:meth:`BodyContacts.carried_start`).
+MEMORY = (
+    "body_contact_key",
+    "body_contact_anchor",
+    "body_contact_normal_impulse",
+    "body_contact_friction_impulse",
+)
+
+
+@dataclass(frozen=True)
+class Planes:
+    """Static planes the bodies collide with: ``(F, 3)`` points and outward unit normals,
+    ``(F,)`` thicknesses [m] (``inf``: a half-space), restitutions and frictions."""
+
+    point: np.ndarray
+    normal: np.ndarray
+    thickness: np.ndarray
+    restitution: np.ndarray
+    friction: np.ndarray
+
+    @classmethod
+    def none(cls) -> Planes:
+        return cls(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0), np.zeros(0))
+
+
+@dataclass(frozen=True)
+class BodyContactSet:
+    """One step's contacts, in solve order, for inspection.
+
+    Attributes:
+        piece_a, piece_b: ``(C,)`` the pieces (``-1 − f`` for plane ``f`` as ``piece_a``).
+        body_a, body_b: ``(C,)`` their bodies (``-1``: the world).
+        point, normal: ``(C, 3)`` contact points [m] and unit normals from A toward B.
+        depth: ``(C,)`` penetration [m] (negative: a speculative contact's gap).
+        normal_velocity: ``(C,)`` relative normal velocity before the solve [m/s].
+        normal_impulse: ``(C,)`` the impulse each received [N·s].
+    """
+
+    piece_a: np.ndarray
+    piece_b: np.ndarray
+    body_a: np.ndarray
+    body_b: np.ndarray
+    point: np.ndarray
+    normal: np.ndarray
+    depth: np.ndarray
+    normal_velocity: np.ndarray
+    normal_impulse: np.ndarray
+
+
+class BodyContacts:
+    """The rigid bodies' contact stage (see the module docstring).
+
+    Args:
+        pieces: The bodies' and the scenery's convex pieces.
+        mass: ``(B,)`` [kg]; ``inertia``: ``(B, 3, 3)`` about the centre of mass in each
+            body's axes [kg·m²].
+        dynamic: ``(B,)`` bool: the bodies contacts push (the others have infinite mass).
+        planes: Static planes.
+        iterations: Sweeps of impulses, and of position corrections, per step.
+        resting_speed: Approach speed [m/s] below which a contact rests.
+        restitution, friction: One coefficient for every pair, or ``None`` for the pair rule.
+    """
+
+    phase: ClassVar[Phase] = Phase.CONTACTS
+    order: ClassVar[int] = 2
+    compiled: ClassVar[bool] = False
+    changes_energy: ClassVar[bool] = True
+    kills_particles: ClassVar[bool] = False
+
+    def __init__(
+        self,
+        pieces: BodyPieces,
+        mass: np.ndarray,
+        inertia: np.ndarray,
+        dynamic: np.ndarray,
+        planes: Planes,
+        *,
+        iterations: int = 20,
+        resting_speed: float = 0.0,
+        restitution: float | None = None,
+        friction: float | None = None,
+    ) -> None:
+        self.pieces = pieces
+        self.count = int(np.shape(mass)[0])
+        dynamic = np.asarray(dynamic, dtype=np.bool_)
+        self.inverse_mass = np.where(dynamic, 1.0 / np.asarray(mass, dtype=np.float64), 0.0)
+        self.inertia = np.asarray(inertia, dtype=np.float64)
+        self.inverse_inertia_body = np.where(
+            dynamic[:, None, None], np.linalg.inv(self.inertia), 0.0
+        )
+        self.dynamic = dynamic
+        self.planes = planes
+        self.iterations = iterations
+        self.resting_speed = resting_speed
+        self.restitution = restitution
+        self.friction = friction
+        # Each body's size: its largest piece's reach from the centre of mass.
+        size = np.zeros(self.count)
+        for p in range(pieces.count):
+            b = pieces.body[p]
+            if b >= 0:
+                reach = np.linalg.norm(pieces.local_position[p]) + pieces.radius[p]
+                size[b] = max(size[b], reach)
+        self.size = size
+
+    def carried_start(self) -> dict[str, np.ndarray]:
+        """The last step's contacts for the warm start: ``body_contact_key`` ``(C,)`` (the
+        pair of pieces), ``body_contact_anchor`` ``(C, 3)`` (the point in piece B's axes),
+        ``body_contact_normal_impulse`` ``(C,)`` and ``body_contact_friction_impulse``
+        ``(C, 3)`` [N·s]; empty at the start."""
+        return dict(zip(MEMORY, (np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0),
+                                 np.zeros((0, 3))), strict=True))  # fmt: skip
+
+    def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
+        """The state with the bodies' contacts resolved."""
+        parts = tuple(np.array(part) for part in after.parts)
+        result = after.from_parts(after.t, parts)
+        x = result["body_position"]
+        q = result["body_orientation"]
+        momentum = result["body_momentum"]
+        spin = result["body_angular_momentum"]
+        memory = tuple(after[name] for name in MEMORY)
+        memory, found = self.resolve(x, q, momentum, spin, h, memory)
+        work.get(self, dict)["solved"] = found
+        return result.with_carried(**dict(zip(MEMORY, memory, strict=True)))
+
+    def solved(self, work: Workspace) -> BodyContactSet | None:
+        """The contacts the latest step of the run whose storage is ``work`` solved."""
+        scratch = work.peek(self)
+        return None if scratch is None else scratch.get("solved")
+
+    def detect(self, x: np.ndarray, rotation: np.ndarray, margin: np.ndarray) -> tuple:
+        """The contacts at centres of mass ``x`` ``(B, 3)`` and rotations ``(B, 3, 3)``, with
+        speculative reach ``margin`` ``(B,)`` [m]: ``(piece_a, piece_b, point, normal,
+        depth)`` and the pieces' world poses."""
+        pieces = self.pieces
+        arrays = pieces.arrays()
+        position = pieces.local_position.copy()
+        turn = pieces.local_rotation.copy()
+        lo = np.empty((pieces.count, 3))
+        hi = np.empty((pieces.count, 3))
+        piece_poses(arrays, pieces.body, x, rotation, margin, position, turn, lo, hi)
+        active = np.ones(pieces.count, dtype=np.bool_)
+        pairs = overlapping_pairs(lo, hi, active)
+        # Two pieces of bodies that nothing moves never need contacts.
+        moving = np.append(self.dynamic, False)[pieces.body]
+        pairs = pairs[moving[pairs[:, 0]] | moving[pairs[:, 1]]]
+        planes = self.planes
+        capacity = MAX_CONTACTS * (pairs.shape[0] + planes.point.shape[0] * pieces.count)
+        out = contact_arrays(capacity)
+        count = pair_contacts(arrays, pieces.body, pairs, position, turn, margin, out)
+        count = plane_contacts(arrays, pieces.body, position, turn, lo, hi, margin, planes.point,
+                               planes.normal, planes.thickness, out, count)  # fmt: skip
+        return tuple(a[:count] for a in out), position, turn
+
+    def resolve(self, x, q, momentum, spin, h, memory):
+        """Resolve one step's contacts in place on the bodies' ``x``, ``q``, ``P``, ``L``
+        (``(B, 3)``, ``(B, 4)``, ``(B, 3)``, ``(B, 3)``); ``memory`` the last step's carried
+        impulses. Returns this step's memory and its :class:`BodyContactSet`."""
+        rotation = quaternion_matrix(q)
+        inverse_inertia = rotation @ self.inverse_inertia_body @ rotation.transpose(0, 2, 1)
+        v = momentum * self.inverse_mass[:, None]
+        w = np.einsum("bij,bj->bi", inverse_inertia, spin)
+        speed = np.linalg.norm(v, axis=1) + np.linalg.norm(w, axis=1) * self.size
+        margin = h * speed + SPECULATIVE * self.size
+        (piece_a, piece_b, point, normal, depth), position, turn = self.detect(x, rotation, margin)
+        pieces = self.pieces
+        body_a = np.where(piece_a >= 0, pieces.body[np.maximum(piece_a, 0)], -1)
+        body_b = pieces.body[piece_b]
+        restitution, friction = self._coefficients(piece_a, piece_b)
+        count = piece_a.shape[0]
+        arm_a, arm_b = np.zeros((count, 3)), np.zeros((count, 3))
+        frame = np.zeros((count, 2, 3))
+        mass_n, mass_t, target = np.zeros(count), np.zeros((count, 2)), np.zeros(count)
+        prepare_contacts(body_a, body_b, point, normal, depth, restitution, self.resting_speed,
+                         h, x, self.inverse_mass, inverse_inertia, v, w, arm_a, arm_b, frame,
+                         mass_n, mass_t, target)  # fmt: skip
+        velocity_before = _normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w)
+        key = (piece_a + self.planes.point.shape[0]) * (pieces.count + 1) + piece_b
+        anchor = np.einsum("cji,cj->ci", turn[piece_b], point - position[piece_b])
+        normal_impulse = np.zeros(count)
+        tangent_impulse = np.zeros((count, 2))
+        _warm_start(key, anchor, MATCH * pieces.radius[piece_b], frame, *memory,
+                    normal_impulse, tangent_impulse)  # fmt: skip
+        solve_impulses(body_a, body_b, normal, friction, arm_a, arm_b, frame, mass_n, mass_t,
+                       target, self.inverse_mass, inverse_inertia, v, w, normal_impulse,
+                       tangent_impulse, self.iterations)  # fmt: skip
+        shift, twist = np.zeros_like(x), np.zeros_like(x)
+        smaller = np.minimum(
+            np.where(piece_a >= 0, pieces.radius[np.maximum(piece_a, 0)], np.inf),
+            pieces.radius[piece_b],
+        )
+        allowance = ALLOWANCE * float(smaller.min()) if count else 0.0
+        correct_positions(body_a, body_b, normal, depth, arm_a, arm_b, mass_n,
+                          self.inverse_mass, inverse_inertia, allowance, CORRECTION,
+                          self.iterations, shift, twist)  # fmt: skip
+        x += shift
+        q[...] = _turned(q, twist)
+        # Back to momenta, with the inertia of the step's end (world frame).
+        momentum[...] = np.where(
+            self.dynamic[:, None],
+            v / np.where(self.inverse_mass > 0, self.inverse_mass, 1.0)[:, None],
+            momentum,
+        )
+        inertia = rotation @ self.inertia @ rotation.transpose(0, 2, 1)
+        spin[...] = np.where(self.dynamic[:, None], np.einsum("bij,bj->bi", inertia, w), spin)
+        friction_world = np.einsum("ct,ctk->ck", tangent_impulse, frame)
+        found = BodyContactSet(piece_a, piece_b, body_a, body_b, point, normal, depth,
+                               velocity_before, normal_impulse)  # fmt: skip
+        return (key, anchor, normal_impulse.copy(), friction_world), found
+
+    def _coefficients(self, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Each contact's restitution and friction (the pair rule, or the stage's value)."""
+        pieces, planes = self.pieces, self.planes
+        plane = -1 - np.minimum(piece_a, -1)
+        on_plane = piece_a < 0
+        index = np.maximum(piece_a, 0)
+        e_a = np.where(on_plane, planes.restitution[plane] if planes.point.shape[0] else 0.0,
+                       pieces.restitution[index])  # fmt: skip
+        mu_a = np.where(on_plane, planes.friction[plane] if planes.point.shape[0] else 0.0,
+                        pieces.friction[index])  # fmt: skip
+        e = np.maximum(e_a, pieces.restitution[piece_b])
+        mu = np.sqrt(mu_a * pieces.friction[piece_b])
+        if self.restitution is not None:
+            e = np.full_like(e, self.restitution)
+        if self.friction is not None:
+            mu = np.full_like(mu, self.friction)
+        return e, mu
+
+
+def _normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w) -> np.ndarray:
+    """Each contact's relative normal velocity ``n·(v_b + ω_b × r_b − v_a − ω_a × r_a)``."""
+    zero = np.zeros((1, 3))
+    va = np.concatenate([v, zero])[body_a] + np.cross(np.concatenate([w, zero])[body_a], arm_a)
+    vb = np.concatenate([v, zero])[body_b] + np.cross(np.concatenate([w, zero])[body_b], arm_b)
+    return np.einsum("ck,ck->c", vb - va, normal)
+
+
+def _turned(q: np.ndarray, twist: np.ndarray) -> np.ndarray:
+    """Quaternions turned by small world rotation vectors: ``q + ½ (0, θ) ⊗ q``, normalized."""
+    w, x, y, z = q.T
+    tx, ty, tz = twist.T
+    dq = 0.5 * np.stack([
+        -tx * x - ty * y - tz * z,
+        tx * w + ty * z - tz * y,
+        ty * w + tz * x - tx * z,
+        tz * w + tx * y - ty * x,
+    ], axis=1)  # fmt: skip
+    turned = q + dq
+    return turned / np.linalg.norm(turned, axis=1, keepdims=True)
+
+
+@njit(cache=True)
+def _warm_start(key, anchor, tolerance, frame, old_key, old_anchor, old_normal, old_friction,
+                normal_impulse, tangent_impulse):  # fmt: skip
+    """Start each contact from the impulses of the last step's contact of the same pair of
+    pieces whose anchor lay nearest, within ``tolerance`` [m]; friction projected on the new
+    tangents."""
+    if old_key.shape[0] == 0:
+        return
+    order = np.argsort(old_key, kind="mergesort")
+    sorted_keys = old_key[order]
+    for c in range(key.shape[0]):
+        first = np.searchsorted(sorted_keys, key[c])
+        best = -1
+        best_distance = tolerance[c] * tolerance[c]
+        k = first
+        while k < sorted_keys.shape[0] and sorted_keys[k] == key[c]:
+            o = order[k]
+            d = np.sum((old_anchor[o] - anchor[c]) ** 2)
+            if d <= best_distance:
+                best_distance = d
+                best = o
+            k += 1
+        if best >= 0:
+            normal_impulse[c] = old_normal[best]
+            for t in range(2):
+                tangent_impulse[c, t] = (
+                    old_friction[best, 0] * frame[c, t, 0]
+                    + old_friction[best, 1] * frame[c, t, 1]
+                    + old_friction[best, 2] * frame[c, t, 2]
+                )

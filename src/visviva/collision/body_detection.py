@@ -1,0 +1,141 @@
+"""Finding the contacts of rigid bodies: poses of their pieces, broad phase, narrow phase.
+
+:func:`piece_poses` places every piece (:mod:`~visviva.collision.body_pieces`) in the world
+from its body's centre of mass and rotation, with its bounding box grown by its margin;
+:func:`~visviva.collision.broad_phase.overlapping_pairs` keeps the pairs whose boxes overlap;
+:func:`pair_contacts` runs GJK/EPA and the manifold on each (:mod:`~visviva.collision.separation`,
+:mod:`~visviva.collision.manifold`) and :func:`plane_contacts` each piece against each plane.
+Contacts come out in the order of their pairs, then of their planes: the same on every run.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .body_pieces import piece_shape
+from .broad_phase import shape_bounds
+from .manifold import CANDIDATES, MAX_CONTACTS, contact_manifold, plane_manifold
+from .separation import plane_separation, shape_distance
+
+__all__ = ["pair_contacts", "piece_poses", "plane_contacts"]
+
+
+@njit(cache=True)
+def piece_poses(pieces, body, position, rotation, margin, piece_position, piece_rotation, lo, hi):
+    """Each piece's world pose and bounding box grown by ``margin[b]`` [m] of its body
+    (static pieces keep their pose and grow by nothing).
+
+    Args:
+        pieces: :meth:`~visviva.collision.body_pieces.BodyPieces.arrays`.
+        body: ``(P,)`` each piece's body (``-1``: static).
+        position, rotation: ``(B, 3)`` centres of mass [m] and ``(B, 3, 3)`` rotations.
+        margin: ``(B,)`` [m].
+        piece_position, piece_rotation: ``(P, 3)``, ``(P, 3, 3)``: the local poses on entry
+            (``BodyPieces.local_position``/``local_rotation``), the world poses on return.
+        lo, hi: ``(P, 3)`` outputs.
+    """
+    for p in range(body.shape[0]):
+        b = body[p]
+        grow = 0.0
+        if b >= 0:
+            local = piece_position[p].copy()
+            turn = piece_rotation[p].copy()
+            piece_position[p] = position[b] + rotation[b] @ local
+            piece_rotation[p] = rotation[b] @ turn
+            grow = margin[b]
+        shape = piece_shape(p, pieces, piece_position[p], piece_rotation[p])
+        shape_bounds(shape[0], shape[1], shape[2], shape[6], shape[7], grow, lo, hi, p)
+
+
+@njit(cache=True)
+def pair_contacts(pieces, body, pairs, piece_position, piece_rotation, margin, out):
+    """The contacts of each candidate pair of pieces, appended to ``out``.
+
+    Args:
+        pairs: ``(K, 2)`` piece pairs from the broad phase.
+        margin: ``(B,)`` speculative reach of each body [m]: a pair keeps contacts whose gap
+            is at most the sum of its bodies'.
+        out: ``(piece_a, piece_b, point (C, 3), normal (C, 3), depth (C,))`` of capacity
+            ``MAX_CONTACTS · K``.
+
+    Returns:
+        How many contacts were written.
+    """
+    piece_a, piece_b, point, normal, depth = out
+    points = np.empty((CANDIDATES, 3))
+    depths = np.empty(CANDIDATES)
+    count = 0
+    for k in range(pairs.shape[0]):
+        i, j = pairs[k, 0], pairs[k, 1]
+        a, b = body[i], body[j]
+        if a == b:
+            continue
+        reach = (margin[a] if a >= 0 else 0.0) + (margin[b] if b >= 0 else 0.0)
+        shape_a = piece_shape(i, pieces, piece_position[i], piece_rotation[i])
+        shape_b = piece_shape(j, pieces, piece_position[j], piece_rotation[j])
+        separation = shape_distance(shape_a, shape_b)
+        found, nx, ny, nz = contact_manifold(shape_a, shape_b, separation, reach, points, depths)
+        for c in range(found):
+            piece_a[count], piece_b[count] = i, j
+            point[count] = points[c]
+            normal[count, 0], normal[count, 1], normal[count, 2] = nx, ny, nz
+            depth[count] = depths[c]
+            count += 1
+    return count
+
+
+@njit(cache=True)
+def plane_contacts(pieces, body, piece_position, piece_rotation, lo, hi, margin,
+                   plane_point, plane_normal, plane_thickness, out, start):  # fmt: skip
+    """The contacts of every moving piece with every plane, appended to ``out`` from row
+    ``start``; the plane is recorded as piece ``-1 − plane``. Returns the new count."""
+    piece_a, piece_b, point, normal, depth = out
+    points = np.empty((CANDIDATES, 3))
+    depths = np.empty(CANDIDATES)
+    count = start
+    for f in range(plane_point.shape[0]):
+        for p in range(body.shape[0]):
+            b = body[p]
+            if b < 0:
+                continue
+            # The bounding box's lowest corner along the normal tells whether it may touch.
+            low = 0.0
+            for axis in range(3):
+                n = plane_normal[f, axis]
+                low += (lo[p, axis] if n >= 0.0 else hi[p, axis]) * n
+            low -= (
+                plane_point[f, 0] * plane_normal[f, 0]
+                + plane_point[f, 1] * plane_normal[f, 1]
+                + plane_point[f, 2] * plane_normal[f, 2]
+            )
+            if low > 0.0:
+                continue
+            shape = piece_shape(p, pieces, piece_position[p], piece_rotation[p])
+            separation = plane_separation(
+                plane_point[f], plane_normal[f], plane_thickness[f], shape
+            )
+            found, nx, ny, nz = plane_manifold(separation, shape, margin[b], points, depths)
+            for c in range(found):
+                if count == piece_a.shape[0]:
+                    return count
+                piece_a[count], piece_b[count] = -1 - f, p
+                point[count] = points[c]
+                normal[count, 0], normal[count, 1], normal[count, 2] = nx, ny, nz
+                depth[count] = depths[c]
+                count += 1
+    return count
+
+
+def contact_arrays(capacity: int) -> tuple[np.ndarray, ...]:
+    """Empty output arrays for :func:`pair_contacts` and :func:`plane_contacts`."""
+    return (
+        np.empty(capacity, dtype=np.int64),
+        np.empty(capacity, dtype=np.int64),
+        np.empty((capacity, 3)),
+        np.empty((capacity, 3)),
+        np.empty(capacity),
+    )
+
+
+__all__ += ["MAX_CONTACTS", "contact_arrays"]
