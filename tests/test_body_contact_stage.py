@@ -44,8 +44,8 @@ def _run(shapes, mass, inertia, x0, steps, *, e, mu=0.5):
 
 
 def test_a_ball_bounces_to_about_e_squared_of_its_drop():
-    # Dropped from 1 m, it leaves the floor at e·√(2gh) and rises to e²h. Without the time of
-    # impact the bounce happens at the step's end, up to v·h away: within 3 % here.
+    # Dropped from 1 m, it leaves the floor at e·√(2gh) and rises to e²h. Symplectic Euler's
+    # own error under gravity, −v h/2 on the rise, is 2 % of e²h here.
     r = 0.1
     path, _ = _run([Sphere((0.0, 0.0, 0.0), r)], [1.0], [0.004 * np.eye(3)],
                    [[0.0, 1.0 + r, 0.0]], 400, e=0.5)  # fmt: skip
@@ -62,17 +62,13 @@ def test_a_box_rests_on_the_floor_without_sinking_or_turning():
     assert q[0] == pytest.approx([1.0, 0.0, 0.0, 0.0], abs=1e-8)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 27, open: the stack settles vertically but its upper boxes creep sideways "
-    "(~0.1 mm/s at the top); the position correction's turns or the friction sweep order",
-)
-def test_a_stack_of_ten_boxes_settles_and_does_not_creep():
+def test_a_stack_of_ten_boxes_stands_still_for_ten_seconds():
+    # Issue 27: every box within 1 mm of its start for 10 s, residual speed below 1e-3 m/s.
     inertia = np.eye(3) / 6.0
     count = 10
     path, _ = _run([Box((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))] * count, [1.0] * count,
-                   [inertia] * count, [[0.0, 0.5 + i, 0.0] for i in range(count)], 1200,
+                   [inertia] * count, [[0.0, 0.5 + i, 0.0] for i in range(count)], 2400,
                    e=0.0)  # fmt: skip
-    # Settled within 5 mm, and no further motion between 2.5 s and 5 s.
-    assert np.abs(path[-1] - path[0]).max() < 5e-3
-    assert np.abs(path[-1] - path[600]).max() < 1e-5
+    assert np.linalg.norm(path - path[0], axis=2).max() < 1e-3
+    speed = np.linalg.norm(path[-1] - path[-2], axis=1) / H
+    assert speed.max() < 1e-3

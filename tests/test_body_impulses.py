@@ -147,14 +147,18 @@ def test_friction_stops_a_slow_slide_and_is_bounded_by_mu_lambda():
     assert v[0] == pytest.approx([2.8, 0.0, 0.0], abs=1e-12)
 
 
-def test_a_speculative_contact_lets_the_gap_close_and_no_more():
-    # 1 cm apart, approaching at 0.5 m/s with h = 0.01 s: it would cover 5 mm, less than the
-    # gap, so nothing stops it; at 2 m/s it would cover 2 cm: it collides now (e = 0.5).
-    for speed, expected in ((0.5, -0.5), (2.0, 1.0)):
+def test_targets_are_posed_on_the_depth_at_the_steps_start():
+    # Depths are measured at the step's end (h = 0.01 s). Ending 5 mm apart at 0.5 m/s: it
+    # started 1 cm apart and is free to go on. Ending 1 cm deep at 2 m/s: it touched within the
+    # step, fast: it collides (e = 0.5). Ending 0.2 mm deep at 0.05 m/s, below the resting
+    # speed 0.1 m/s: it started 0.3 mm apart and may close that gap only: -0.03 m/s. Ending
+    # 1 mm deep at that speed it started 0.5 mm deep: it stops.
+    cases = ((0.5, -0.005, -0.5), (2.0, 0.01, 1.0), (0.05, 2e-4, -0.03), (0.05, 1e-3, 0.0))
+    for speed, depth, expected in cases:
         v = np.array([[0.0, -speed, 0.0]])
-        _solve([-1], [0], [[0.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]], [-0.01], [0.5], [0.0],
+        _solve([-1], [0], [[0.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]], [depth], [0.5], [0.0],
                np.array([[0.0, 0.5, 0.0]]), np.array([1.0]), np.zeros((1, 3, 3)), v,
-               np.zeros((1, 3)), iterations=4)  # fmt: skip
+               np.zeros((1, 3)), iterations=4, resting_speed=0.1)  # fmt: skip
         assert v[0, 1] == pytest.approx(expected)
 
 

@@ -9,9 +9,15 @@ into static convex scenery and into planes:
    ``h (|v| + |ω| r)``, plus :data:`SPECULATIVE` of its size — swept and pruned, then GJK/EPA
    and the contact manifold per candidate pair, and every moving piece against every plane.
 2. **Impulses** (velocities): sequential impulses with restitution and Coulomb friction
-   (:mod:`~visviva.collision.body_impulses`), warm-started from the impulses of the last step's
-   contacts at the same place on the same pair of pieces (carried in the state).
-3. **Position correction**: what overlap is left beyond :data:`ALLOWANCE` of the smaller
+   (:mod:`~visviva.collision.body_impulses`), swept bottom-up along gravity (a stack's support
+   first) and warm-started from the impulses of the last step's contacts at the same place on
+   the same pair of pieces (carried in the state).
+3. **The step again**: each body is moved by ``(1 − τ) h Δv`` and turned by ``(1 − τ) h Δω``
+   for the velocity change the impulses made, as if it had moved with its old velocity until
+   its earliest collision of the step, at the fraction ``τ`` (from the contact's depths at the
+   step's start and end, to first order; 0 for a body that only rests) and with the new one
+   after: a resting body stays where it was, a bouncing one leaves from where it hit.
+4. **Position correction**: what overlap is left beyond :data:`ALLOWANCE` of the smaller
    piece's size is removed by moving and turning the bodies (velocities untouched).
 
 A pair's coefficients are the larger restitution of the two and the geometric mean of their
@@ -21,6 +27,7 @@ makes any pair slippery), unless the stage is given one value for every pair.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
@@ -113,6 +120,7 @@ class BodyContacts:
         iterations: Sweeps of impulses, and of position corrections, per step.
         resting_speed: Approach speed [m/s] below which a contact rests.
         restitution, friction: One coefficient for every pair, or ``None`` for the pair rule.
+        gravity: Gravitational acceleration [m/s²]: the contacts are swept against it.
     """
 
     phase: ClassVar[Phase] = Phase.CONTACTS
@@ -133,6 +141,7 @@ class BodyContacts:
         resting_speed: float = 0.0,
         restitution: float | None = None,
         friction: float | None = None,
+        gravity: Sequence[float] = (0.0, -9.81, 0.0),
     ) -> None:
         self.pieces = pieces
         self.count = int(np.shape(mass)[0])
@@ -148,6 +157,9 @@ class BodyContacts:
         self.resting_speed = resting_speed
         self.restitution = restitution
         self.friction = friction
+        g = np.asarray(gravity, dtype=np.float64)
+        size = float(np.linalg.norm(g))
+        self.up = -g / size if size > 0.0 else np.zeros(3)
         # Each body's size: its largest piece's reach from the centre of mass.
         size = np.zeros(self.count)
         for p in range(pieces.count):
@@ -217,7 +229,11 @@ class BodyContacts:
         w = np.einsum("bij,bj->bi", inverse_inertia, spin)
         speed = np.linalg.norm(v, axis=1) + np.linalg.norm(w, axis=1) * self.size
         margin = h * speed + SPECULATIVE * self.size
-        (piece_a, piece_b, point, normal, depth), position, turn = self.detect(x, rotation, margin)
+        found, position, turn = self.detect(x, rotation, margin)
+        # Bottom up along gravity: a stack's support is met before what rests on it, which
+        # is what a sweep needs to carry the weight down in few iterations.
+        order = np.argsort(found[2] @ self.up, kind="stable")
+        piece_a, piece_b, point, normal, depth = (a[order] for a in found)
         pieces = self.pieces
         body_a = np.where(piece_a >= 0, pieces.body[np.maximum(piece_a, 0)], -1)
         body_b = pieces.body[piece_b]
@@ -236,32 +252,58 @@ class BodyContacts:
         tangent_impulse = np.zeros((count, 2))
         _warm_start(key, anchor, MATCH * pieces.radius[piece_b], frame, *memory,
                     normal_impulse, tangent_impulse)  # fmt: skip
+        v_start, w_start = v.copy(), w.copy()
         solve_impulses(body_a, body_b, normal, friction, arm_a, arm_b, frame, mass_n, mass_t,
                        target, self.inverse_mass, inverse_inertia, v, w, normal_impulse,
                        tangent_impulse, self.iterations)  # fmt: skip
-        shift, twist = np.zeros_like(x), np.zeros_like(x)
+        # The step again with the new velocities: a body that collided within the step moves
+        # with its old velocity until the impact (the fraction τ of the step at which its
+        # earliest colliding contact touched, to first order), with the new one after; the
+        # others as if they had had the new velocity all along. So each body is moved by
+        # (1 − τ) h Δv and turned by (1 − τ) h Δω.
+        impact = self._impact_fractions(body_a, body_b, depth, velocity_before, h)
+        remainder = h * (1.0 - impact)[:, None]
+        shift = remainder * (v - v_start)
+        twist = remainder * (w - w_start)
+        moved = _normal_velocities(body_a, body_b, normal, arm_a, arm_b, shift, twist)
+        remaining = depth - moved
         smaller = np.minimum(
             np.where(piece_a >= 0, pieces.radius[np.maximum(piece_a, 0)], np.inf),
             pieces.radius[piece_b],
         )
         allowance = ALLOWANCE * float(smaller.min()) if count else 0.0
-        correct_positions(body_a, body_b, normal, depth, arm_a, arm_b, mass_n,
+        correction, turn_correction = np.zeros_like(x), np.zeros_like(x)
+        correct_positions(body_a, body_b, normal, remaining, arm_a, arm_b, mass_n,
                           self.inverse_mass, inverse_inertia, allowance, CORRECTION,
-                          self.iterations, shift, twist)  # fmt: skip
-        x += shift
-        q[...] = _turned(q, twist)
+                          self.iterations, correction, turn_correction)  # fmt: skip
+        x += shift + correction
+        q[...] = _turned(q, twist + turn_correction)
         # Back to momenta, with the inertia of the step's end (world frame).
-        momentum[...] = np.where(
-            self.dynamic[:, None],
-            v / np.where(self.inverse_mass > 0, self.inverse_mass, 1.0)[:, None],
-            momentum,
-        )
+        mass = np.where(self.dynamic, 1.0 / np.where(self.dynamic, self.inverse_mass, 1.0), 0.0)
+        momentum[...] = np.where(self.dynamic[:, None], mass[:, None] * v, momentum)
         inertia = rotation @ self.inertia @ rotation.transpose(0, 2, 1)
         spin[...] = np.where(self.dynamic[:, None], np.einsum("bij,bj->bi", inertia, w), spin)
         friction_world = np.einsum("ct,ctk->ck", tangent_impulse, frame)
         found = BodyContactSet(piece_a, piece_b, body_a, body_b, point, normal, depth,
                                velocity_before, normal_impulse)  # fmt: skip
         return (key, anchor, normal_impulse.copy(), friction_world), found
+
+    def _impact_fractions(self, body_a, body_b, depth, approach, h) -> np.ndarray:
+        """``(B,)``: for each body, the fraction ``τ`` of the step at which its earliest
+        colliding contact touched, 0 for a body with none. A contact that approaches at
+        ``v_n`` < −resting speed and ends ``d`` ≥ 0 deep started ``h|v_n| − d`` apart; moving
+        linearly, it touched at ``τ = 1 − d / (h|v_n|)``."""
+        colliding = (depth >= 0.0) & (approach < -self.resting_speed)
+        if not colliding.any():
+            return np.zeros(self.count)
+        closing = -h * approach[colliding]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tau = np.clip(1.0 - depth[colliding] / closing, 0.0, 1.0)
+        tau = np.where(np.isfinite(tau), tau, 0.0)
+        earliest = np.ones(self.count + 1)  # the last entry stands for the world (-1)
+        np.minimum.at(earliest, body_a[colliding], tau)
+        np.minimum.at(earliest, body_b[colliding], tau)
+        return np.where(earliest < 1.0, earliest, 0.0)[: self.count]
 
     def _coefficients(self, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple[np.ndarray, ...]:
         """Each contact's restitution and friction (the pair rule, or the stage's value)."""

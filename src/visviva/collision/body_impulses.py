@@ -26,10 +26,14 @@ impulses, a projected Gauss–Seidel iteration on the contacts' accumulated impu
 "Iterative dynamics with temporal coherence", GDC 2005): each sweep gives each contact the
 impulse that brings its ``v_n`` to its target, keeps the accumulated normal impulse ``λ ≥ 0``
 (contacts push, never pull), and a friction impulse in the tangent plane that opposes the
-sliding, its accumulated size at most ``μ λ`` (Coulomb's cone). The target is ``−e v_n⁻`` for
-a contact that approached faster than the resting speed (it collides), 0 for one that rests
-(B. Mirtich, J. Canny, "Impulse-based simulation of rigid bodies", I3D 1995), and
-``−gap/h`` for a speculative contact a gap apart: it may close the gap this step but not more.
+sliding, its accumulated size at most ``μ λ`` (Coulomb's cone). The contacts are found at the
+step's end poses, and the bodies are moved again by ``h Δv`` (and turned by ``h Δω``) for the
+velocity change ``Δv`` the impulses make — what the step would have done had the bodies had
+those velocities — so the target is posed on the depth at the step's start,
+``d₀ = d + h v_n``: ``−e v_n`` for a contact that reaches the other body within the step faster
+than the resting speed (it collides), and otherwise ``min(d₀, 0)/h``: a resting contact stops
+(B. Mirtich, J. Canny, "Impulse-based simulation of rigid bodies", I3D 1995), and a
+speculative one a gap apart may close the gap this step but not more.
 Friction and restitution act through the same impulses as in E. Guendelman, R. Bridson,
 R. Fedkiw, "Nonconvex rigid bodies with stacking", SIGGRAPH 2003: both change the spin.
 
@@ -126,7 +130,8 @@ def prepare_contacts(
     Args:
         body_a, body_b: ``(C,)`` the bodies (``-1``: the world).
         point, normal: ``(C, 3)`` contact points [m] and unit normals from A toward B.
-        depth: ``(C,)`` penetration [m], negative for a speculative contact's gap.
+        depth: ``(C,)`` penetration [m] at the step's end poses (after the bodies moved by
+            ``h v``), negative for a speculative contact's gap.
         restitution: ``(C,)`` coefficient of restitution of each contact's pair.
         resting_speed: Approach speed [m/s] below which a contact rests rather than bounces.
         h: The step [s].
@@ -162,15 +167,14 @@ def prepare_contacts(
         vax, vay, vaz = _point_velocity(a, v, w, rax, ray, raz)
         vbx, vby, vbz = _point_velocity(b, v, w, rbx, rby, rbz)
         v_n = (vbx - vax) * nx + (vby - vay) * ny + (vbz - vaz) * nz
-        gap = -depth[c]
-        if gap > 0.0 and v_n * h > -gap:
-            # A speculative contact that will not close its gap this step: it may approach
-            # by the gap, no more.
-            target[c] = -gap / h
-        elif v_n < -resting_speed:
+        # The depth at the step's start, to first order: the end's less the approach.
+        start = depth[c] + h * v_n
+        if v_n < -resting_speed and depth[c] >= 0.0:
+            # It reaches the other body within the step, fast: it collides.
             target[c] = -restitution[c] * v_n
         else:
-            target[c] = 0.0
+            # It rests, or has a gap it may close this step but not more (speculative).
+            target[c] = min(start, 0.0) / h
 
 
 @njit(cache=True)
