@@ -186,7 +186,10 @@ class BodyContacts:
         momentum = result["body_momentum"]
         spin = result["body_angular_momentum"]
         memory = tuple(after[name] for name in MEMORY)
-        memory, found = self.resolve(x, q, momentum, spin, h, memory)
+        q0 = before["body_orientation"]
+        v0, w0 = self.velocities(q0, before["body_momentum"], before["body_angular_momentum"])
+        start = (before["body_position"], q0, v0, w0)
+        memory, found = self.resolve(x, q, momentum, spin, h, memory, start)
         work.get(self, dict)["solved"] = found
         return result.with_carried(**dict(zip(MEMORY, memory, strict=True)))
 
@@ -219,10 +222,20 @@ class BodyContacts:
                                planes.normal, planes.thickness, out, count)  # fmt: skip
         return tuple(a[:count] for a in out), position, turn
 
-    def resolve(self, x, q, momentum, spin, h, memory):
+    def velocities(self, q: np.ndarray, momentum: np.ndarray, spin: np.ndarray) -> tuple:
+        """``v = P/M`` and ``ω = I⁻¹ L`` ``(B, 3)`` of the dynamic bodies (0 for the others)."""
+        rotation = quaternion_matrix(q)
+        inverse_inertia = rotation @ self.inverse_inertia_body @ rotation.transpose(0, 2, 1)
+        return momentum * self.inverse_mass[:, None], np.einsum("bij,bj->bi", inverse_inertia, spin)
+
+    def resolve(self, x, q, momentum, spin, h, memory, start=None):
         """Resolve one step's contacts in place on the bodies' ``x``, ``q``, ``P``, ``L``
         (``(B, 3)``, ``(B, 4)``, ``(B, 3)``, ``(B, 3)``); ``memory`` the last step's carried
-        impulses. Returns this step's memory and its :class:`BodyContactSet`."""
+        impulses; ``start`` the bodies at the step's start, ``(x, q, v, ω)``, if known: the
+        contacts' depths at the start are then measured from how the bodies moved, and a
+        collision within the step reverses the approach at the moment of impact, not the
+        step's end. Returns this step's memory and its
+        :class:`BodyContactSet`."""
         rotation = quaternion_matrix(q)
         inverse_inertia = rotation @ self.inverse_inertia_body @ rotation.transpose(0, 2, 1)
         v = momentum * self.inverse_mass[:, None]
@@ -242,10 +255,15 @@ class BodyContacts:
         arm_a, arm_b = np.zeros((count, 3)), np.zeros((count, 3))
         frame = np.zeros((count, 2, 3))
         mass_n, mass_t, target = np.zeros(count), np.zeros((count, 2)), np.zeros(count)
-        prepare_contacts(body_a, body_b, point, normal, depth, restitution, self.resting_speed,
+        start_depth = self._start_depths(body_a, body_b, point, normal, depth, x, rotation, start)
+        prepare_contacts(body_a, body_b, point, normal, depth, start_depth, restitution,
+                         self.resting_speed,
                          h, x, self.inverse_mass, inverse_inertia, v, w, arm_a, arm_b, frame,
                          mass_n, mass_t, target)  # fmt: skip
         velocity_before = _normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w)
+        if start is not None:
+            self._reverse_at_impact(body_a, body_b, normal, arm_a, arm_b, depth, start_depth,
+                                    restitution, velocity_before, start[2:], target)  # fmt: skip
         key = (piece_a + self.planes.point.shape[0]) * (pieces.count + 1) + piece_b
         anchor = np.einsum("cji,cj->ci", turn[piece_b], point - position[piece_b])
         normal_impulse = np.zeros(count)
@@ -257,14 +275,19 @@ class BodyContacts:
                        target, self.inverse_mass, inverse_inertia, v, w, normal_impulse,
                        tangent_impulse, self.iterations)  # fmt: skip
         # The step again with the new velocities: a body that collided within the step moves
-        # with its old velocity until the impact (the fraction τ of the step at which its
-        # earliest colliding contact touched, to first order), with the new one after; the
-        # others as if they had had the new velocity all along. So each body is moved by
-        # (1 − τ) h Δv and turned by (1 − τ) h Δω.
-        impact = self._impact_fractions(body_a, body_b, depth, velocity_before, h)
-        remainder = h * (1.0 - impact)[:, None]
-        shift = remainder * (v - v_start)
-        twist = remainder * (w - w_start)
+        # as the integrator moved it until the impact (the fraction τ of the step at which its
+        # earliest colliding contact touched, to first order), with its new velocity after;
+        # the others touched as if they had had the new velocity all along. So each body the
+        # impulses changed ends at x(τ) + (1 − τ) h v: moved by (1 − τ)(h v − Δx) for the
+        # step's move Δx (h v before the impulses if the start is unknown), turned likewise.
+        impact = self._impact_fractions(body_a, body_b, depth, start_depth, velocity_before, h)
+        remainder = (1.0 - impact)[:, None]
+        travel, rotation_vector = (
+            (h * v_start, h * w_start) if start is None else _moves(start[0], start[1], x, q)
+        )
+        touched = (np.any(v != v_start, axis=1) | np.any(w != w_start, axis=1))[:, None]
+        shift = np.where(touched, remainder * (h * v - travel), 0.0)
+        twist = np.where(touched, remainder * (h * w - rotation_vector), 0.0)
         moved = _normal_velocities(body_a, body_b, normal, arm_a, arm_b, shift, twist)
         remaining = depth - moved
         smaller = np.minimum(
@@ -288,18 +311,58 @@ class BodyContacts:
                                velocity_before, normal_impulse)  # fmt: skip
         return (key, anchor, normal_impulse.copy(), friction_world), found
 
-    def _impact_fractions(self, body_a, body_b, depth, approach, h) -> np.ndarray:
+    def _start_depths(self, body_a, body_b, point, normal, depth, x, rotation, start):
+        """Each contact's depth at the step's start ``(C,)`` [m]: the end depth plus how far
+        the two material points at the contact moved toward each other along ``n`` over the
+        step (a point at arm ``r`` from the centre at the end was at ``x₀ + R₀ R₁ᵀ r``); NaN
+        when the start is unknown."""
+        if start is None:
+            return np.full(depth.shape, np.nan)
+        x0, q0 = start[0], start[1]
+        turn = quaternion_matrix(q0) @ rotation.transpose(0, 2, 1)  # R₀ R₁ᵀ
+        moved = np.zeros(point.shape)
+        for body, sign in ((body_b, 1.0), (body_a, -1.0)):
+            real = body >= 0
+            b = body[real]
+            arm = point[real] - x[b]
+            earlier = x0[b] + np.einsum("cij,cj->ci", turn[b], arm)
+            moved[real] += sign * (point[real] - earlier)
+        return depth + np.einsum("ck,ck->c", moved, normal)
+
+    @staticmethod
+    def _impact_times(depth, start_depth):
+        """The fraction of the step at which each contact touched, moving linearly from its
+        start depth to its end depth (0 if it overlapped already at the start)."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tau = np.where(start_depth < 0.0, start_depth / (start_depth - depth), 0.0)
+        return np.clip(np.where(np.isfinite(tau), tau, 0.0), 0.0, 1.0)
+
+    def _reverse_at_impact(self, body_a, body_b, normal, arm_a, arm_b, depth, start_depth,
+                           restitution, approach, start, target):  # fmt: skip
+        """Targets of the colliding contacts from the approach at the impact: the forces of
+        the step (gravity) change a contact's normal velocity from ``v₀`` at the start to
+        ``v₁`` at the end; at the impact, the fraction ``τ`` of the step, it is
+        ``v₀ + τ (v₁ − v₀)``; reversed with restitution and changed by the forces for the rest
+        of the step, the target is ``−e (v₀ + τ (v₁ − v₀)) + (1 − τ)(v₁ − v₀)``."""
+        colliding = (depth >= 0.0) & (approach < -self.resting_speed)
+        if not colliding.any():
+            return
+        initial = _normal_velocities(body_a, body_b, normal, arm_a, arm_b, *start)
+        tau = self._impact_times(depth, start_depth)
+        change = approach - initial
+        at_impact = np.minimum(initial + tau * change, 0.0)
+        reversed_ = -restitution * at_impact + (1.0 - tau) * change
+        target[colliding] = reversed_[colliding]
+
+    def _impact_fractions(self, body_a, body_b, depth, start_depth, approach, h) -> np.ndarray:
         """``(B,)``: for each body, the fraction ``τ`` of the step at which its earliest
-        colliding contact touched, 0 for a body with none. A contact that approaches at
-        ``v_n`` < −resting speed and ends ``d`` ≥ 0 deep started ``h|v_n| − d`` apart; moving
-        linearly, it touched at ``τ = 1 − d / (h|v_n|)``."""
+        colliding contact touched, 0 for a body with none (start depths unknown: as if it had
+        moved at its end velocity, ``d₀ = d + h v_n``)."""
         colliding = (depth >= 0.0) & (approach < -self.resting_speed)
         if not colliding.any():
             return np.zeros(self.count)
-        closing = -h * approach[colliding]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tau = np.clip(1.0 - depth[colliding] / closing, 0.0, 1.0)
-        tau = np.where(np.isfinite(tau), tau, 0.0)
+        known = np.where(np.isnan(start_depth), depth + h * approach, start_depth)
+        tau = self._impact_times(depth[colliding], known[colliding])
         earliest = np.ones(self.count + 1)  # the last entry stands for the world (-1)
         np.minimum.at(earliest, body_a[colliding], tau)
         np.minimum.at(earliest, body_b[colliding], tau)
@@ -330,6 +393,22 @@ def _normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w) -> np.ndarray
     va = np.concatenate([v, zero])[body_a] + np.cross(np.concatenate([w, zero])[body_a], arm_a)
     vb = np.concatenate([v, zero])[body_b] + np.cross(np.concatenate([w, zero])[body_b], arm_b)
     return np.einsum("ck,ck->c", vb - va, normal)
+
+
+def _moves(x0: np.ndarray, q0: np.ndarray, x1: np.ndarray, q1: np.ndarray) -> tuple:
+    """How each body moved over the step: ``x₁ − x₀`` ``(B, 3)`` [m] and the rotation vector
+    ``θ`` ``(B, 3)`` [rad] of ``q₁ ⊗ q₀⁻¹`` (world frame, the shorter way round)."""
+    w0, v0 = q0[:, :1], -q0[:, 1:]  # q₀⁻¹ = conj(q₀) for a unit quaternion
+    w1, v1 = q1[:, :1], q1[:, 1:]
+    w = w1 * w0 - np.einsum("bk,bk->b", v1, v0)[:, None]
+    vec = w1 * v0 + w0 * v1 + np.cross(v1, v0)
+    vec = np.where(w < 0.0, -vec, vec)
+    w = np.abs(w)
+    sine = np.linalg.norm(vec, axis=1, keepdims=True)
+    angle = 2.0 * np.arctan2(sine, w)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        axis_scale = np.where(sine > 0.0, angle / sine, 2.0)
+    return x1 - x0, vec * axis_scale
 
 
 def _turned(q: np.ndarray, twist: np.ndarray) -> np.ndarray:

@@ -29,9 +29,9 @@ impulse that brings its ``v_n`` to its target, keeps the accumulated normal impu
 sliding, its accumulated size at most ``μ λ`` (Coulomb's cone). The contacts are found at the
 step's end poses, and the bodies are moved again by ``h Δv`` (and turned by ``h Δω``) for the
 velocity change ``Δv`` the impulses make — what the step would have done had the bodies had
-those velocities — so the target is posed on the depth at the step's start,
-``d₀ = d + h v_n``: ``−e v_n`` for a contact that reaches the other body within the step faster
-than the resting speed (it collides), and otherwise ``min(d₀, 0)/h``: a resting contact stops
+those velocities — so the target is posed on the depth at the step's start ``d₀``
+(``d + h v_n`` to first order): ``−e v_n`` for a contact that reaches the other body within
+the step faster than the resting speed (it collides), and otherwise ``min(d₀, 0)/h``: a resting contact stops
 (B. Mirtich, J. Canny, "Impulse-based simulation of rigid bodies", I3D 1995), and a
 speculative one a gap apart may close the gap this step but not more.
 Friction and restitution act through the same impulses as in E. Guendelman, R. Bridson,
@@ -121,7 +121,7 @@ def _tangents(nx, ny, nz):
 
 @njit(cache=True)
 def prepare_contacts(
-    body_a, body_b, point, normal, depth, restitution, resting_speed, h,
+    body_a, body_b, point, normal, depth, start_depth, restitution, resting_speed, h,
     position, inverse_mass, inverse_inertia, v, w,
     arm_a, arm_b, frame, mass_n, mass_t, target,
 ):  # fmt: skip
@@ -130,8 +130,10 @@ def prepare_contacts(
     Args:
         body_a, body_b: ``(C,)`` the bodies (``-1``: the world).
         point, normal: ``(C, 3)`` contact points [m] and unit normals from A toward B.
-        depth: ``(C,)`` penetration [m] at the step's end poses (after the bodies moved by
-            ``h v``), negative for a speculative contact's gap.
+        depth: ``(C,)`` penetration [m] at the step's end poses, negative for a speculative
+            contact's gap.
+        start_depth: ``(C,)`` the same at the step's start (NaN: unknown, then ``d + h v_n``,
+            as if the bodies had moved with ``v`` all the step).
         restitution: ``(C,)`` coefficient of restitution of each contact's pair.
         resting_speed: Approach speed [m/s] below which a contact rests rather than bounces.
         h: The step [s].
@@ -167,8 +169,7 @@ def prepare_contacts(
         vax, vay, vaz = _point_velocity(a, v, w, rax, ray, raz)
         vbx, vby, vbz = _point_velocity(b, v, w, rbx, rby, rbz)
         v_n = (vbx - vax) * nx + (vby - vay) * ny + (vbz - vaz) * nz
-        # The depth at the step's start, to first order: the end's less the approach.
-        start = depth[c] + h * v_n
+        start = start_depth[c] if start_depth[c] == start_depth[c] else depth[c] + h * v_n
         if v_n < -resting_speed and depth[c] >= 0.0:
             # It reaches the other body within the step, fast: it collides.
             target[c] = -restitution[c] * v_n

@@ -11,7 +11,7 @@ a folder and its line here, in :data:`BUILT_IN` (with its builder method among
 
 The built-in kinds, in their order (which is the order their ``finish`` hooks run in):
 particles, particle_cloud, rope, hair, springs, cloth, cloth_mesh, soft_lattice, soft_mesh,
-body, emitter, system, force, collider, particle_collisions, boids, crowd.
+body, emitter, system, force, collider, particle_collisions, body_contacts, boids, crowd.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from .._lazy import lazy_names
 from .._registry import Registry
 from . import (
     body,
+    body_contacts,
     boids,
     cloth,
     cloth_mesh,
@@ -82,6 +83,7 @@ BUILT_IN: tuple[EntityKind, ...] = (
     force.KIND,
     collider.KIND,
     particle_collisions.KIND,
+    body_contacts.KIND,
     boids.KIND,
     crowd.KIND,
 )
@@ -103,6 +105,7 @@ class EntityMethods(
     force.ForceFieldMethods,
     collider.ColliderMethods,
     particle_collisions.ParticleCollisionMethods,
+    body_contacts.BodyContactMethods,
     boids.BoidsMethods,
     crowd.CrowdMethods,
 ):

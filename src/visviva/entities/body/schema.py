@@ -42,7 +42,17 @@ from pydantic import Field, model_validator
 from pydantic_core import PydanticCustomError
 
 from ..deformable import FilePath
-from ..fields import Color, Finite, Index, Name, NonNegative, Positive, Strict, Vector
+from ..fields import (
+    Color,
+    Finite,
+    Fraction,
+    Index,
+    Name,
+    NonNegative,
+    Positive,
+    Strict,
+    Vector,
+)
 from ..methods import Builds, Triple, given, refusing_renamed
 
 __all__ = ["BODY_SHAPES", "Anchor", "Push", "RigidBody"]
@@ -129,6 +139,24 @@ class RigidBody(Strict):
     push: list[Push] = Field(default_factory=list, description="forces at points, for a while")
     anchor: Anchor | None = Field(None, description="a point held by a spring")
     color: Color = Field((0.8, 0.8, 0.8), description="sRGB colour in [0, 1]")
+    restitution: Fraction = Field(
+        0.5, description="coefficient of restitution e of its contacts (a pair takes the larger)"
+    )
+    friction: NonNegative = Field(
+        0.5, description="Coulomb friction μ of its contacts (a pair takes √(μ_a μ_b))"
+    )
+    collision_shape: Literal["shape", "hull", "none"] = Field(
+        "shape",
+        description="what it collides as: its shape (a mesh must be convex), its mesh's convex "
+        "hull, or nothing",
+    )
+    convex_pieces: (
+        Annotated[list[Annotated[list[Vector], Field(min_length=4)]], Field(min_length=1)] | None
+    ) = Field(
+        None,
+        description="the convex pieces it collides as: each the hull of ≥ 4 points in the "
+        "body's own axes [m] (instead of its shape)",
+    )
 
     @model_validator(mode="after")
     def _complete(self) -> Self:
@@ -180,6 +208,19 @@ class RigidBody(Strict):
                 'belong to motion = "dynamic"',
                 {"motion": self.motion},
             )
+        if self.convex_pieces is not None and self.collision_shape != "shape":
+            raise PydanticCustomError(
+                "pieces_and_shape",
+                "give `convex_pieces` or `collision_shape`, not both: the pieces are what the "
+                "body collides as",
+            )
+        if self.collision_shape == "hull" and self.shape != "mesh":
+            raise PydanticCustomError(
+                "hull_of_primitive",
+                'collision_shape = "hull" is the convex hull of a mesh; a {shape} collides as '
+                "itself (leave `collision_shape` out)",
+                {"shape": self.shape},
+            )
         if not any(self.orientation):
             raise PydanticCustomError(
                 "zero_quaternion",
@@ -219,6 +260,10 @@ class RigidBodyMethods:
         anchor: Mapping[str, Any] | None = None,
         motion: str | None = None,
         color: Triple | None = None,
+        restitution: float | None = None,
+        friction: float | None = None,
+        collision_shape: str | None = None,
+        convex_pieces: Sequence[Any] | None = None,
         name: str | None = None,
     ) -> int:
         """Add a rigid body: a ``shape`` (``"box"`` with ``size`` [m] its full edge lengths,
@@ -234,7 +279,11 @@ class RigidBodyMethods:
         ``anchor`` holds one of its points at a world point by a spring (``{"point": ...,
         "at": ..., "stiffness": ..., "damping": ...}``). ``motion``: ``"dynamic"`` (the
         default), ``"kinematic"`` (moves at its velocities whatever acts on it) or
-        ``"static"`` (see :mod:`visviva.entities.body.schema`).
+        ``"static"`` (see :mod:`visviva.entities.body.schema`). With ``add_body_contacts`` it
+        collides with ``restitution`` e in [0, 1] and Coulomb ``friction`` μ (a pair takes the
+        larger e and √(μ_a μ_b)) as its shape, or ``collision_shape="hull"`` (a mesh's convex
+        hull), ``"none"``, or ``convex_pieces``: a list of point sets in its own axes [m], each
+        piece their convex hull (:mod:`visviva.collision.body_contacts`).
         Its state is ``body_position`` (the centre of mass), ``body_orientation``,
         ``body_momentum`` and ``body_angular_momentum``."""
         fields = given(locals())

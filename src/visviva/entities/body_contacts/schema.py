@@ -1,0 +1,64 @@
+"""The scene entity of rigid-body contacts (``type = "body_contacts"``).
+
+One such entity makes the bodies it targets (the body entities it names, or every body)
+collide with each other and with the scene's impulse colliders (planes, boxes and spheres),
+each body as its collision shape (``collision_shape``, ``convex_pieces`` of the body entity),
+with impulses of restitution and Coulomb friction and resting contact that holds stacks; the
+stage that does it, its method and sources are in :mod:`visviva.collision.body_contacts`. A
+scene holds at most one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Annotated, Literal
+
+from pydantic import Field
+
+from ..fields import Fraction, Name, Names, NonNegative, Strict
+from ..methods import Builds, given
+
+__all__ = ["BodyContactSettings"]
+
+
+class BodyContactSettings(Strict):
+    """``type = "body_contacts"``: the targeted bodies collide with each other and with the
+    impulse colliders that target them."""
+
+    type: Literal["body_contacts"]
+    name: Name | None = None
+    targets: Names | None = Field(None, description="body entity names (default: every body)")
+    restitution: Fraction | None = Field(
+        None, description="one e for every pair (default: each pair's larger)"
+    )
+    friction: NonNegative | None = Field(
+        None, description="one μ for every pair (default: each pair's √(μ_a μ_b))"
+    )
+    iterations: Annotated[int, Field(strict=True, ge=1, le=10_000)] = Field(
+        20, description="sweeps of impulses, then of overlap corrections, per step"
+    )
+    resting_speed: NonNegative | None = Field(
+        None, description="approach speed below which a contact rests [m/s] (default: 2|g|dt)"
+    )
+
+
+class BodyContactMethods:
+    """The builder's method of this kind (:mod:`visviva.entities.methods`)."""
+
+    def add_body_contacts(
+        self: Builds,
+        *,
+        targets: Sequence[str] | None = None,
+        restitution: float | None = None,
+        friction: float | None = None,
+        iterations: int | None = None,
+        resting_speed: float | None = None,
+        name: str | None = None,
+    ) -> int:
+        """Make the bodies of ``targets`` (default: every body) collide with each other and
+        with the impulse colliders that target them, each as its collision shape; a pair's
+        restitution and friction are the bodies' own (the larger e, √(μ_a μ_b)) unless
+        ``restitution`` or ``friction`` is given for all; ``iterations`` sweeps per step;
+        approaches slower than ``resting_speed`` [m/s] rest
+        (:mod:`visviva.collision.body_contacts`)."""
+        return self.add("body_contacts", **given(locals()))
