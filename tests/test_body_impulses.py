@@ -26,8 +26,9 @@ def _solve(body_a, body_b, point, normal, depth, restitution, friction, position
     body_b = np.array(body_b, dtype=np.int64)
     point, normal = np.array(point, float), np.array(normal, float)
     prepare_contacts(body_a, body_b, point, normal, np.array(depth, float),
-                     np.full(count, np.nan), np.array(restitution, float), resting_speed, h, position, inverse_mass,
-                     inverse_inertia, v, w, *arrays.values())  # fmt: skip
+                     np.full(count, np.nan), np.array(restitution, float), resting_speed, h,
+                     position, inverse_mass, inverse_inertia, v, w,
+                     *arrays.values())  # fmt: skip
     normal_impulse = np.zeros(count)
     tangent_impulse = np.zeros((count, 2))
     solve_impulses(body_a, body_b, normal, np.array(friction, float), arrays["arm_a"],

@@ -31,9 +31,9 @@ step's end poses, and the bodies are moved again by ``h Δv`` (and turned by ``h
 velocity change ``Δv`` the impulses make — what the step would have done had the bodies had
 those velocities — so the target is posed on the depth at the step's start ``d₀``
 (``d + h v_n`` to first order): ``−e v_n`` for a contact that reaches the other body within
-the step faster than the resting speed (it collides), and otherwise ``min(d₀, 0)/h``: a resting contact stops
-(B. Mirtich, J. Canny, "Impulse-based simulation of rigid bodies", I3D 1995), and a
-speculative one a gap apart may close the gap this step but not more.
+the step faster than the resting speed (it collides), and otherwise ``min(d₀, 0)/h``: a
+resting contact stops (B. Mirtich, J. Canny, "Impulse-based simulation of rigid bodies",
+I3D 1995), and a speculative one a gap apart may close the gap this step but not more.
 Friction and restitution act through the same impulses as in E. Guendelman, R. Bridson,
 R. Fedkiw, "Nonconvex rigid bodies with stacking", SIGGRAPH 2003: both change the spin.
 
