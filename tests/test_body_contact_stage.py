@@ -38,7 +38,7 @@ def _run(shapes, mass, inertia, x0, steps, *, e, mu=0.5):
         inverse = rotation @ np.linalg.inv(inertia) @ rotation.transpose(0, 2, 1)
         x += H * momentum / mass[:, None]
         q = _turned(q, H * np.einsum("bij,bj->bi", inverse, spin))
-        memory, _ = stage.resolve(x, q, momentum, spin, H, memory)
+        memory = stage.resolve(x, q, momentum, spin, H, memory)
         path.append(x.copy())
     return np.array(path), q
 

@@ -207,3 +207,30 @@ def test_bad_contact_input_is_refused_with_the_field_named():
     builder.add_body_contacts()
     with pytest.raises(ModelError, match="need rigid bodies"):
         builder.build()
+
+
+def test_the_contacts_of_a_moment_are_classified_as_baraff_does():
+    # A box resting on the floor touches at four corners, resting; a ball about to hit the
+    # box's top at 3 m/s collides; a ball leaving the floor at 3 m/s separates.
+    builder = _floor_scene()
+    builder.add_body("box", size=(1, 1, 1), density=1000.0, position=(0, 0.5, 0), name="crate")
+    builder.add_body("sphere", radius=0.1, density=1000.0, position=(0, 1.1, 0),
+                     velocity=(0, -3, 0), name="falling")  # fmt: skip
+    builder.add_body("sphere", radius=0.1, density=1000.0, position=(3, 0.1, 0),
+                     velocity=(0, 3, 0), name="leaving")  # fmt: skip
+    builder.add_body_contacts()
+    simulation = vv.Simulation(builder.build())
+    found = simulation.body_contacts()
+    pairs = sorted(zip(found.body_a.tolist(), found.body_b.tolist(), found.classes(),
+                       strict=True))  # fmt: skip
+    assert pairs == [(-1, 0, "resting")] * 4 + [(-1, 2, "separating"), (0, 1, "colliding")]
+    crate = found.body_b == 0
+    assert found.depth[crate] == pytest.approx([0.0] * 4, abs=1e-12)
+    assert found.normal[crate] == pytest.approx(np.tile([0.0, 1.0, 0.0], (4, 1)))
+    hit = found.body_b == 1
+    assert found.normal_velocity[hit] == pytest.approx([-3.0])
+    assert found.counts() == {"colliding": 1, "resting": 4, "separating": 1}
+    plain = _floor_scene()
+    plain.add_body("box", size=(1, 1, 1), density=1.0)
+    with pytest.raises(ModelError, match="body_contacts"):
+        vv.Simulation(plain.build()).body_contacts()

@@ -27,7 +27,7 @@ makes any pair slippery), unless the stage is given one value for every pair.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
@@ -40,6 +40,7 @@ from .body_detection import contact_arrays, pair_contacts, piece_poses, plane_co
 from .body_impulses import correct_positions, prepare_contacts, solve_impulses
 from .body_pieces import BodyPieces
 from .broad_phase import overlapping_pairs
+from .contact_classes import CLASSES, COLLIDING, RESTING, SEPARATING
 from .manifold import MAX_CONTACTS
 
 if TYPE_CHECKING:
@@ -86,15 +87,17 @@ class Planes:
 
 @dataclass(frozen=True)
 class BodyContactSet:
-    """One step's contacts, in solve order, for inspection.
+    """The bodies' contacts at one moment, in solve order, for inspection.
 
     Attributes:
         piece_a, piece_b: ``(C,)`` the pieces (``-1 − f`` for plane ``f`` as ``piece_a``).
         body_a, body_b: ``(C,)`` their bodies (``-1``: the world).
         point, normal: ``(C, 3)`` contact points [m] and unit normals from A toward B.
-        depth: ``(C,)`` penetration [m] (negative: a speculative contact's gap).
-        normal_velocity: ``(C,)`` relative normal velocity before the solve [m/s].
-        normal_impulse: ``(C,)`` the impulse each received [N·s].
+        depth: ``(C,)`` penetration [m] (negative: a gap).
+        normal_velocity: ``(C,)`` relative normal velocity of B's point from A's [m/s]
+            (negative: approaching).
+        kind: ``(C,)`` :data:`~visviva.collision.contact_classes.COLLIDING`, ``RESTING`` or
+            ``SEPARATING``: Baraff's classes with the stage's resting speed.
     """
 
     piece_a: np.ndarray
@@ -105,7 +108,18 @@ class BodyContactSet:
     normal: np.ndarray
     depth: np.ndarray
     normal_velocity: np.ndarray
-    normal_impulse: np.ndarray
+    kind: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.piece_a.shape[0])
+
+    def classes(self) -> list[str]:
+        """Each contact's class by name."""
+        return [CLASSES[k] for k in self.kind]
+
+    def counts(self) -> dict[str, int]:
+        """How many contacts of each class."""
+        return {name: int(np.count_nonzero(self.kind == k)) for k, name in enumerate(CLASSES)}
 
 
 class BodyContacts:
@@ -189,14 +203,33 @@ class BodyContacts:
         q0 = before["body_orientation"]
         v0, w0 = self.velocities(q0, before["body_momentum"], before["body_angular_momentum"])
         start = (before["body_position"], q0, v0, w0)
-        memory, found = self.resolve(x, q, momentum, spin, h, memory, start)
-        work.get(self, dict)["solved"] = found
+        memory = self.resolve(x, q, momentum, spin, h, memory, start)
         return result.with_carried(**dict(zip(MEMORY, memory, strict=True)))
 
-    def solved(self, work: Workspace) -> BodyContactSet | None:
-        """The contacts the latest step of the run whose storage is ``work`` solved."""
-        scratch = work.peek(self)
-        return None if scratch is None else scratch.get("solved")
+    def contacts(self, state: Mapping[str, np.ndarray], gap: float) -> BodyContactSet:
+        """The contacts of ``state``'s bodies (a state, or a mapping of ``body_position``,
+        ``body_orientation``, ``body_momentum`` and ``body_angular_momentum``): the pairs of
+        pieces within ``gap`` [m] of each other, classified with the stage's resting speed."""
+        x = np.ascontiguousarray(state["body_position"], dtype=np.float64)
+        q = np.asarray(state["body_orientation"], dtype=np.float64)
+        q = q / np.linalg.norm(q, axis=1, keepdims=True)
+        v, w = self.velocities(q, state["body_momentum"], state["body_angular_momentum"])
+        found, _, _ = self.detect(x, quaternion_matrix(q), np.full(self.count, 0.5 * gap))
+        piece_a, piece_b, point, normal, depth = found
+        body_a, body_b = self._bodies_of(piece_a, piece_b)
+        arm_a = np.where((body_a >= 0)[:, None], point - x[body_a], 0.0)
+        arm_b = point - x[body_b]
+        velocity = _normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w)
+        kind = np.full(velocity.shape, RESTING, dtype=np.int64)
+        kind[velocity < -self.resting_speed] = COLLIDING
+        kind[velocity > self.resting_speed] = SEPARATING
+        return BodyContactSet(piece_a, piece_b, body_a, body_b, point, normal, depth,
+                              velocity, kind)  # fmt: skip
+
+    def _bodies_of(self, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The bodies of the contacts' pieces (-1: a plane or the scenery)."""
+        body = self.pieces.body
+        return np.where(piece_a >= 0, body[np.maximum(piece_a, 0)], -1), body[piece_b]
 
     def detect(self, x: np.ndarray, rotation: np.ndarray, margin: np.ndarray) -> tuple:
         """The contacts at centres of mass ``x`` ``(B, 3)`` and rotations ``(B, 3, 3)``, with
@@ -234,8 +267,8 @@ class BodyContacts:
         impulses; ``start`` the bodies at the step's start, ``(x, q, v, ω)``, if known: the
         contacts' depths at the start are then measured from how the bodies moved, and a
         collision within the step reverses the approach at the moment of impact, not the
-        step's end. Returns this step's memory and its
-        :class:`BodyContactSet`."""
+        step's end. Returns this step's contacts and impulses, the carried parts (:data:`MEMORY`)
+        the next step warm-starts from."""
         rotation = quaternion_matrix(q)
         inverse_inertia = rotation @ self.inverse_inertia_body @ rotation.transpose(0, 2, 1)
         v = momentum * self.inverse_mass[:, None]
@@ -248,8 +281,7 @@ class BodyContacts:
         order = np.argsort(found[2] @ self.up, kind="stable")
         piece_a, piece_b, point, normal, depth = (a[order] for a in found)
         pieces = self.pieces
-        body_a = np.where(piece_a >= 0, pieces.body[np.maximum(piece_a, 0)], -1)
-        body_b = pieces.body[piece_b]
+        body_a, body_b = self._bodies_of(piece_a, piece_b)
         restitution, friction = self._coefficients(piece_a, piece_b)
         count = piece_a.shape[0]
         arm_a, arm_b = np.zeros((count, 3)), np.zeros((count, 3))
@@ -307,9 +339,7 @@ class BodyContacts:
         inertia = rotation @ self.inertia @ rotation.transpose(0, 2, 1)
         spin[...] = np.where(self.dynamic[:, None], np.einsum("bij,bj->bi", inertia, w), spin)
         friction_world = np.einsum("ct,ctk->ck", tangent_impulse, frame)
-        found = BodyContactSet(piece_a, piece_b, body_a, body_b, point, normal, depth,
-                               velocity_before, normal_impulse)  # fmt: skip
-        return (key, anchor, normal_impulse.copy(), friction_world), found
+        return key, anchor, normal_impulse, friction_world
 
     def _start_depths(self, body_a, body_b, point, normal, depth, x, rotation, start):
         """Each contact's depth at the step's start ``(C,)`` [m]: the end depth plus how far

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..collision.body_contacts import BodyContacts, BodyContactSet
 from ..collision.contact_classes import DEFAULT_GAP, Contacts, ContactSource
 from ..collision.particle_contacts import PairContacts, ParticleContacts
 from ..entities.context import ParticleGroup
@@ -212,6 +213,22 @@ class Model:
         where, how deep, and colliding, resting or separating; see
         :mod:`visviva.collision.contact_classes`)."""
         return Contacts.join([source.contacts(state, gap) for source in self.contact_sources])
+
+    def body_contacts(self, state: State, gap: float = DEFAULT_GAP) -> BodyContactSet:
+        """The contacts of ``state``'s rigid bodies with each other and with the colliders:
+        pieces within ``gap`` [m] of each other, with points, normals, depths, relative normal
+        velocities and classes (see :mod:`visviva.collision.body_contacts`).
+
+        Raises:
+            ModelError: If the scene has no ``body_contacts`` entity.
+        """
+        stage = next((s for s in self.stages if isinstance(s, BodyContacts)), None)
+        if stage is None:
+            raise ModelError(
+                'this scene\'s bodies do not collide: add an entity of type "body_contacts" '
+                "(SceneBuilder.add_body_contacts)"
+            )
+        return stage.contacts(state, gap)
 
     def pair_contacts(self, state: State, gap: float = DEFAULT_GAP) -> PairContacts:
         """The sphere–sphere contacts of ``state`` among the particles of the scene's

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._validation import real_number, whole_number
+from ..collision.body_contacts import BodyContactSet
 from ..collision.contact_classes import DEFAULT_GAP, Contacts
 from ..collision.particle_contacts import PairContacts
 from ..errors import ModelError, SimulationError
@@ -212,6 +213,18 @@ class Simulation:
         """
         gap = real_number("gap", gap, nonnegative=True, unit=" m")
         return self.model.pair_contacts(self._current(), gap)
+
+    def body_contacts(self, gap: float = DEFAULT_GAP) -> BodyContactSet:
+        """The rigid bodies' contacts now, with each other and with the colliders (a scene's
+        ``body_contacts``): which pieces touch (within ``gap`` [m]), where, along which
+        normal, how deep, and whether colliding, resting or separating
+        (:class:`~visviva.collision.body_contacts.BodyContactSet`).
+
+        Raises:
+            ModelError: If the scene's bodies do not collide.
+        """
+        gap = real_number("gap", gap, nonnegative=True, unit=" m")
+        return self.model.body_contacts(self._current(), gap)
 
     def bodies(self) -> BodyViews:
         """What the rigid bodies' state implies now: ``v``, ``R``, the world inverse inertia
