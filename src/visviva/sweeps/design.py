@@ -145,12 +145,22 @@ def _draw(parameters: tuple[Parameter, ...], seed: int, index: int) -> list[Any]
         if parameter.values is not None:
             drawn.append(parameter.values[int(rng.integers(len(parameter.values)))])
         elif parameter.range is not None:
-            drawn.append(float(rng.uniform(parameter.range[0], parameter.range[1])))
+            drawn.append(_between(parameter.range[0], parameter.range[1], rng.random()))
         else:
             assert parameter.log_range is not None
             low, high = np.log(parameter.log_range[0]), np.log(parameter.log_range[1])
-            drawn.append(float(np.exp(rng.uniform(low, high))))
+            drawn.append(float(np.exp(_between(low, high, rng.random()))))
     return drawn
+
+
+def _between(low: float, high: float, u: float) -> float:
+    """The point a fraction ``u`` in [0, 1) of the way from ``low`` to ``high``, either order:
+    ``low + (high − low) u`` as NumPy's ``uniform`` draws it (so earlier sweeps draw the same
+    values), or weighted when the difference overflows (a range of ±1e308)."""
+    span = high - low
+    if math.isfinite(span):
+        return float(low + span * u)
+    return float(low * (1.0 - u) + high * u)
 
 
 def expand(sweep: Sweep, *, check: bool = True) -> list[SweepRun]:
