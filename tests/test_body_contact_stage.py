@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from visviva.collision import Box, Sphere
-from visviva.collision.body_contacts import BodyContacts, Planes, _turned
+from visviva.collision.body_contacts import BodyContacts, Planes
 from visviva.collision.body_pieces import BodyPieces
+from visviva.collision.body_response import turned
 from visviva.geometry.quaternions import quaternion_matrix
 
 G = 9.81
@@ -37,7 +38,7 @@ def _run(shapes, mass, inertia, x0, steps, *, e, mu=0.5):
         rotation = quaternion_matrix(q)
         inverse = rotation @ np.linalg.inv(inertia) @ rotation.transpose(0, 2, 1)
         x += H * momentum / mass[:, None]
-        q = _turned(q, H * np.einsum("bij,bj->bi", inverse, spin))
+        turned(q, H * np.einsum("bij,bj->bi", inverse, spin))
         memory = stage.resolve(x, q, momentum, spin, H, memory)
         path.append(x.copy())
     return np.array(path), q

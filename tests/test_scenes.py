@@ -220,6 +220,7 @@ def test_cli_validate_schema_dry_run_and_plot(tmp_path):
         "boids",
         "crowd",
         "particle_collisions",
+        "body_contacts",
     }
     assert schema["$defs"]["Particles"]["additionalProperties"] is False
     out = tmp_path / "dry"

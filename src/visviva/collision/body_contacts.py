@@ -34,11 +34,10 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 from numba import njit
 
-from ..geometry.quaternions import quaternion_matrix
 from ..ode.stage import Phase
 from .body_detection import contact_arrays, pair_contacts, piece_poses, plane_contacts
-from .body_impulses import correct_positions, prepare_contacts, solve_impulses
 from .body_pieces import BodyPieces
+from .body_response import body_frames, normal_velocities, respond
 from .broad_phase import overlapping_pairs
 from .contact_classes import CLASSES, COLLIDING, RESTING, SEPARATING
 from .manifold import MAX_CONTACTS
@@ -200,9 +199,11 @@ class BodyContacts:
         momentum = result["body_momentum"]
         spin = result["body_angular_momentum"]
         memory = tuple(after[name] for name in MEMORY)
-        q0 = before["body_orientation"]
-        v0, w0 = self.velocities(q0, before["body_momentum"], before["body_angular_momentum"])
-        start = (before["body_position"], q0, v0, w0)
+        x0, q0 = before["body_position"], before["body_orientation"]
+        momentum0, spin0 = before["body_momentum"], before["body_angular_momentum"]
+        _, _, v0, w0 = body_frames(q0, self.inverse_inertia_body, self.inverse_mass,
+                                   momentum0, spin0)  # fmt: skip
+        start = (x0, q0, v0, w0)
         memory = self.resolve(x, q, momentum, spin, h, memory, start)
         return result.with_carried(**dict(zip(MEMORY, memory, strict=True)))
 
@@ -213,13 +214,16 @@ class BodyContacts:
         x = np.ascontiguousarray(state["body_position"], dtype=np.float64)
         q = np.asarray(state["body_orientation"], dtype=np.float64)
         q = q / np.linalg.norm(q, axis=1, keepdims=True)
-        v, w = self.velocities(q, state["body_momentum"], state["body_angular_momentum"])
-        found, _, _ = self.detect(x, quaternion_matrix(q), np.full(self.count, 0.5 * gap))
+        momentum = np.ascontiguousarray(state["body_momentum"], dtype=np.float64)
+        spin = np.ascontiguousarray(state["body_angular_momentum"], dtype=np.float64)
+        rotation, _, v, w = body_frames(q, self.inverse_inertia_body, self.inverse_mass,
+                                        momentum, spin)  # fmt: skip
+        found, _, _ = self.detect(x, rotation, np.full(self.count, 0.5 * gap))
         piece_a, piece_b, point, normal, depth = found
         body_a, body_b = self._bodies_of(piece_a, piece_b)
         arm_a = np.where((body_a >= 0)[:, None], point - x[body_a], 0.0)
         arm_b = point - x[body_b]
-        velocity = _normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w)
+        velocity = normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w)
         kind = np.full(velocity.shape, RESTING, dtype=np.int64)
         kind[velocity < -self.resting_speed] = COLLIDING
         kind[velocity > self.resting_speed] = SEPARATING
@@ -255,25 +259,18 @@ class BodyContacts:
                                planes.normal, planes.thickness, out, count)  # fmt: skip
         return tuple(a[:count] for a in out), position, turn
 
-    def velocities(self, q: np.ndarray, momentum: np.ndarray, spin: np.ndarray) -> tuple:
-        """``v = P/M`` and ``ω = I⁻¹ L`` ``(B, 3)`` of the dynamic bodies (0 for the others)."""
-        rotation = quaternion_matrix(q)
-        inverse_inertia = rotation @ self.inverse_inertia_body @ rotation.transpose(0, 2, 1)
-        return momentum * self.inverse_mass[:, None], np.einsum("bij,bj->bi", inverse_inertia, spin)
-
     def resolve(self, x, q, momentum, spin, h, memory, start=None):
         """Resolve one step's contacts in place on the bodies' ``x``, ``q``, ``P``, ``L``
         (``(B, 3)``, ``(B, 4)``, ``(B, 3)``, ``(B, 3)``); ``memory`` the last step's carried
         impulses; ``start`` the bodies at the step's start, ``(x, q, v, ω)``, if known: the
         contacts' depths at the start are then measured from how the bodies moved, and a
         collision within the step reverses the approach at the moment of impact, not the
-        step's end. Returns this step's contacts and impulses, the carried parts (:data:`MEMORY`)
-        the next step warm-starts from."""
-        rotation = quaternion_matrix(q)
-        inverse_inertia = rotation @ self.inverse_inertia_body @ rotation.transpose(0, 2, 1)
-        v = momentum * self.inverse_mass[:, None]
-        w = np.einsum("bij,bj->bi", inverse_inertia, spin)
-        speed = np.linalg.norm(v, axis=1) + np.linalg.norm(w, axis=1) * self.size
+        step's end. Returns this step's contacts and impulses, the carried parts
+        (:data:`MEMORY`) the next step warm-starts from."""
+        rotation, inverse_inertia, v, w = body_frames(
+            q, self.inverse_inertia_body, self.inverse_mass, momentum, spin
+        )
+        speed = np.sqrt((v * v).sum(axis=1)) + np.sqrt((w * w).sum(axis=1)) * self.size
         margin = h * speed + SPECULATIVE * self.size
         found, position, turn = self.detect(x, rotation, margin)
         # Bottom up along gravity: a stack's support is met before what rests on it, which
@@ -283,120 +280,26 @@ class BodyContacts:
         pieces = self.pieces
         body_a, body_b = self._bodies_of(piece_a, piece_b)
         restitution, friction = self._coefficients(piece_a, piece_b)
-        count = piece_a.shape[0]
-        arm_a, arm_b = np.zeros((count, 3)), np.zeros((count, 3))
-        frame = np.zeros((count, 2, 3))
-        mass_n, mass_t, target = np.zeros(count), np.zeros((count, 2)), np.zeros(count)
-        start_depth = self._start_depths(body_a, body_b, point, normal, depth, x, rotation, start)
-        prepare_contacts(body_a, body_b, point, normal, depth, start_depth, restitution,
-                         self.resting_speed,
-                         h, x, self.inverse_mass, inverse_inertia, v, w, arm_a, arm_b, frame,
-                         mass_n, mass_t, target)  # fmt: skip
-        velocity_before = _normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w)
-        if start is not None:
-            self._reverse_at_impact(body_a, body_b, normal, arm_a, arm_b, depth, start_depth,
-                                    restitution, velocity_before, start[2:], target)  # fmt: skip
         key = (piece_a + self.planes.point.shape[0]) * (pieces.count + 1) + piece_b
         anchor = np.einsum("cji,cj->ci", turn[piece_b], point - position[piece_b])
-        normal_impulse = np.zeros(count)
-        tangent_impulse = np.zeros((count, 2))
-        _warm_start(key, anchor, MATCH * pieces.radius[piece_b], frame, *memory,
-                    normal_impulse, tangent_impulse)  # fmt: skip
-        v_start, w_start = v.copy(), w.copy()
-        solve_impulses(body_a, body_b, normal, friction, arm_a, arm_b, frame, mass_n, mass_t,
-                       target, self.inverse_mass, inverse_inertia, v, w, normal_impulse,
-                       tangent_impulse, self.iterations)  # fmt: skip
-        # The step again with the new velocities: a body that collided within the step moves
-        # as the integrator moved it until the impact (the fraction τ of the step at which its
-        # earliest colliding contact touched, to first order), with its new velocity after;
-        # the others touched as if they had had the new velocity all along. So each body the
-        # impulses changed ends at x(τ) + (1 − τ) h v: moved by (1 − τ)(h v − Δx) for the
-        # step's move Δx (h v before the impulses if the start is unknown), turned likewise.
-        impact = self._impact_fractions(body_a, body_b, depth, start_depth, velocity_before, h)
-        remainder = (1.0 - impact)[:, None]
-        travel, rotation_vector = (
-            (h * v_start, h * w_start) if start is None else _moves(start[0], start[1], x, q)
-        )
-        touched = (np.any(v != v_start, axis=1) | np.any(w != w_start, axis=1))[:, None]
-        shift = np.where(touched, remainder * (h * v - travel), 0.0)
-        twist = np.where(touched, remainder * (h * w - rotation_vector), 0.0)
-        moved = _normal_velocities(body_a, body_b, normal, arm_a, arm_b, shift, twist)
-        remaining = depth - moved
-        smaller = np.minimum(
-            np.where(piece_a >= 0, pieces.radius[np.maximum(piece_a, 0)], np.inf),
-            pieces.radius[piece_b],
-        )
-        allowance = ALLOWANCE * float(smaller.min()) if count else 0.0
-        correction, turn_correction = np.zeros_like(x), np.zeros_like(x)
-        correct_positions(body_a, body_b, normal, remaining, arm_a, arm_b, mass_n,
-                          self.inverse_mass, inverse_inertia, allowance, CORRECTION,
-                          self.iterations, correction, turn_correction)  # fmt: skip
-        x += shift + correction
-        q[...] = _turned(q, twist + turn_correction)
-        # Back to momenta, with the inertia of the step's end (world frame).
-        mass = np.where(self.dynamic, 1.0 / np.where(self.dynamic, self.inverse_mass, 1.0), 0.0)
-        momentum[...] = np.where(self.dynamic[:, None], mass[:, None] * v, momentum)
-        inertia = rotation @ self.inertia @ rotation.transpose(0, 2, 1)
-        spin[...] = np.where(self.dynamic[:, None], np.einsum("bij,bj->bi", inertia, w), spin)
-        friction_world = np.einsum("ct,ctk->ck", tangent_impulse, frame)
-        return key, anchor, normal_impulse, friction_world
-
-    def _start_depths(self, body_a, body_b, point, normal, depth, x, rotation, start):
-        """Each contact's depth at the step's start ``(C,)`` [m]: the end depth plus how far
-        the two material points at the contact moved toward each other along ``n`` over the
-        step (a point at arm ``r`` from the centre at the end was at ``x₀ + R₀ R₁ᵀ r``); NaN
-        when the start is unknown."""
+        warm_normal, warm_friction = _warm_start(key, anchor, MATCH * pieces.radius[piece_b],
+                                                 *memory)  # fmt: skip
         if start is None:
-            return np.full(depth.shape, np.nan)
-        x0, q0 = start[0], start[1]
-        turn = quaternion_matrix(q0) @ rotation.transpose(0, 2, 1)  # R₀ R₁ᵀ
-        moved = np.zeros(point.shape)
-        for body, sign in ((body_b, 1.0), (body_a, -1.0)):
-            real = body >= 0
-            b = body[real]
-            arm = point[real] - x[b]
-            earlier = x0[b] + np.einsum("cij,cj->ci", turn[b], arm)
-            moved[real] += sign * (point[real] - earlier)
-        return depth + np.einsum("ck,ck->c", moved, normal)
-
-    @staticmethod
-    def _impact_times(depth, start_depth):
-        """The fraction of the step at which each contact touched, moving linearly from its
-        start depth to its end depth (0 if it overlapped already at the start)."""
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tau = np.where(start_depth < 0.0, start_depth / (start_depth - depth), 0.0)
-        return np.clip(np.where(np.isfinite(tau), tau, 0.0), 0.0, 1.0)
-
-    def _reverse_at_impact(self, body_a, body_b, normal, arm_a, arm_b, depth, start_depth,
-                           restitution, approach, start, target):  # fmt: skip
-        """Targets of the colliding contacts from the approach at the impact: the forces of
-        the step (gravity) change a contact's normal velocity from ``v₀`` at the start to
-        ``v₁`` at the end; at the impact, the fraction ``τ`` of the step, it is
-        ``v₀ + τ (v₁ − v₀)``; reversed with restitution and changed by the forces for the rest
-        of the step, the target is ``−e (v₀ + τ (v₁ − v₀)) + (1 − τ)(v₁ − v₀)``."""
-        colliding = (depth >= 0.0) & (approach < -self.resting_speed)
-        if not colliding.any():
-            return
-        initial = _normal_velocities(body_a, body_b, normal, arm_a, arm_b, *start)
-        tau = self._impact_times(depth, start_depth)
-        change = approach - initial
-        at_impact = np.minimum(initial + tau * change, 0.0)
-        reversed_ = -restitution * at_impact + (1.0 - tau) * change
-        target[colliding] = reversed_[colliding]
-
-    def _impact_fractions(self, body_a, body_b, depth, start_depth, approach, h) -> np.ndarray:
-        """``(B,)``: for each body, the fraction ``τ`` of the step at which its earliest
-        colliding contact touched, 0 for a body with none (start depths unknown: as if it had
-        moved at its end velocity, ``d₀ = d + h v_n``)."""
-        colliding = (depth >= 0.0) & (approach < -self.resting_speed)
-        if not colliding.any():
-            return np.zeros(self.count)
-        known = np.where(np.isnan(start_depth), depth + h * approach, start_depth)
-        tau = self._impact_times(depth[colliding], known[colliding])
-        earliest = np.ones(self.count + 1)  # the last entry stands for the world (-1)
-        np.minimum.at(earliest, body_a[colliding], tau)
-        np.minimum.at(earliest, body_b[colliding], tau)
-        return np.where(earliest < 1.0, earliest, 0.0)[: self.count]
+            has_start, x0, q0, v0, w0 = False, x, q, v, w
+        else:
+            has_start, (x0, q0, v0, w0) = True, start
+        radius = pieces.radius
+        smaller = np.minimum(np.where(piece_a >= 0, radius[np.maximum(piece_a, 0)], np.inf),
+                             radius[piece_b])  # fmt: skip
+        allowance = ALLOWANCE * float(smaller.min()) if smaller.size else 0.0
+        normal_impulse, friction_impulse = respond(
+            body_a, body_b, point, normal, depth, restitution, friction, warm_normal,
+            warm_friction, x, q, momentum, spin, rotation, inverse_inertia, v, w,
+            self.inverse_mass, self.inertia, self.dynamic,
+            has_start, x0, q0, v0, w0,
+            h, self.resting_speed, self.iterations, allowance, CORRECTION,
+        )  # fmt: skip
+        return key, anchor, normal_impulse, friction_impulse
 
     def _coefficients(self, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple[np.ndarray, ...]:
         """Each contact's restitution and friction (the pair rule, or the stage's value)."""
@@ -417,59 +320,22 @@ class BodyContacts:
         return e, mu
 
 
-def _normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w) -> np.ndarray:
-    """Each contact's relative normal velocity ``n·(v_b + ω_b × r_b − v_a − ω_a × r_a)``."""
-    zero = np.zeros((1, 3))
-    va = np.concatenate([v, zero])[body_a] + np.cross(np.concatenate([w, zero])[body_a], arm_a)
-    vb = np.concatenate([v, zero])[body_b] + np.cross(np.concatenate([w, zero])[body_b], arm_b)
-    return np.einsum("ck,ck->c", vb - va, normal)
-
-
-def _moves(x0: np.ndarray, q0: np.ndarray, x1: np.ndarray, q1: np.ndarray) -> tuple:
-    """How each body moved over the step: ``x₁ − x₀`` ``(B, 3)`` [m] and the rotation vector
-    ``θ`` ``(B, 3)`` [rad] of ``q₁ ⊗ q₀⁻¹`` (world frame, the shorter way round)."""
-    w0, v0 = q0[:, :1], -q0[:, 1:]  # q₀⁻¹ = conj(q₀) for a unit quaternion
-    w1, v1 = q1[:, :1], q1[:, 1:]
-    w = w1 * w0 - np.einsum("bk,bk->b", v1, v0)[:, None]
-    vec = w1 * v0 + w0 * v1 + np.cross(v1, v0)
-    vec = np.where(w < 0.0, -vec, vec)
-    w = np.abs(w)
-    sine = np.linalg.norm(vec, axis=1, keepdims=True)
-    angle = 2.0 * np.arctan2(sine, w)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        axis_scale = np.where(sine > 0.0, angle / sine, 2.0)
-    return x1 - x0, vec * axis_scale
-
-
-def _turned(q: np.ndarray, twist: np.ndarray) -> np.ndarray:
-    """Quaternions turned by small world rotation vectors: ``q + ½ (0, θ) ⊗ q``, normalized."""
-    w, x, y, z = q.T
-    tx, ty, tz = twist.T
-    dq = 0.5 * np.stack([
-        -tx * x - ty * y - tz * z,
-        tx * w + ty * z - tz * y,
-        ty * w + tz * x - tx * z,
-        tz * w + tx * y - ty * x,
-    ], axis=1)  # fmt: skip
-    turned = q + dq
-    return turned / np.linalg.norm(turned, axis=1, keepdims=True)
-
-
 @njit(cache=True)
-def _warm_start(key, anchor, tolerance, frame, old_key, old_anchor, old_normal, old_friction,
-                normal_impulse, tangent_impulse):  # fmt: skip
-    """Start each contact from the impulses of the last step's contact of the same pair of
-    pieces whose anchor lay nearest, within ``tolerance`` [m]; friction projected on the new
-    tangents."""
+def _warm_start(key, anchor, tolerance, old_key, old_anchor, old_normal, old_friction):
+    """Each contact's warm start: the impulses (normal ``(C,)``, friction ``(C, 3)`` world
+    frame) of the last step's contact of the same pair of pieces whose anchor lay nearest,
+    within ``tolerance`` [m]; zero for a new contact."""
+    count = key.shape[0]
+    normal = np.zeros(count)
+    friction = np.zeros((count, 3))
     if old_key.shape[0] == 0:
-        return
+        return normal, friction
     order = np.argsort(old_key, kind="mergesort")
     sorted_keys = old_key[order]
-    for c in range(key.shape[0]):
-        first = np.searchsorted(sorted_keys, key[c])
+    for c in range(count):
         best = -1
         best_distance = tolerance[c] * tolerance[c]
-        k = first
+        k = np.searchsorted(sorted_keys, key[c])
         while k < sorted_keys.shape[0] and sorted_keys[k] == key[c]:
             o = order[k]
             d = np.sum((old_anchor[o] - anchor[c]) ** 2)
@@ -478,10 +344,6 @@ def _warm_start(key, anchor, tolerance, frame, old_key, old_anchor, old_normal, 
                 best = o
             k += 1
         if best >= 0:
-            normal_impulse[c] = old_normal[best]
-            for t in range(2):
-                tangent_impulse[c, t] = (
-                    old_friction[best, 0] * frame[c, t, 0]
-                    + old_friction[best, 1] * frame[c, t, 1]
-                    + old_friction[best, 2] * frame[c, t, 2]
-                )
+            normal[c] = old_normal[best]
+            friction[c] = old_friction[best]
+    return normal, friction

@@ -10,11 +10,14 @@ Contacts come out in the order of their pairs, then of their planes: the same on
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
 from .body_pieces import piece_shape
 from .broad_phase import shape_bounds
+from .convex import SPHERE
 from .manifold import CANDIDATES, MAX_CONTACTS, contact_manifold, plane_manifold
 from .separation import plane_separation, shape_distance
 
@@ -72,6 +75,10 @@ def pair_contacts(pieces, body, pairs, piece_position, piece_rotation, margin, o
         if a == b:
             continue
         reach = (margin[a] if a >= 0 else 0.0) + (margin[b] if b >= 0 else 0.0)
+        if pieces[0][i] == SPHERE and pieces[0][j] == SPHERE:
+            # Two balls: along the line of centres, no iteration needed.
+            count = _ball_contact(i, j, pieces[1], piece_position, reach, out, count)
+            continue
         shape_a = piece_shape(i, pieces, piece_position[i], piece_rotation[i])
         shape_b = piece_shape(j, pieces, piece_position[j], piece_rotation[j])
         separation = shape_distance(shape_a, shape_b)
@@ -83,6 +90,32 @@ def pair_contacts(pieces, body, pairs, piece_position, piece_rotation, margin, o
             depth[count] = depths[c]
             count += 1
     return count
+
+
+@njit(cache=True)
+def _ball_contact(i, j, params, piece_position, reach, out, count):
+    """Append the contact of balls ``i`` and ``j`` if their gap is at most ``reach``."""
+    piece_a, piece_b, point, normal, depth = out
+    dx = piece_position[j, 0] - piece_position[i, 0]
+    dy = piece_position[j, 1] - piece_position[i, 1]
+    dz = piece_position[j, 2] - piece_position[i, 2]
+    distance = math.sqrt(dx * dx + dy * dy + dz * dz)
+    gap = distance - params[i, 0] - params[j, 0]
+    if gap > reach:
+        return count
+    if distance > 0.0:
+        nx, ny, nz = dx / distance, dy / distance, dz / distance
+    else:
+        nx, ny, nz = 0.0, 1.0, 0.0
+    # Midway between the two surfaces along the line of centres.
+    along = params[i, 0] + 0.5 * gap
+    piece_a[count], piece_b[count] = i, j
+    point[count, 0] = piece_position[i, 0] + along * nx
+    point[count, 1] = piece_position[i, 1] + along * ny
+    point[count, 2] = piece_position[i, 2] + along * nz
+    normal[count, 0], normal[count, 1], normal[count, 2] = nx, ny, nz
+    depth[count] = -gap
+    return count + 1
 
 
 @njit(cache=True)

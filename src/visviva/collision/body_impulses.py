@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 __all__ = ["correct_positions", "prepare_contacts", "solve_impulses"]
@@ -69,7 +70,7 @@ def _times(m, b, x, y, z):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _point_velocity(b, v, w, rx, ry, rz):
     """Velocity ``v + ω × r`` of the point at arm ``r`` of body ``b`` (0 for the world)."""
     if b < 0:
@@ -78,7 +79,7 @@ def _point_velocity(b, v, w, rx, ry, rz):
     return v[b, 0] + cx, v[b, 1] + cy, v[b, 2] + cz
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _resistance(b, inverse_mass, inverse_inertia, rx, ry, rz, dx, dy, dz):
     """``1/M + (r × d)·I⁻¹(r × d)`` of body ``b`` along the unit direction ``d``."""
     if b < 0:
@@ -88,7 +89,7 @@ def _resistance(b, inverse_mass, inverse_inertia, rx, ry, rz, dx, dy, dz):
     return inverse_mass[b] + cx * ix + cy * iy + cz * iz
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _push(b, sign, inverse_mass, inverse_inertia, v, w, rx, ry, rz, jx, jy, jz):
     """Apply the impulse ``sign·J`` at arm ``r`` of body ``b``: ``Δv = J/M``,
     ``Δω = I⁻¹ (r × J)``."""
@@ -191,36 +192,49 @@ def solve_impulses(
     first.
     """
     count = body_a.shape[0]
+    bodies = v.shape[0]
+    # Each contact's three directions (n, t₁, t₂) and, per body and direction, r × d (what
+    # the spin adds to the velocity along d) and I⁻¹(r × d) (how an impulse along d turns the
+    # body): computed once, so a sweep is dot products and additions. The world is an extra
+    # body, at rest and of infinite mass, so that no sweep branches on it.
+    axes = np.empty((count, 3, 3))
+    lever = np.zeros((count, 2, 3, 3))
+    turn = np.zeros((count, 2, 3, 3))
+    index = np.empty((count, 2), dtype=np.int64)
     for c in range(count):
-        jx = normal_impulse[c] * normal[c, 0]
-        jy = normal_impulse[c] * normal[c, 1]
-        jz = normal_impulse[c] * normal[c, 2]
-        for t in range(2):
-            jx += tangent_impulse[c, t] * frame[c, t, 0]
-            jy += tangent_impulse[c, t] * frame[c, t, 1]
-            jz += tangent_impulse[c, t] * frame[c, t, 2]
-        _apply_pair(c, body_a, body_b, arm_a, arm_b, inverse_mass, inverse_inertia, v, w,
-                    jx, jy, jz)  # fmt: skip
+        axes[c, 0] = normal[c]
+        axes[c, 1] = frame[c, 0]
+        axes[c, 2] = frame[c, 1]
+        for side in range(2):
+            b = body_a[c] if side == 0 else body_b[c]
+            index[c, side] = b if b >= 0 else bodies
+            if b < 0:
+                continue
+            rx, ry, rz = (arm_a[c, 0], arm_a[c, 1], arm_a[c, 2]) if side == 0 else (
+                arm_b[c, 0], arm_b[c, 1], arm_b[c, 2])  # fmt: skip
+            for k in range(3):
+                cx, cy, cz = _cross(rx, ry, rz, axes[c, k, 0], axes[c, k, 1], axes[c, k, 2])
+                lever[c, side, k, 0], lever[c, side, k, 1], lever[c, side, k, 2] = cx, cy, cz
+                tx, ty, tz = _times(inverse_inertia, b, cx, cy, cz)
+                turn[c, side, k, 0], turn[c, side, k, 1], turn[c, side, k, 2] = tx, ty, tz
+    vel = np.zeros((bodies + 1, 3))
+    spin = np.zeros((bodies + 1, 3))
+    weight = np.zeros(bodies + 1)
+    vel[:bodies] = v
+    spin[:bodies] = w
+    weight[:bodies] = inverse_mass
+    for c in range(count):
+        _impulse(c, 0, normal_impulse[c], axes, lever, turn, index, weight, vel, spin)
+        _impulse(c, 1, tangent_impulse[c, 0], axes, lever, turn, index, weight, vel, spin)
+        _impulse(c, 2, tangent_impulse[c, 1], axes, lever, turn, index, weight, vel, spin)
     for _ in range(iterations):
         for c in range(count):
-            a = body_a[c]
-            b = body_b[c]
-            nx, ny, nz = normal[c, 0], normal[c, 1], normal[c, 2]
-            rax, ray, raz = arm_a[c, 0], arm_a[c, 1], arm_a[c, 2]
-            rbx, rby, rbz = arm_b[c, 0], arm_b[c, 1], arm_b[c, 2]
             # Friction first, bounded by the normal impulse of the last sweep (Catto 2005).
-            vax, vay, vaz = _point_velocity(a, v, w, rax, ray, raz)
-            vbx, vby, vbz = _point_velocity(b, v, w, rbx, rby, rbz)
-            rx, ry, rz = vbx - vax, vby - vay, vbz - vaz
             limit = friction[c] * normal_impulse[c]
             old0 = tangent_impulse[c, 0]
             old1 = tangent_impulse[c, 1]
-            new0 = old0 - mass_t[c, 0] * (
-                rx * frame[c, 0, 0] + ry * frame[c, 0, 1] + rz * frame[c, 0, 2]
-            )
-            new1 = old1 - mass_t[c, 1] * (
-                rx * frame[c, 1, 0] + ry * frame[c, 1, 1] + rz * frame[c, 1, 2]
-            )
+            new0 = old0 - mass_t[c, 0] * _speed(c, 1, axes, lever, index, vel, spin)
+            new1 = old1 - mass_t[c, 1] * _speed(c, 2, axes, lever, index, vel, spin)
             size = math.sqrt(new0 * new0 + new1 * new1)
             if size > limit:
                 scale = limit / size if size > 0.0 else 0.0
@@ -228,32 +242,47 @@ def solve_impulses(
                 new1 *= scale
             tangent_impulse[c, 0] = new0
             tangent_impulse[c, 1] = new1
-            d0 = new0 - old0
-            d1 = new1 - old1
-            jx = d0 * frame[c, 0, 0] + d1 * frame[c, 1, 0]
-            jy = d0 * frame[c, 0, 1] + d1 * frame[c, 1, 1]
-            jz = d0 * frame[c, 0, 2] + d1 * frame[c, 1, 2]
-            _apply_pair(c, body_a, body_b, arm_a, arm_b, inverse_mass, inverse_inertia, v, w,
-                        jx, jy, jz)  # fmt: skip
+            _impulse(c, 1, new0 - old0, axes, lever, turn, index, weight, vel, spin)
+            _impulse(c, 2, new1 - old1, axes, lever, turn, index, weight, vel, spin)
             # The normal impulse toward the target, accumulated and kept ≥ 0.
-            vax, vay, vaz = _point_velocity(a, v, w, rax, ray, raz)
-            vbx, vby, vbz = _point_velocity(b, v, w, rbx, rby, rbz)
-            v_n = (vbx - vax) * nx + (vby - vay) * ny + (vbz - vaz) * nz
+            v_n = _speed(c, 0, axes, lever, index, vel, spin)
             old = normal_impulse[c]
             new = max(old + mass_n[c] * (target[c] - v_n), 0.0)
             normal_impulse[c] = new
-            d = new - old
-            _apply_pair(c, body_a, body_b, arm_a, arm_b, inverse_mass, inverse_inertia, v, w,
-                        d * nx, d * ny, d * nz)  # fmt: skip
+            _impulse(c, 0, new - old, axes, lever, turn, index, weight, vel, spin)
+    v[:] = vel[:bodies]
+    w[:] = spin[:bodies]
 
 
-@njit(cache=True)
-def _apply_pair(c, body_a, body_b, arm_a, arm_b, inverse_mass, inverse_inertia, v, w, jx, jy, jz):
-    """``J`` on contact ``c``'s body B, ``−J`` on its body A."""
-    _push(body_b[c], 1.0, inverse_mass, inverse_inertia, v, w,
-          arm_b[c, 0], arm_b[c, 1], arm_b[c, 2], jx, jy, jz)  # fmt: skip
-    _push(body_a[c], -1.0, inverse_mass, inverse_inertia, v, w,
-          arm_a[c, 0], arm_a[c, 1], arm_a[c, 2], jx, jy, jz)  # fmt: skip
+@njit(cache=True, inline="always")
+def _speed(c, k, axes, lever, index, vel, spin):
+    """Contact ``c``'s relative velocity along its direction ``k``, B's point from A's."""
+    a = index[c, 0]
+    b = index[c, 1]
+    return (
+        axes[c, k, 0] * (vel[b, 0] - vel[a, 0])
+        + axes[c, k, 1] * (vel[b, 1] - vel[a, 1])
+        + axes[c, k, 2] * (vel[b, 2] - vel[a, 2])
+        + lever[c, 1, k, 0] * spin[b, 0]
+        + lever[c, 1, k, 1] * spin[b, 1]
+        + lever[c, 1, k, 2] * spin[b, 2]
+        - lever[c, 0, k, 0] * spin[a, 0]
+        - lever[c, 0, k, 1] * spin[a, 1]
+        - lever[c, 0, k, 2] * spin[a, 2]
+    )
+
+
+@njit(cache=True, inline="always")
+def _impulse(c, k, size, axes, lever, turn, index, weight, vel, spin):
+    """An impulse of ``size`` along contact ``c``'s direction ``k`` on B, its opposite on A."""
+    a = index[c, 0]
+    b = index[c, 1]
+    for i in range(3):
+        d = size * axes[c, k, i]
+        vel[b, i] += weight[b] * d
+        vel[a, i] -= weight[a] * d
+        spin[b, i] += size * turn[c, 1, k, i]
+        spin[a, i] -= size * turn[c, 0, k, i]
 
 
 @njit(cache=True)
