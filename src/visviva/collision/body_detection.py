@@ -38,14 +38,26 @@ def piece_poses(pieces, body, position, rotation, margin, piece_position, piece_
             (``BodyPieces.local_position``/``local_rotation``), the world poses on return.
         lo, hi: ``(P, 3)`` outputs.
     """
+    local = np.empty(3)
+    turn = np.empty((3, 3))
     for p in range(body.shape[0]):
         b = body[p]
         grow = 0.0
         if b >= 0:
-            local = piece_position[p].copy()
-            turn = piece_rotation[p].copy()
-            piece_position[p] = position[b] + rotation[b] @ local
-            piece_rotation[p] = rotation[b] @ turn
+            local[:] = piece_position[p]
+            turn[:] = piece_rotation[p]
+            for i in range(3):
+                piece_position[p, i] = position[b, i] + (
+                    rotation[b, i, 0] * local[0]
+                    + rotation[b, i, 1] * local[1]
+                    + rotation[b, i, 2] * local[2]
+                )
+                for j in range(3):
+                    piece_rotation[p, i, j] = (
+                        rotation[b, i, 0] * turn[0, j]
+                        + rotation[b, i, 1] * turn[1, j]
+                        + rotation[b, i, 2] * turn[2, j]
+                    )
             grow = margin[b]
         shape = piece_shape(p, pieces, piece_position[p], piece_rotation[p])
         shape_bounds(shape[0], shape[1], shape[2], shape[6], shape[7], grow, lo, hi, p)

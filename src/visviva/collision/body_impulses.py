@@ -89,24 +89,6 @@ def _resistance(b, inverse_mass, inverse_inertia, rx, ry, rz, dx, dy, dz):
     return inverse_mass[b] + cx * ix + cy * iy + cz * iz
 
 
-@njit(cache=True, inline="always")
-def _push(b, sign, inverse_mass, inverse_inertia, v, w, rx, ry, rz, jx, jy, jz):
-    """Apply the impulse ``sign·J`` at arm ``r`` of body ``b``: ``Δv = J/M``,
-    ``Δω = I⁻¹ (r × J)``."""
-    if b < 0:
-        return
-    jx, jy, jz = sign * jx, sign * jy, sign * jz
-    m = inverse_mass[b]
-    v[b, 0] += m * jx
-    v[b, 1] += m * jy
-    v[b, 2] += m * jz
-    cx, cy, cz = _cross(rx, ry, rz, jx, jy, jz)
-    ix, iy, iz = _times(inverse_inertia, b, cx, cy, cz)
-    w[b, 0] += ix
-    w[b, 1] += iy
-    w[b, 2] += iz
-
-
 @njit(cache=True)
 def _tangents(nx, ny, nz):
     """Two unit vectors that make a right-handed frame with the unit ``n``."""
@@ -180,6 +162,38 @@ def prepare_contacts(
 
 
 @njit(cache=True)
+def _levers(body_a, body_b, normal, frame, arm_a, arm_b, inverse_inertia, bodies, directions):
+    """Each contact's first ``directions`` of (n, t₁, t₂) and, per body and direction, r × d
+    (what the spin adds to the velocity along d) and I⁻¹(r × d) (how an impulse along d turns
+    the body), computed once so that a sweep is dot products and additions; and each
+    contact's two bodies, the world as the extra body ``bodies`` (at rest, of infinite mass),
+    so that no sweep branches on it."""
+    count = body_a.shape[0]
+    axes = np.empty((count, 3, 3))
+    lever = np.zeros((count, 2, 3, 3))
+    turn = np.zeros((count, 2, 3, 3))
+    index = np.empty((count, 2), dtype=np.int64)
+    for c in range(count):
+        axes[c, 0] = normal[c]
+        if directions > 1:
+            axes[c, 1] = frame[c, 0]
+            axes[c, 2] = frame[c, 1]
+        for side in range(2):
+            b = body_a[c] if side == 0 else body_b[c]
+            index[c, side] = b if b >= 0 else bodies
+            if b < 0:
+                continue
+            arm = arm_a[c] if side == 0 else arm_b[c]
+            for k in range(directions):
+                cx, cy, cz = _cross(arm[0], arm[1], arm[2], axes[c, k, 0], axes[c, k, 1],
+                                    axes[c, k, 2])  # fmt: skip
+                lever[c, side, k, 0], lever[c, side, k, 1], lever[c, side, k, 2] = cx, cy, cz
+                tx, ty, tz = _times(inverse_inertia, b, cx, cy, cz)
+                turn[c, side, k, 0], turn[c, side, k, 1], turn[c, side, k, 2] = tx, ty, tz
+    return axes, lever, turn, index
+
+
+@njit(cache=True)
 def solve_impulses(
     body_a, body_b, normal, friction, arm_a, arm_b, frame, mass_n, mass_t, target,
     inverse_mass, inverse_inertia, v, w, normal_impulse, tangent_impulse, iterations,
@@ -193,30 +207,8 @@ def solve_impulses(
     """
     count = body_a.shape[0]
     bodies = v.shape[0]
-    # Each contact's three directions (n, t₁, t₂) and, per body and direction, r × d (what
-    # the spin adds to the velocity along d) and I⁻¹(r × d) (how an impulse along d turns the
-    # body): computed once, so a sweep is dot products and additions. The world is an extra
-    # body, at rest and of infinite mass, so that no sweep branches on it.
-    axes = np.empty((count, 3, 3))
-    lever = np.zeros((count, 2, 3, 3))
-    turn = np.zeros((count, 2, 3, 3))
-    index = np.empty((count, 2), dtype=np.int64)
-    for c in range(count):
-        axes[c, 0] = normal[c]
-        axes[c, 1] = frame[c, 0]
-        axes[c, 2] = frame[c, 1]
-        for side in range(2):
-            b = body_a[c] if side == 0 else body_b[c]
-            index[c, side] = b if b >= 0 else bodies
-            if b < 0:
-                continue
-            rx, ry, rz = (arm_a[c, 0], arm_a[c, 1], arm_a[c, 2]) if side == 0 else (
-                arm_b[c, 0], arm_b[c, 1], arm_b[c, 2])  # fmt: skip
-            for k in range(3):
-                cx, cy, cz = _cross(rx, ry, rz, axes[c, k, 0], axes[c, k, 1], axes[c, k, 2])
-                lever[c, side, k, 0], lever[c, side, k, 1], lever[c, side, k, 2] = cx, cy, cz
-                tx, ty, tz = _times(inverse_inertia, b, cx, cy, cz)
-                turn[c, side, k, 0], turn[c, side, k, 1], turn[c, side, k, 2] = tx, ty, tz
+    axes, lever, turn, index = _levers(body_a, body_b, normal, frame, arm_a, arm_b,
+                                       inverse_inertia, bodies, 3)  # fmt: skip
     vel = np.zeros((bodies + 1, 3))
     spin = np.zeros((bodies + 1, 3))
     weight = np.zeros(bodies + 1)
@@ -297,23 +289,21 @@ def correct_positions(
     ``shift`` and ``turn`` ``(B, 3)``, zero on entry, receive each body's translation [m]
     and small rotation vector [rad] (world frame).
     """
-    count = body_a.shape[0]
+    bodies = shift.shape[0]
+    axes, lever, turn_of, index = _levers(body_a, body_b, normal, normal, arm_a, arm_b,
+                                          inverse_inertia, bodies, 1)  # fmt: skip
+    moved = np.zeros((bodies + 1, 3))
+    turned = np.zeros((bodies + 1, 3))
+    weight = np.zeros(bodies + 1)
+    moved[:bodies] = shift
+    turned[:bodies] = turn
+    weight[:bodies] = inverse_mass
     for _ in range(iterations):
-        for c in range(count):
-            a = body_a[c]
-            b = body_b[c]
-            nx, ny, nz = normal[c, 0], normal[c, 1], normal[c, 2]
-            rax, ray, raz = arm_a[c, 0], arm_a[c, 1], arm_a[c, 2]
-            rbx, rby, rbz = arm_b[c, 0], arm_b[c, 1], arm_b[c, 2]
+        for c in range(body_a.shape[0]):
             # The depth now: less how far the bodies' points moved apart along n so far.
-            pax, pay, paz = _point_velocity(a, shift, turn, rax, ray, raz)
-            pbx, pby, pbz = _point_velocity(b, shift, turn, rbx, rby, rbz)
-            now = depth[c] - ((pbx - pax) * nx + (pby - pay) * ny + (pbz - paz) * nz)
-            excess = now - allowance
-            if excess <= 0.0:
-                continue
-            p = fraction * excess * mass_n[c]
-            _push(b, 1.0, inverse_mass, inverse_inertia, shift, turn, rbx, rby, rbz,
-                  p * nx, p * ny, p * nz)  # fmt: skip
-            _push(a, -1.0, inverse_mass, inverse_inertia, shift, turn, rax, ray, raz,
-                  p * nx, p * ny, p * nz)  # fmt: skip
+            excess = depth[c] - _speed(c, 0, axes, lever, index, moved, turned) - allowance
+            if excess > 0.0:
+                _impulse(c, 0, fraction * excess * mass_n[c], axes, lever, turn_of, index,
+                         weight, moved, turned)  # fmt: skip
+    shift[:] = moved[:bodies]
+    turn[:] = turned[:bodies]

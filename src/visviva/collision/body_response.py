@@ -51,7 +51,15 @@ def body_frames(q, inverse_inertia_body, inverse_mass, momentum, spin):
         r[2, 0] = 2.0 * (qx * qz - qw * qy)
         r[2, 1] = 2.0 * (qy * qz + qw * qx)
         r[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
-        inverse[b] = r @ inverse_inertia_body[b] @ r.T
+        # R I⁻¹ Rᵀ, written out (small matrix products would allocate)
+        body_inverse = inverse_inertia_body[b]
+        for i in range(3):
+            for j in range(3):
+                total = 0.0
+                for k in range(3):
+                    for m in range(3):
+                        total += r[i, k] * body_inverse[k, m] * r[j, m]
+                inverse[b, i, j] = total
         for i in range(3):
             v[b, i] = momentum[b, i] * inverse_mass[b]
             w[b, i] = (
@@ -123,6 +131,7 @@ def _start_depths(body_a, body_b, point, normal, depth, x, rotation, x0, q0):
     centre at the end was at ``x₀ + R₀ R₁ᵀ r``)."""
     out = np.empty(depth.shape[0])
     start_rotation = np.empty((3, 3))
+    local_arm = np.empty(3)
     for c in range(depth.shape[0]):
         moved = 0.0
         for side in range(2):
@@ -142,10 +151,20 @@ def _start_depths(body_a, body_b, point, normal, depth, x, rotation, x0, q0):
             start_rotation[2, 0] = 2.0 * (qx * qz - qw * qy)
             start_rotation[2, 1] = 2.0 * (qy * qz + qw * qx)
             start_rotation[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
-            arm = point[c] - x[b]
-            local = rotation[b].T @ arm
-            earlier = x0[b] + start_rotation @ local
-            moved += sign * np.dot(point[c] - earlier, normal[c])
+            # arm in the body's axes at the end, then turned as the body was at the start
+            ax = point[c, 0] - x[b, 0]
+            ay = point[c, 1] - x[b, 1]
+            az = point[c, 2] - x[b, 2]
+            for i in range(3):
+                local = rotation[b, 0, i] * ax + rotation[b, 1, i] * ay + rotation[b, 2, i] * az
+                local_arm[i] = local
+            for i in range(3):
+                earlier = x0[b, i] + (
+                    start_rotation[i, 0] * local_arm[0]
+                    + start_rotation[i, 1] * local_arm[1]
+                    + start_rotation[i, 2] * local_arm[2]
+                )
+                moved += sign * (point[c, i] - earlier) * normal[c, i]
         out[c] = depth[c] + moved
     return out
 
@@ -165,7 +184,7 @@ def respond(
     x, q, momentum, spin, rotation, inverse_inertia, v, w,
     inverse_mass, inertia_body, dynamic,
     has_start, x0, q0, v0, w0,
-    h, resting_speed, iterations, allowance, fraction,
+    h, resting_speed, iterations, position_iterations, allowance, fraction,
 ):  # fmt: skip
     """Resolve one step's contacts (module docstring) in place on ``x``, ``q``, ``momentum``
     and ``spin``; ``warm_normal`` ``(C,)`` and ``warm_friction`` ``(C, 3)`` (world frame) are
@@ -240,17 +259,36 @@ def respond(
             twist[b, i] = remainder * (h * w[b, i] - turn[i])
     # The correction measures each depth less what the moves so far took off it.
     correct_positions(body_a, body_b, normal, depth, arm_a, arm_b, mass_n, inverse_mass,
-                      inverse_inertia, allowance, fraction, iterations, shift, twist)  # fmt: skip
+                      inverse_inertia, allowance, fraction, position_iterations, shift,
+                      twist)  # fmt: skip
     x += shift
     turned(q, twist)
     # Back to momenta, with the inertia of the step's end (world frame).
+    local_w = np.empty(3)
+    local_l = np.empty(3)
     for b in range(bodies):
         if not dynamic[b]:
             continue
-        inertia = rotation[b] @ inertia_body[b] @ rotation[b].T
+        # L = R I_body Rᵀ ω
+        for i in range(3):
+            local_w[i] = (
+                rotation[b, 0, i] * w[b, 0]
+                + rotation[b, 1, i] * w[b, 1]
+                + rotation[b, 2, i] * w[b, 2]
+            )
+        for i in range(3):
+            local_l[i] = (
+                inertia_body[b, i, 0] * local_w[0]
+                + inertia_body[b, i, 1] * local_w[1]
+                + inertia_body[b, i, 2] * local_w[2]
+            )
         for i in range(3):
             momentum[b, i] = v[b, i] / inverse_mass[b]
-            spin[b, i] = inertia[i, 0] * w[b, 0] + inertia[i, 1] * w[b, 1] + inertia[i, 2] * w[b, 2]
+            spin[b, i] = (
+                rotation[b, i, 0] * local_l[0]
+                + rotation[b, i, 1] * local_l[1]
+                + rotation[b, i, 2] * local_l[2]
+            )
     friction_world = np.empty((count, 3))
     for c in range(count):
         for i in range(3):
