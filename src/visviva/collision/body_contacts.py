@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 from numba import njit
 
+from ..errors import ModelError
 from ..ode.stage import Phase
 from .body_detection import contact_arrays, pair_contacts, piece_poses, plane_contacts
 from .body_pieces import BodyPieces
@@ -60,6 +61,8 @@ CORRECTION = 0.4
 #: A contact takes the last step's impulses of its pair's contact that lay within this
 #: fraction of the piece's size of it.
 MATCH = 0.05
+#: How the impacts of a step are resolved (see :class:`BodyContacts`).
+IMPACTS = ("sequential", "simultaneous")
 #: The carried parts, in order (:meth:`BodyContacts.carried_start`).
 MEMORY = (
     "body_contact_key",
@@ -135,6 +138,11 @@ class BodyContacts:
         resting_speed: Approach speed [m/s] below which a contact rests.
         restitution, friction: One coefficient for every pair, or ``None`` for the pair rule.
         gravity: Gravitational acceleration [m/s²]: the contacts are swept against it.
+        impacts: ``"sequential"``: a colliding contact's bounce is a target of the impulse
+            sweeps, with the resting contacts; ``"simultaneous"``: the impacts of a step are
+            resolved first, together, by generalized reflections
+            (:mod:`~visviva.collision.simultaneous`), so an impact travels along a row of
+            touching bodies as in a Newton's cradle.
     """
 
     phase: ClassVar[Phase] = Phase.CONTACTS
@@ -156,6 +164,7 @@ class BodyContacts:
         restitution: float | None = None,
         friction: float | None = None,
         gravity: Sequence[float] = (0.0, -9.81, 0.0),
+        impacts: str = "sequential",
     ) -> None:
         self.pieces = pieces
         self.count = int(np.shape(mass)[0])
@@ -171,6 +180,11 @@ class BodyContacts:
         self.resting_speed = resting_speed
         self.restitution = restitution
         self.friction = friction
+        if impacts not in IMPACTS:
+            raise ModelError(
+                f"`impacts` must be one of {', '.join(map(repr, IMPACTS))} (got {impacts!r})"
+            )
+        self.impacts = impacts
         g = np.asarray(gravity, dtype=np.float64)
         size = float(np.linalg.norm(g))
         self.up = -g / size if size > 0.0 else np.zeros(3)
@@ -299,7 +313,7 @@ class BodyContacts:
             self.inverse_mass, self.inertia, self.dynamic,
             has_start, x0, q0, v0, w0,
             h, self.resting_speed, self.iterations, max(self.iterations // 4, 1), allowance,
-            CORRECTION,
+            CORRECTION, self.impacts == "simultaneous",
         )  # fmt: skip
         return key, anchor, normal_impulse, friction_impulse
 

@@ -52,7 +52,14 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["correct_positions", "prepare_contacts", "solve_impulses"]
+__all__ = [
+    "correct_positions",
+    "lever_impulse",
+    "lever_speed",
+    "levers",
+    "prepare_contacts",
+    "solve_impulses",
+]
 
 
 @njit(cache=True, inline="always")
@@ -162,7 +169,7 @@ def prepare_contacts(
 
 
 @njit(cache=True)
-def _levers(body_a, body_b, normal, frame, arm_a, arm_b, inverse_inertia, bodies, directions):
+def levers(body_a, body_b, normal, frame, arm_a, arm_b, inverse_inertia, bodies, directions):
     """Each contact's first ``directions`` of (n, t₁, t₂) and, per body and direction, r × d
     (what the spin adds to the velocity along d) and I⁻¹(r × d) (how an impulse along d turns
     the body), computed once so that a sweep is dot products and additions; and each
@@ -207,7 +214,7 @@ def solve_impulses(
     """
     count = body_a.shape[0]
     bodies = v.shape[0]
-    axes, lever, turn, index = _levers(body_a, body_b, normal, frame, arm_a, arm_b,
+    axes, lever, turn, index = levers(body_a, body_b, normal, frame, arm_a, arm_b,
                                        inverse_inertia, bodies, 3)  # fmt: skip
     vel = np.zeros((bodies + 1, 3))
     spin = np.zeros((bodies + 1, 3))
@@ -216,17 +223,17 @@ def solve_impulses(
     spin[:bodies] = w
     weight[:bodies] = inverse_mass
     for c in range(count):
-        _impulse(c, 0, normal_impulse[c], axes, lever, turn, index, weight, vel, spin)
-        _impulse(c, 1, tangent_impulse[c, 0], axes, lever, turn, index, weight, vel, spin)
-        _impulse(c, 2, tangent_impulse[c, 1], axes, lever, turn, index, weight, vel, spin)
+        lever_impulse(c, 0, normal_impulse[c], axes, lever, turn, index, weight, vel, spin)
+        lever_impulse(c, 1, tangent_impulse[c, 0], axes, lever, turn, index, weight, vel, spin)
+        lever_impulse(c, 2, tangent_impulse[c, 1], axes, lever, turn, index, weight, vel, spin)
     for _ in range(iterations):
         for c in range(count):
             # Friction first, bounded by the normal impulse of the last sweep (Catto 2005).
             limit = friction[c] * normal_impulse[c]
             old0 = tangent_impulse[c, 0]
             old1 = tangent_impulse[c, 1]
-            new0 = old0 - mass_t[c, 0] * _speed(c, 1, axes, lever, index, vel, spin)
-            new1 = old1 - mass_t[c, 1] * _speed(c, 2, axes, lever, index, vel, spin)
+            new0 = old0 - mass_t[c, 0] * lever_speed(c, 1, axes, lever, index, vel, spin)
+            new1 = old1 - mass_t[c, 1] * lever_speed(c, 2, axes, lever, index, vel, spin)
             size = math.sqrt(new0 * new0 + new1 * new1)
             if size > limit:
                 scale = limit / size if size > 0.0 else 0.0
@@ -234,20 +241,20 @@ def solve_impulses(
                 new1 *= scale
             tangent_impulse[c, 0] = new0
             tangent_impulse[c, 1] = new1
-            _impulse(c, 1, new0 - old0, axes, lever, turn, index, weight, vel, spin)
-            _impulse(c, 2, new1 - old1, axes, lever, turn, index, weight, vel, spin)
+            lever_impulse(c, 1, new0 - old0, axes, lever, turn, index, weight, vel, spin)
+            lever_impulse(c, 2, new1 - old1, axes, lever, turn, index, weight, vel, spin)
             # The normal impulse toward the target, accumulated and kept ≥ 0.
-            v_n = _speed(c, 0, axes, lever, index, vel, spin)
+            v_n = lever_speed(c, 0, axes, lever, index, vel, spin)
             old = normal_impulse[c]
             new = max(old + mass_n[c] * (target[c] - v_n), 0.0)
             normal_impulse[c] = new
-            _impulse(c, 0, new - old, axes, lever, turn, index, weight, vel, spin)
+            lever_impulse(c, 0, new - old, axes, lever, turn, index, weight, vel, spin)
     v[:] = vel[:bodies]
     w[:] = spin[:bodies]
 
 
 @njit(cache=True, inline="always")
-def _speed(c, k, axes, lever, index, vel, spin):
+def lever_speed(c, k, axes, lever, index, vel, spin):
     """Contact ``c``'s relative velocity along its direction ``k``, B's point from A's."""
     a = index[c, 0]
     b = index[c, 1]
@@ -265,7 +272,7 @@ def _speed(c, k, axes, lever, index, vel, spin):
 
 
 @njit(cache=True, inline="always")
-def _impulse(c, k, size, axes, lever, turn, index, weight, vel, spin):
+def lever_impulse(c, k, size, axes, lever, turn, index, weight, vel, spin):
     """An impulse of ``size`` along contact ``c``'s direction ``k`` on B, its opposite on A."""
     a = index[c, 0]
     b = index[c, 1]
@@ -290,7 +297,7 @@ def correct_positions(
     and small rotation vector [rad] (world frame).
     """
     bodies = shift.shape[0]
-    axes, lever, turn_of, index = _levers(body_a, body_b, normal, normal, arm_a, arm_b,
+    axes, lever, turn_of, index = levers(body_a, body_b, normal, normal, arm_a, arm_b,
                                           inverse_inertia, bodies, 1)  # fmt: skip
     moved = np.zeros((bodies + 1, 3))
     turned = np.zeros((bodies + 1, 3))
@@ -301,9 +308,9 @@ def correct_positions(
     for _ in range(iterations):
         for c in range(body_a.shape[0]):
             # The depth now: less how far the bodies' points moved apart along n so far.
-            excess = depth[c] - _speed(c, 0, axes, lever, index, moved, turned) - allowance
+            excess = depth[c] - lever_speed(c, 0, axes, lever, index, moved, turned) - allowance
             if excess > 0.0:
-                _impulse(c, 0, fraction * excess * mass_n[c], axes, lever, turn_of, index,
+                lever_impulse(c, 0, fraction * excess * mass_n[c], axes, lever, turn_of, index,
                          weight, moved, turned)  # fmt: skip
     shift[:] = moved[:bodies]
     turn[:] = turned[:bodies]

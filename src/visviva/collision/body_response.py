@@ -7,7 +7,9 @@ Given the contacts found at the step's end poses (sorted bottom-up), :func:`resp
    over the step, or ``d + h v_n`` when the start is unknown), tangent frame, effective masses
    and target (:func:`~visviva.collision.body_impulses.prepare_contacts`); a colliding
    contact's target taken at the moment of impact within the step;
-2. the warm start from the last step's impulses, and sequential impulses
+2. with simultaneous impacts, the impact by generalized reflections
+   (:mod:`~visviva.collision.simultaneous`); then the warm start from the last step's
+   impulses, and sequential impulses
    (:func:`~visviva.collision.body_impulses.solve_impulses`);
 3. the step redone for the bodies the impulses changed, from each one's first impact;
 4. the position correction of what overlap is left;
@@ -24,6 +26,7 @@ import numpy as np
 from numba import njit
 
 from .body_impulses import correct_positions, prepare_contacts, solve_impulses
+from .simultaneous import reflect_impacts
 
 __all__ = ["body_frames", "normal_velocities", "respond", "turned"]
 
@@ -184,7 +187,7 @@ def respond(
     x, q, momentum, spin, rotation, inverse_inertia, v, w,
     inverse_mass, inertia_body, dynamic,
     has_start, x0, q0, v0, w0,
-    h, resting_speed, iterations, position_iterations, allowance, fraction,
+    h, resting_speed, iterations, position_iterations, allowance, fraction, simultaneous,
 ):  # fmt: skip
     """Resolve one step's contacts (module docstring) in place on ``x``, ``q``, ``momentum``
     and ``spin``; ``warm_normal`` ``(C,)`` and ``warm_friction`` ``(C, 3)`` (world frame) are
@@ -223,6 +226,17 @@ def respond(
             change = approach[c] - initial[c]
             at_impact = min(initial[c] + tau * change, 0.0)
             target[c] = -restitution[c] * at_impact + (1.0 - tau) * change
+    if simultaneous:
+        # The impact first, all its contacts together by generalized reflections; what is
+        # left for the sweeps is to keep every contact from approaching.
+        touching = np.empty(count, dtype=np.bool_)
+        for c in range(count):
+            touching[c] = depth[c] >= -allowance
+        reflect_impacts(body_a, body_b, normal, arm_a, arm_b, mass_n, restitution, touching,
+                        resting_speed, inverse_mass, inverse_inertia, v, w)  # fmt: skip
+        for c in range(count):
+            if target[c] > 0.0:
+                target[c] = 0.0
     normal_impulse = warm_normal.copy()
     tangent_impulse = np.empty((count, 2))
     for c in range(count):

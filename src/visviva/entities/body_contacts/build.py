@@ -113,6 +113,7 @@ def _finish(entries: Sequence[tuple[str, BodyContactSettings]], context: BuildCo
         restitution=entity.restitution,
         friction=entity.friction,
         gravity=context.scene.world.gravity,
+        impacts=entity.impacts,
     )
     context.stages.append(stage)
 

@@ -40,6 +40,11 @@ class BodyContactSettings(Strict):
     resting_speed: NonNegative | None = Field(
         None, description="approach speed below which a contact rests [m/s] (default: 2|g|dt)"
     )
+    impacts: Literal["sequential", "simultaneous"] = Field(
+        "sequential",
+        description="sequential (bounces among the resting contacts' impulses) or "
+        "simultaneous (generalized reflections: an impact travels along a row)",
+    )
 
 
 class BodyContactMethods:
@@ -53,12 +58,14 @@ class BodyContactMethods:
         friction: float | None = None,
         iterations: int | None = None,
         resting_speed: float | None = None,
+        impacts: str | None = None,
         name: str | None = None,
     ) -> int:
         """Make the bodies of ``targets`` (default: every body) collide with each other and
         with the impulse colliders that target them, each as its collision shape; a pair's
         restitution and friction are the bodies' own (the larger e, √(μ_a μ_b)) unless
         ``restitution`` or ``friction`` is given for all; ``iterations`` sweeps per step;
-        approaches slower than ``resting_speed`` [m/s] rest
-        (:mod:`visviva.collision.body_contacts`)."""
+        approaches slower than ``resting_speed`` [m/s] rest; ``impacts="simultaneous"``
+        resolves a step's impacts together by generalized reflections, as a Newton's cradle
+        needs (:mod:`visviva.collision.body_contacts`)."""
         return self.add("body_contacts", **given(locals()))
