@@ -26,7 +26,8 @@ def _solve(body_a, body_b, point, normal, depth, restitution, friction, position
     body_b = np.array(body_b, dtype=np.int64)
     point, normal = np.array(point, float), np.array(normal, float)
     prepare_contacts(body_a, body_b, point, normal, np.array(depth, float),
-                     np.full(count, np.nan), np.array(restitution, float), resting_speed, h,
+                     np.full(count, np.nan), np.zeros(count), np.array(restitution, float),
+                     resting_speed, h,
                      position, inverse_mass, inverse_inertia, v, w,
                      *arrays.values())  # fmt: skip
     normal_impulse = np.zeros(count)
@@ -172,6 +173,6 @@ def test_position_correction_removes_the_excess_depth_and_keeps_the_centre_of_ma
     shift, turn = np.zeros((2, 3)), np.zeros((2, 3))
     correct_positions(body_a, body_b, normal, np.array([0.1]), np.array([[0.5, 0.0, 0.0]]),
                       np.array([[-0.4, 0.0, 0.0]]), np.array([0.5]), np.array([1.0, 1.0]),
-                      inverse_inertia, 1e-3, 0.8, 30, shift, turn)  # fmt: skip
+                      inverse_inertia, np.array([1e-3]), 0.8, 30, shift, turn)  # fmt: skip
     assert shift[1, 0] - shift[0, 0] == pytest.approx(0.099, rel=1e-9)
     assert shift[0] + shift[1] == pytest.approx(np.zeros(3), abs=1e-15)

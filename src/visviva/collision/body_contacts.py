@@ -36,12 +36,14 @@ import numpy as np
 from numba import njit
 
 from ..errors import ModelError
+from ..geometry.quaternions import quaternion_matrix
 from ..ode.stage import Phase
 from .body_detection import contact_arrays, pair_contacts, piece_poses, plane_contacts
 from .body_pieces import BodyPieces
 from .body_response import body_frames, normal_velocities, respond
 from .broad_phase import overlapping_pairs
 from .contact_classes import CLASSES, COLLIDING, RESTING, SEPARATING
+from .impact_time import pull_back
 from .manifold import MAX_CONTACTS
 
 if TYPE_CHECKING:
@@ -63,6 +65,13 @@ CORRECTION = 0.4
 MATCH = 0.05
 #: How the impacts of a step are resolved (see :class:`BodyContacts`).
 IMPACTS = ("sequential", "simultaneous")
+#: How a fast body's time of impact is found, in :mod:`~visviva.collision.impact_time`'s order.
+TIME_OF_IMPACT = ("advancement", "bisection")
+#: When a body's time of impact is looked for.
+BODY_TIME_OF_IMPACT = ("auto", "always", "never")
+#: A body is fast, and its time of impact looked for by default, when it moves more than this
+#: fraction of its size in a step: then it might pass through something as thin as itself.
+FAST = 0.25
 #: The carried parts, in order (:meth:`BodyContacts.carried_start`).
 MEMORY = (
     "body_contact_key",
@@ -138,6 +147,12 @@ class BodyContacts:
         resting_speed: Approach speed [m/s] below which a contact rests.
         restitution, friction: One coefficient for every pair, or ``None`` for the pair rule.
         gravity: Gravitational acceleration [m/s²]: the contacts are swept against it.
+        time_of_impact: How a fast body's first impact in a step is found
+            (:mod:`~visviva.collision.impact_time`): ``"advancement"`` (conservative
+            advancement, which sees a body pass through a thin one) or ``"bisection"`` (seed
+            003's, which needs the overlap at the step's end).
+        body_time_of_impact: Per body, ``"auto"`` (when it moves more than :data:`FAST` of
+            its size in a step), ``"always"`` or ``"never"``.
         impacts: ``"sequential"``: a colliding contact's bounce is a target of the impulse
             sweeps, with the resting contacts; ``"simultaneous"``: the impacts of a step are
             resolved first, together, by generalized reflections
@@ -165,6 +180,8 @@ class BodyContacts:
         friction: float | None = None,
         gravity: Sequence[float] = (0.0, -9.81, 0.0),
         impacts: str = "sequential",
+        time_of_impact: str = "advancement",
+        body_time_of_impact: Sequence[str] | None = None,
     ) -> None:
         self.pieces = pieces
         self.count = int(np.shape(mass)[0])
@@ -185,6 +202,14 @@ class BodyContacts:
                 f"`impacts` must be one of {', '.join(map(repr, IMPACTS))} (got {impacts!r})"
             )
         self.impacts = impacts
+        if time_of_impact not in TIME_OF_IMPACT:
+            raise ModelError(
+                f"`time_of_impact` must be one of {', '.join(map(repr, TIME_OF_IMPACT))} "
+                f"(got {time_of_impact!r})"
+            )
+        self.time_of_impact = TIME_OF_IMPACT.index(time_of_impact)
+        modes = ["auto"] * self.count if body_time_of_impact is None else list(body_time_of_impact)
+        self.fast_mode = np.array([BODY_TIME_OF_IMPACT.index(m) for m in modes], dtype=np.int64)
         g = np.asarray(gravity, dtype=np.float64)
         size = float(np.linalg.norm(g))
         self.up = -g / size if size > 0.0 else np.zeros(3)
@@ -196,6 +221,7 @@ class BodyContacts:
                 reach = np.linalg.norm(pieces.local_position[p]) + pieces.radius[p]
                 size[b] = max(size[b], reach)
         self.size = size
+        self.reach = np.linalg.norm(pieces.local_position, axis=1) + pieces.radius
 
     def carried_start(self) -> dict[str, np.ndarray]:
         """The last step's contacts for the warm start: ``body_contact_key`` ``(C,)`` (the
@@ -280,8 +306,11 @@ class BodyContacts:
         impulses; ``start`` the bodies at the step's start, ``(x, q, v, ω)``, if known: the
         contacts' depths at the start are then measured from how the bodies moved, and a
         collision within the step reverses the approach at the moment of impact, not the
-        step's end. Returns this step's contacts and impulses, the carried parts
+        step's end, and a fast body is first moved back to its first impact of the step
+        (:meth:`pull_back`). Returns this step's contacts and impulses, the carried parts
         (:data:`MEMORY`) the next step warm-starts from."""
+        if start is not None:
+            self.pull_back(start[0], start[1], x, q)
         rotation, inverse_inertia, v, w = body_frames(
             q, self.inverse_inertia_body, self.inverse_mass, momentum, spin
         )
@@ -306,7 +335,7 @@ class BodyContacts:
         radius = pieces.radius
         smaller = np.minimum(np.where(piece_a >= 0, radius[np.maximum(piece_a, 0)], np.inf),
                              radius[piece_b])  # fmt: skip
-        allowance = ALLOWANCE * float(smaller.min()) if smaller.size else 0.0
+        allowance = ALLOWANCE * smaller
         normal_impulse, friction_impulse = respond(
             body_a, body_b, point, normal, depth, restitution, friction, warm_normal,
             warm_friction, x, q, momentum, spin, rotation, inverse_inertia, v, w,
@@ -316,6 +345,33 @@ class BodyContacts:
             CORRECTION, self.impacts == "simultaneous",
         )  # fmt: skip
         return key, anchor, normal_impulse, friction_impulse
+
+    def pull_back(self, x0: np.ndarray, q0: np.ndarray, x: np.ndarray, q: np.ndarray) -> int:
+        """Move each fast body (see ``body_time_of_impact``) back along its step from
+        ``(x0, q0)`` to ``(x, q)`` to its first impact, in place on ``x`` and ``q``; returns
+        how many were moved (:mod:`~visviva.collision.impact_time`)."""
+        travel = np.sqrt(((x - x0) ** 2).sum(axis=1))
+        mode = self.fast_mode
+        fast = self.dynamic & ((mode == 1) | ((mode == 0) & (travel > FAST * self.size)))
+        if not fast.any():
+            return 0
+        pieces = self.pieces
+        arrays = pieces.arrays()
+        bounds = []
+        for position, orientation in ((x0, q0), (x, q)):
+            unit = orientation / np.linalg.norm(orientation, axis=1, keepdims=True)
+            lo = np.empty((pieces.count, 3))
+            hi = np.empty((pieces.count, 3))
+            piece_poses(arrays, pieces.body, position, quaternion_matrix(unit),
+                        np.zeros(self.count), pieces.local_position.copy(),
+                        pieces.local_rotation.copy(), lo, hi)  # fmt: skip
+            bounds.append((lo, hi))
+        lo = np.minimum(bounds[0][0], bounds[1][0])
+        hi = np.maximum(bounds[0][1], bounds[1][1])
+        pairs = overlapping_pairs(lo, hi, np.ones(pieces.count, dtype=np.bool_))
+        return pull_back(pairs, fast, self.time_of_impact, ALLOWANCE, arrays, pieces.body,
+                         pieces.local_position, pieces.local_rotation, self.reach,
+                         pieces.radius, x0, q0, x, q)  # fmt: skip
 
     def _coefficients(self, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple[np.ndarray, ...]:
         """Each contact's restitution and friction (the pair rule, or the stage's value)."""

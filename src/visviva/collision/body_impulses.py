@@ -111,7 +111,7 @@ def _tangents(nx, ny, nz):
 
 @njit(cache=True)
 def prepare_contacts(
-    body_a, body_b, point, normal, depth, start_depth, restitution, resting_speed, h,
+    body_a, body_b, point, normal, depth, start_depth, touch, restitution, resting_speed, h,
     position, inverse_mass, inverse_inertia, v, w,
     arm_a, arm_b, frame, mass_n, mass_t, target,
 ):  # fmt: skip
@@ -122,6 +122,7 @@ def prepare_contacts(
         point, normal: ``(C, 3)`` contact points [m] and unit normals from A toward B.
         depth: ``(C,)`` penetration [m] at the step's end poses, negative for a speculative
             contact's gap.
+        touch: ``(C,)`` [m]: a contact closer than this counts as touching (it may collide).
         start_depth: ``(C,)`` the same at the step's start (NaN: unknown, then ``d + h v_n``,
             as if the bodies had moved with ``v`` all the step).
         restitution: ``(C,)`` coefficient of restitution of each contact's pair.
@@ -160,7 +161,7 @@ def prepare_contacts(
         vbx, vby, vbz = _point_velocity(b, v, w, rbx, rby, rbz)
         v_n = (vbx - vax) * nx + (vby - vay) * ny + (vbz - vaz) * nz
         start = start_depth[c] if start_depth[c] == start_depth[c] else depth[c] + h * v_n
-        if v_n < -resting_speed and depth[c] >= 0.0:
+        if v_n < -resting_speed and depth[c] >= -touch[c]:
             # It reaches the other body within the step, fast: it collides.
             target[c] = -restitution[c] * v_n
         else:
@@ -290,7 +291,7 @@ def correct_positions(
     inverse_mass, inverse_inertia, allowance, fraction, iterations, shift, turn,
 ):  # fmt: skip
     """Split position correction: sweeps of pseudo-impulses that move the bodies apart where
-    they overlap by more than ``allowance`` [m], each removing ``fraction`` of a contact's
+    they overlap by more than ``allowance[c]`` [m], each removing ``fraction`` of a contact's
     remaining excess depth, the depths updated to first order as the bodies move.
 
     ``shift`` and ``turn`` ``(B, 3)``, zero on entry, receive each body's translation [m]
@@ -308,7 +309,7 @@ def correct_positions(
     for _ in range(iterations):
         for c in range(body_a.shape[0]):
             # The depth now: less how far the bodies' points moved apart along n so far.
-            excess = depth[c] - lever_speed(c, 0, axes, lever, index, moved, turned) - allowance
+            excess = depth[c] - lever_speed(c, 0, axes, lever, index, moved, turned) - allowance[c]
             if excess > 0.0:
                 lever_impulse(c, 0, fraction * excess * mass_n[c], axes, lever, turn_of, index,
                          weight, moved, turned)  # fmt: skip

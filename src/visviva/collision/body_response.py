@@ -175,7 +175,8 @@ def _start_depths(body_a, body_b, point, normal, depth, x, rotation, x0, q0):
 @njit(cache=True)
 def _impact_time(depth, start):
     """The fraction of the step at which a contact touched, moving linearly from its start
-    depth to its end depth (0 if it overlapped already at the start)."""
+    depth to its end depth (0 if it overlapped already at the start, 1 if it ends just short
+    of touching)."""
     if start >= 0.0 or not start - depth < 0.0:
         return 0.0
     return min(max(start / (start - depth), 0.0), 1.0)
@@ -205,7 +206,7 @@ def respond(
         start_depth = _start_depths(body_a, body_b, point, normal, depth, x, rotation, x0, q0)
     else:
         start_depth = np.full(count, np.nan)
-    prepare_contacts(body_a, body_b, point, normal, depth, start_depth, restitution,
+    prepare_contacts(body_a, body_b, point, normal, depth, start_depth, allowance, restitution,
                      resting_speed, h, x, inverse_mass, inverse_inertia, v, w, arm_a, arm_b,
                      frame, mass_n, mass_t, target)  # fmt: skip
     approach = normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w)
@@ -213,7 +214,7 @@ def respond(
     # Each body's first impact of the step, as a fraction of it (1: none).
     first = np.ones(bodies + 1)
     for c in range(count):
-        if not (depth[c] >= 0.0 and approach[c] < -resting_speed):
+        if not (depth[c] >= -allowance[c] and approach[c] < -resting_speed):
             continue
         start = start_depth[c] if has_start else depth[c] + h * approach[c]
         tau = _impact_time(depth[c], start)
@@ -231,7 +232,7 @@ def respond(
         # left for the sweeps is to keep every contact from approaching.
         touching = np.empty(count, dtype=np.bool_)
         for c in range(count):
-            touching[c] = depth[c] >= -allowance
+            touching[c] = depth[c] >= -allowance[c]
         reflect_impacts(body_a, body_b, normal, arm_a, arm_b, mass_n, restitution, touching,
                         resting_speed, inverse_mass, inverse_inertia, v, w)  # fmt: skip
         for c in range(count):

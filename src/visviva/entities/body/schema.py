@@ -150,6 +150,11 @@ class RigidBody(Strict):
         description="what it collides as: its shape (a mesh must be convex), its mesh's convex "
         "hull, or nothing",
     )
+    time_of_impact: Literal["auto", "always", "never"] = Field(
+        "auto",
+        description="look for its first impact within a step: auto (when it moves more than a "
+        "quarter of its size in a step), always, never",
+    )
     convex_pieces: (
         Annotated[list[Annotated[list[Vector], Field(min_length=4)]], Field(min_length=1)] | None
     ) = Field(
@@ -264,6 +269,7 @@ class RigidBodyMethods:
         friction: float | None = None,
         collision_shape: str | None = None,
         convex_pieces: Sequence[Any] | None = None,
+        time_of_impact: str | None = None,
         name: str | None = None,
     ) -> int:
         """Add a rigid body: a ``shape`` (``"box"`` with ``size`` [m] its full edge lengths,
@@ -283,7 +289,9 @@ class RigidBodyMethods:
         collides with ``restitution`` e in [0, 1] and Coulomb ``friction`` μ (a pair takes the
         larger e and √(μ_a μ_b)) as its shape, or ``collision_shape="hull"`` (a mesh's convex
         hull), ``"none"``, or ``convex_pieces``: a list of point sets in its own axes [m], each
-        piece their convex hull (:mod:`visviva.collision.body_contacts`).
+        piece their convex hull; its first impact within a step is looked for when it moves
+        fast (``time_of_impact="auto"``), ``"always"`` or ``"never"``
+        (:mod:`visviva.collision.body_contacts`).
         Its state is ``body_position`` (the centre of mass), ``body_orientation``,
         ``body_momentum`` and ``body_angular_momentum``."""
         fields = given(locals())

@@ -114,6 +114,8 @@ def _finish(entries: Sequence[tuple[str, BodyContactSettings]], context: BuildCo
         friction=entity.friction,
         gravity=context.scene.world.gravity,
         impacts=entity.impacts,
+        time_of_impact=entity.time_of_impact,
+        body_time_of_impact=[body.time_of_impact for _, body in chosen],
     )
     context.stages.append(stage)
 

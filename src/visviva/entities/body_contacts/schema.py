@@ -40,6 +40,11 @@ class BodyContactSettings(Strict):
     resting_speed: NonNegative | None = Field(
         None, description="approach speed below which a contact rests [m/s] (default: 2|g|dt)"
     )
+    time_of_impact: Literal["advancement", "bisection"] = Field(
+        "advancement",
+        description="how a fast body's first impact in a step is found: conservative "
+        "advancement (sees a body pass through a thin one) or seed 003's bisection",
+    )
     impacts: Literal["sequential", "simultaneous"] = Field(
         "sequential",
         description="sequential (bounces among the resting contacts' impulses) or "
@@ -59,6 +64,7 @@ class BodyContactMethods:
         iterations: int | None = None,
         resting_speed: float | None = None,
         impacts: str | None = None,
+        time_of_impact: str | None = None,
         name: str | None = None,
     ) -> int:
         """Make the bodies of ``targets`` (default: every body) collide with each other and
@@ -67,5 +73,6 @@ class BodyContactMethods:
         ``restitution`` or ``friction`` is given for all; ``iterations`` sweeps per step;
         approaches slower than ``resting_speed`` [m/s] rest; ``impacts="simultaneous"``
         resolves a step's impacts together by generalized reflections, as a Newton's cradle
-        needs (:mod:`visviva.collision.body_contacts`)."""
+        needs; a fast body's first impact within a step is found by ``time_of_impact``
+        ``"advancement"`` or ``"bisection"`` (:mod:`visviva.collision.impact_time`)."""
         return self.add("body_contacts", **given(locals()))
