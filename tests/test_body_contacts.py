@@ -334,3 +334,25 @@ def test_a_fast_ball_does_not_pass_through_a_thin_plate_with_time_of_impact():
 def _advance(simulation):
     simulation.step(24)
     return simulation.state["body_position"][0]
+
+
+def test_bodies_rest_on_a_mesh_collider_and_roll_off_its_edge():
+    # A 1 m × 0.2 m × 1 m step as a triangle mesh on the floor: a cube dropped on it rests on
+    # its top (y = 0.2 + 0.1); a ball dropped beside it lands on the floor.
+    corners = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 0.2) for z in (-0.5, 0.5)])
+    faces = [[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+             [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]]  # fmt: skip
+    builder = _floor_scene(e=0.0)
+    builder.add_collider("mesh", vertices=corners.tolist(), triangles=faces, restitution=0.0)
+    builder.add_body("box", size=(0.2, 0.2, 0.2), density=1000.0, position=(0.5, 0.6, 0.0),
+                     restitution=0.0)  # fmt: skip
+    builder.add_body("sphere", radius=0.1, density=1000.0, position=(-0.5, 0.6, 0.0),
+                     restitution=0.0)  # fmt: skip
+    builder.add_body_contacts()
+    simulation = vv.Simulation(builder.build())
+    simulation.step(480)
+    x = simulation.state["body_position"]
+    assert x[0] == pytest.approx([0.5, 0.3, 0.0], abs=1e-4)
+    assert x[1] == pytest.approx([-0.5, 0.1, 0.0], abs=1e-4)
+    found = simulation.body_contacts()
+    assert set(found.body_b.tolist()) == {0, 1} and (found.body_a == -1).all()

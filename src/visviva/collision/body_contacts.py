@@ -38,10 +38,17 @@ from numba import njit
 from ..errors import ModelError
 from ..geometry.quaternions import quaternion_matrix
 from ..ode.stage import Phase
-from .body_detection import contact_arrays, pair_contacts, piece_poses, plane_contacts
+from .body_detection import (
+    contact_arrays,
+    mesh_contacts,
+    pair_contacts,
+    piece_poses,
+    plane_contacts,
+)
 from .body_pieces import BodyPieces
 from .body_response import body_frames, normal_velocities, respond
 from .broad_phase import overlapping_pairs
+from .bvh import MeshBVH
 from .contact_classes import CLASSES, COLLIDING, RESTING, SEPARATING
 from .impact_time import pull_back
 from .manifold import MAX_CONTACTS
@@ -102,7 +109,8 @@ class BodyContactSet:
     """The bodies' contacts at one moment, in solve order, for inspection.
 
     Attributes:
-        piece_a, piece_b: ``(C,)`` the pieces (``-1 − f`` for plane ``f`` as ``piece_a``).
+        piece_a, piece_b: ``(C,)`` the pieces (``piece_a`` is ``-1 − s`` for scenery ``s``:
+            the planes, then the meshes' triangles).
         body_a, body_b: ``(C,)`` their bodies (``-1``: the world).
         point, normal: ``(C, 3)`` contact points [m] and unit normals from A toward B.
         depth: ``(C,)`` penetration [m] (negative: a gap).
@@ -143,6 +151,8 @@ class BodyContacts:
             body's axes [kg·m²].
         dynamic: ``(B,)`` bool: the bodies contacts push (the others have infinite mass).
         planes: Static planes.
+        meshes: Static triangle meshes, each ``(tree, restitution, friction)``
+            (:class:`~visviva.collision.bvh.MeshBVH`): a body meets them from outside.
         iterations: Sweeps of impulses, and of position corrections, per step.
         resting_speed: Approach speed [m/s] below which a contact rests.
         restitution, friction: One coefficient for every pair, or ``None`` for the pair rule.
@@ -174,6 +184,7 @@ class BodyContacts:
         dynamic: np.ndarray,
         planes: Planes,
         *,
+        meshes: Sequence[tuple[MeshBVH, float, float]] = (),
         iterations: int = 20,
         resting_speed: float = 0.0,
         restitution: float | None = None,
@@ -193,6 +204,20 @@ class BodyContacts:
         )
         self.dynamic = dynamic
         self.planes = planes
+        self.meshes = tuple(meshes)
+        # The scenery a contact's piece A may be instead of a piece, numbered -1 − id: the
+        # planes, then each mesh's triangle slots; with each one's coefficients.
+        sizes = [bvh.triangle_points.shape[0] for bvh, _, _ in self.meshes]
+        self.mesh_first = np.concatenate([[planes.point.shape[0]], planes.point.shape[0]
+                                          + np.cumsum(sizes, dtype=np.int64)])[:-1]  # fmt: skip
+        self.scenery_restitution = np.concatenate(
+            [planes.restitution, *[np.full(n, e) for n, (_, e, _) in zip(sizes, self.meshes,
+                                                                          strict=True)]]
+        )  # fmt: skip
+        self.scenery_friction = np.concatenate(
+            [planes.friction, *[np.full(n, mu) for n, (_, _, mu) in zip(sizes, self.meshes,
+                                                                         strict=True)]]
+        )  # fmt: skip
         self.iterations = iterations
         self.resting_speed = resting_speed
         self.restitution = restitution
@@ -293,12 +318,21 @@ class BodyContacts:
         moving = np.append(self.dynamic, False)[pieces.body]
         pairs = pairs[moving[pairs[:, 0]] | moving[pairs[:, 1]]]
         planes = self.planes
-        capacity = MAX_CONTACTS * (pairs.shape[0] + planes.point.shape[0] * pieces.count)
-        out = contact_arrays(capacity)
-        count = pair_contacts(arrays, pieces.body, pairs, position, turn, margin, out)
-        count = plane_contacts(arrays, pieces.body, position, turn, lo, hi, margin, planes.point,
-                               planes.normal, planes.thickness, out, count)  # fmt: skip
-        return tuple(a[:count] for a in out), position, turn
+        scenery = planes.point.shape[0] + 16 * len(self.meshes)
+        capacity = MAX_CONTACTS * (pairs.shape[0] + scenery * pieces.count) + 16
+        while True:
+            out = contact_arrays(capacity)
+            count = pair_contacts(arrays, pieces.body, pairs, position, turn, margin, out)
+            count = plane_contacts(arrays, pieces.body, position, turn, lo, hi, margin,
+                                   planes.point, planes.normal, planes.thickness, out,
+                                   count)  # fmt: skip
+            for (bvh, _, _), first in zip(self.meshes, self.mesh_first, strict=True):
+                count = mesh_contacts(bvh.node_bounds, bvh.node_links, bvh.triangle_points,
+                                      first, arrays, pieces.body, position, turn, lo, hi,
+                                      margin, out, count)  # fmt: skip
+            if count < capacity:
+                return tuple(a[:count] for a in out), position, turn
+            capacity *= 2  # a mesh gave more contacts than room was made for
 
     def resolve(self, x, q, momentum, spin, h, memory, start=None):
         """Resolve one step's contacts in place on the bodies' ``x``, ``q``, ``P``, ``L``
@@ -324,7 +358,7 @@ class BodyContacts:
         pieces = self.pieces
         body_a, body_b = self._bodies_of(piece_a, piece_b)
         restitution, friction = self._coefficients(piece_a, piece_b)
-        key = (piece_a + self.planes.point.shape[0]) * (pieces.count + 1) + piece_b
+        key = (piece_a + self.scenery_restitution.shape[0]) * (pieces.count + 1) + piece_b
         anchor = np.einsum("cji,cj->ci", turn[piece_b], point - position[piece_b])
         warm_normal, warm_friction = _warm_start(key, anchor, MATCH * pieces.radius[piece_b],
                                                  *memory)  # fmt: skip
@@ -375,13 +409,14 @@ class BodyContacts:
 
     def _coefficients(self, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple[np.ndarray, ...]:
         """Each contact's restitution and friction (the pair rule, or the stage's value)."""
-        pieces, planes = self.pieces, self.planes
-        plane = -1 - np.minimum(piece_a, -1)
-        on_plane = piece_a < 0
+        pieces = self.pieces
+        scenery = -1 - np.minimum(piece_a, -1)
+        on_scenery = piece_a < 0
         index = np.maximum(piece_a, 0)
-        e_a = np.where(on_plane, planes.restitution[plane] if planes.point.shape[0] else 0.0,
+        has = self.scenery_restitution.shape[0] > 0
+        e_a = np.where(on_scenery, self.scenery_restitution[scenery] if has else 0.0,
                        pieces.restitution[index])  # fmt: skip
-        mu_a = np.where(on_plane, planes.friction[plane] if planes.point.shape[0] else 0.0,
+        mu_a = np.where(on_scenery, self.scenery_friction[scenery] if has else 0.0,
                         pieces.friction[index])  # fmt: skip
         e = np.maximum(e_a, pieces.restitution[piece_b])
         mu = np.sqrt(mu_a * pieces.friction[piece_b])

@@ -4,7 +4,8 @@
 from its body's centre of mass and rotation, with its bounding box grown by its margin;
 :func:`~visviva.collision.broad_phase.overlapping_pairs` keeps the pairs whose boxes overlap;
 :func:`pair_contacts` runs GJK/EPA and the manifold on each (:mod:`~visviva.collision.separation`,
-:mod:`~visviva.collision.manifold`) and :func:`plane_contacts` each piece against each plane.
+:mod:`~visviva.collision.manifold`), :func:`plane_contacts` each piece against each plane and
+:func:`mesh_contacts` against the triangles of a static mesh its box overlaps.
 Contacts come out in the order of their pairs, then of their planes: the same on every run.
 """
 
@@ -17,11 +18,19 @@ from numba import njit
 
 from .body_pieces import piece_shape
 from .broad_phase import shape_bounds
-from .convex import SPHERE
+from .bvh import STACK_SIZE
+from .convex import HULL, SPHERE
 from .manifold import CANDIDATES, MAX_CONTACTS, contact_manifold, plane_manifold
 from .separation import plane_separation, shape_distance
 
-__all__ = ["pair_contacts", "piece_poses", "plane_contacts"]
+__all__ = [
+    "MAX_CONTACTS",
+    "contact_arrays",
+    "mesh_contacts",
+    "pair_contacts",
+    "piece_poses",
+    "plane_contacts",
+]
 
 
 @njit(cache=True)
@@ -183,4 +192,75 @@ def contact_arrays(capacity: int) -> tuple[np.ndarray, ...]:
     )
 
 
-__all__ += ["MAX_CONTACTS", "contact_arrays"]
+@njit(cache=True)
+def _triangle_shape(corners):
+    """A triangle ``(3, 3)`` as a flat posed hull of two faces, its front counter-clockwise
+    (the mesh's outside) first, in the world frame."""
+    ex = corners[1] - corners[0]
+    ey = corners[2] - corners[0]
+    n = np.cross(ex, ey)
+    n /= math.sqrt(np.dot(n, n))
+    planes = np.empty((2, 4))
+    planes[0, :3] = n
+    planes[0, 3] = np.dot(n, corners[0])
+    planes[1, :3] = -n
+    planes[1, 3] = -planes[0, 3]
+    face_start = np.array([0, 3, 6], dtype=np.int64)
+    face_vertices = np.array([0, 1, 2, 0, 2, 1], dtype=np.int64)
+    params = np.zeros(4)
+    return (HULL, params, corners, planes, face_start, face_vertices, np.zeros(3), np.eye(3)), n
+
+
+@njit(cache=True)
+def mesh_contacts(node_bounds, node_links, triangle_points, first_id, pieces, body,
+                  piece_position, piece_rotation, lo, hi, margin, out, start):  # fmt: skip
+    """The contacts of every moving piece with the triangles of a static mesh (its tree's
+    arrays, :class:`~visviva.collision.bvh.MeshBVH`) whose boxes its bounding box overlaps,
+    appended to ``out`` from row ``start``; triangle slot ``s`` is recorded as piece
+    ``-1 − (first_id + s)``. A triangle meets a piece only from the mesh's outside (the piece's
+    origin in front of the triangle's plane), so the contacts push it out, never through.
+    Returns the new count."""
+    piece_a, piece_b, point, normal, depth = out
+    points = np.empty((CANDIDATES, 3))
+    depths = np.empty(CANDIDATES)
+    stack = np.empty(STACK_SIZE, dtype=np.int64)
+    count = start
+    for p in range(body.shape[0]):
+        b = body[p]
+        if b < 0:
+            continue
+        stack[0] = 0
+        top = 1
+        while top > 0:
+            top -= 1
+            k = stack[top]
+            overlaps = True
+            for axis in range(3):
+                if node_bounds[k, axis] > hi[p, axis] or node_bounds[k, 3 + axis] < lo[p, axis]:
+                    overlaps = False
+            if not overlaps:
+                continue
+            first, size = node_links[k, 0], node_links[k, 1]
+            if size == 0:
+                stack[top] = first
+                stack[top + 1] = first + 1
+                top += 2
+                continue
+            for slot in range(first, first + size):
+                corners = triangle_points[slot]
+                triangle, n = _triangle_shape(corners)
+                if np.dot(n, piece_position[p] - corners[0]) < 0.0:
+                    continue  # behind the triangle: inside the mesh, or beyond it
+                shape = piece_shape(p, pieces, piece_position[p], piece_rotation[p])
+                separation = shape_distance(triangle, shape)
+                found, nx, ny, nz = contact_manifold(triangle, shape, separation, margin[b],
+                                                     points, depths)  # fmt: skip
+                for c in range(found):
+                    if count == piece_a.shape[0]:
+                        return count
+                    piece_a[count], piece_b[count] = -1 - (first_id + slot), p
+                    point[count] = points[c]
+                    normal[count, 0], normal[count, 1], normal[count, 2] = nx, ny, nz
+                    depth[count] = depths[c]
+                    count += 1
+    return count

@@ -5,9 +5,9 @@ colliders as static pieces and planes, and the contact stage
 A body collides as its shape, centred where its mass properties put its centre of mass: a
 primitive as itself, a mesh as its own surface only if that is convex (the hull of a
 non-convex mesh is never taken silently: ``collision_shape = "hull"`` asks for it,
-``convex_pieces`` gives the pieces). The impulse colliders (planes, boxes, spheres) act on
-every targeted body, with their own restitution and friction; their ``targets`` choose
-particles only.
+``convex_pieces`` gives the pieces). The impulse colliders — planes, boxes, spheres and meshes
+(met from outside) — act on every targeted body, with their own restitution and friction;
+their ``targets`` choose particles only.
 """
 
 from __future__ import annotations
@@ -81,6 +81,7 @@ def _finish(entries: Sequence[tuple[str, BodyContactSettings]], context: BuildCo
         restitution += [body.restitution] * len(pieces)
         friction += [body.friction] * len(pieces)
     planes: list[tuple[Plane, float, float]] = []
+    meshes: list[tuple[Any, float, float]] = []
     for collider_where, collider in context.of_kind("collider"):
         if collider.response != "impulse":
             continue
@@ -93,11 +94,7 @@ def _finish(entries: Sequence[tuple[str, BodyContactSettings]], context: BuildCo
             restitution.append(collider.restitution)
             friction.append(collider.friction)
         else:
-            raise Located(
-                collider_where,
-                "a mesh collider does not meet rigid bodies yet: give the bodies planes, "
-                "boxes or spheres to collide with, or leave out body_contacts",
-            )
+            meshes.append((shape.bvh, collider.restitution, collider.friction))
     resting = entity.resting_speed
     if resting is None:
         resting = 2.0 * math.hypot(*context.gravity) * context.h  # Mirtich & Canny 1995
@@ -108,6 +105,7 @@ def _finish(entries: Sequence[tuple[str, BodyContactSettings]], context: BuildCo
         bodies.inertia,
         dynamic,
         _planes(planes),
+        meshes=meshes,
         iterations=entity.iterations,
         resting_speed=resting,
         restitution=entity.restitution,
