@@ -356,3 +356,30 @@ def test_bodies_rest_on_a_mesh_collider_and_roll_off_its_edge():
     assert x[1] == pytest.approx([-0.5, 0.1, 0.0], abs=1e-4)
     found = simulation.body_contacts()
     assert set(found.body_b.tolist()) == {0, 1} and (found.body_a == -1).all()
+
+
+def test_a_non_convex_mesh_cut_into_convex_pieces_lands_on_its_faces():
+    from visviva.collision.decomposition import convex_decomposition
+
+    vertices, triangles = _l_prism()
+    pieces = convex_decomposition(np.array(vertices, float), np.array(triangles))
+    # The L is two boxes: no piece may fill the notch (x > 1 and y > 1).
+    assert len(pieces) >= 2
+    for piece in pieces:
+        assert not ((piece[:, 0] > 1.0 + 1e-3) & (piece[:, 1] > 1.0 + 1e-3)).any()
+    builder = _floor_scene(e=0.0)
+    builder.add_body("mesh", vertices=vertices, triangles=triangles, density=1000.0,
+                     collision_shape="decomposition", position=(0, 0.5, 0),
+                     restitution=0.0)  # fmt: skip
+    builder.add_body_contacts()
+    simulation = vv.Simulation(builder.build())
+    simulation.step(720)
+    # It rests on the floor: its lowest corner at y = 0 (to the pieces' approximation, 1 cm).
+    from visviva.geometry.quaternions import quaternion_matrix
+
+    model = simulation.model
+    centre = model.bodies.center[0]
+    rotation = quaternion_matrix(simulation.state["body_orientation"][0])
+    world = (np.array(vertices) - centre) @ rotation.T + simulation.state["body_position"][0]
+    assert world[:, 1].min() == pytest.approx(0.0, abs=0.01)
+    assert np.abs(simulation.state["body_momentum"]).max() < 3.0

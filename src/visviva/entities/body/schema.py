@@ -145,10 +145,10 @@ class RigidBody(Strict):
     friction: NonNegative = Field(
         0.5, description="Coulomb friction μ of its contacts (a pair takes √(μ_a μ_b))"
     )
-    collision_shape: Literal["shape", "hull", "none"] = Field(
+    collision_shape: Literal["shape", "hull", "decomposition", "none"] = Field(
         "shape",
         description="what it collides as: its shape (a mesh must be convex), its mesh's convex "
-        "hull, or nothing",
+        "hull, its mesh cut into convex pieces (CoACD), or nothing",
     )
     time_of_impact: Literal["auto", "always", "never"] = Field(
         "auto",
@@ -219,12 +219,12 @@ class RigidBody(Strict):
                 "give `convex_pieces` or `collision_shape`, not both: the pieces are what the "
                 "body collides as",
             )
-        if self.collision_shape == "hull" and self.shape != "mesh":
+        if self.collision_shape in ("hull", "decomposition") and self.shape != "mesh":
             raise PydanticCustomError(
                 "hull_of_primitive",
-                'collision_shape = "hull" is the convex hull of a mesh; a {shape} collides as '
-                "itself (leave `collision_shape` out)",
-                {"shape": self.shape},
+                'collision_shape = "{kind}" is for a mesh; a {shape} collides as itself '
+                "(leave `collision_shape` out)",
+                {"shape": self.shape, "kind": self.collision_shape},
             )
         if not any(self.orientation):
             raise PydanticCustomError(
@@ -288,7 +288,8 @@ class RigidBodyMethods:
         ``"static"`` (see :mod:`visviva.entities.body.schema`). With ``add_body_contacts`` it
         collides with ``restitution`` e in [0, 1] and Coulomb ``friction`` μ (a pair takes the
         larger e and √(μ_a μ_b)) as its shape, or ``collision_shape="hull"`` (a mesh's convex
-        hull), ``"none"``, or ``convex_pieces``: a list of point sets in its own axes [m], each
+        hull), ``"decomposition"`` (a mesh cut into convex pieces), ``"none"``, or
+        ``convex_pieces``: a list of point sets in its own axes [m], each
         piece their convex hull; its first impact within a step is looked for when it moves
         fast (``time_of_impact="auto"``), ``"always"`` or ``"never"``
         (:mod:`visviva.collision.body_contacts`).

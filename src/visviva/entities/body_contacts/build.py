@@ -5,7 +5,8 @@ colliders as static pieces and planes, and the contact stage
 A body collides as its shape, centred where its mass properties put its centre of mass: a
 primitive as itself, a mesh as its own surface only if that is convex (the hull of a
 non-convex mesh is never taken silently: ``collision_shape = "hull"`` asks for it,
-``convex_pieces`` gives the pieces). The impulse colliders — planes, boxes, spheres and meshes
+``"decomposition"`` cuts the mesh into convex pieces (:mod:`visviva.collision.decomposition`),
+``convex_pieces`` gives them). The impulse colliders — planes, boxes, spheres and meshes
 (met from outside) — act on every targeted body, with their own restitution and friction;
 their ``targets`` choose particles only.
 """
@@ -23,6 +24,7 @@ from ..._registry import did_you_mean
 from ...collision import Box, Capsule, Cone, ConvexHull, Cylinder, Ellipsoid, Plane, Sphere
 from ...collision.body_contacts import BodyContacts, Planes
 from ...collision.body_pieces import BodyPieces
+from ...collision.decomposition import convex_decomposition
 from ...errors import ModelError, SceneProblem
 from ...geometry.mesh_topology import enclosed_volume
 from ..collider.shapes import collider_shape
@@ -161,6 +163,11 @@ def _pieces(where: str, body: Any, origin: np.ndarray) -> list[Any]:
     if body.shape == "ellipsoid":
         return [Ellipsoid(at, body.size)]
     vertices = np.asarray(body.vertices, dtype=np.float64)
+    if body.collision_shape == "decomposition":
+        triangles = np.asarray(body.triangles, dtype=np.int64)
+        return [
+            ConvexHull(piece, position=at) for piece in convex_decomposition(vertices, triangles)
+        ]
     if body.collision_shape == "shape":
         volume = enclosed_volume(vertices, np.asarray(body.triangles, dtype=np.int64))
         hull = Qhull(vertices).volume
@@ -169,8 +176,9 @@ def _pieces(where: str, body: Any, origin: np.ndarray) -> list[Any]:
                 f"{where}.vertices",
                 f"the mesh is not convex (its volume {volume:.6g} m³ is less than its hull's "
                 f"{hull:.6g} m³), and a body collides as convex pieces: give `convex_pieces` "
-                '(lists of points in the body\'s axes), or collision_shape = "hull" to collide '
-                "as its convex hull",
+                '(lists of points in the body\'s axes), collision_shape = "decomposition" to '
+                'have it cut into convex pieces, or collision_shape = "hull" to collide as its '
+                "convex hull",
             )
     return [ConvexHull(vertices, position=at)]
 
