@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from visviva.collision import Box, Sphere
-from visviva.collision.body_contacts import BodyContacts, Planes
+from visviva.collision.body_contacts import BodyContacts, Moving, Planes
 from visviva.collision.body_pieces import BodyPieces
 from visviva.collision.body_response import turned
 from visviva.geometry.quaternions import quaternion_matrix
@@ -39,7 +39,7 @@ def _run(shapes, mass, inertia, x0, steps, *, e, mu=0.5):
         inverse = rotation @ np.linalg.inv(inertia) @ rotation.transpose(0, 2, 1)
         x += H * momentum / mass[:, None]
         turned(q, H * np.einsum("bij,bj->bi", inverse, spin))
-        memory = stage.resolve(x, q, momentum, spin, H, memory)
+        memory = stage.resolve(stage.movers, Moving(x, q, momentum, spin), H, memory)
         path.append(x.copy())
     return np.array(path), q
 

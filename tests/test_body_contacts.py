@@ -383,3 +383,44 @@ def test_a_non_convex_mesh_cut_into_convex_pieces_lands_on_its_faces():
     world = (np.array(vertices) - centre) @ rotation.T + simulation.state["body_position"][0]
     assert world[:, 1].min() == pytest.approx(0.0, abs=0.01)
     assert np.abs(simulation.state["body_momentum"]).max() < 3.0
+
+
+def _pour(meet: bool):
+    builder = _floor_scene("symplectic_euler", e=0.0)
+    builder.add_body("box", size=(1.0, 0.2, 1.0), density=500.0, position=(0, 0.1, 0))
+    rng = np.random.default_rng(0)
+    positions = np.column_stack([rng.uniform(-0.3, 0.3, 100), rng.uniform(0.4, 1.2, 100),
+                                 rng.uniform(-0.3, 0.3, 100)])  # fmt: skip
+    builder.add_particles(positions=positions, radius=0.03, mass=0.05, name="balls")
+    builder.add_particle_collisions(targets=["balls"])
+    builder.add_body_contacts(particles=["balls"] if meet else None)
+    simulation = vv.Simulation(builder.build())
+    simulation.step(360)
+    return simulation
+
+
+def test_particles_poured_onto_a_body_rest_on_it_and_push_it():
+    # Balls poured onto a slab rest on its top (y = 0.2 + r), the slab pressed into the floor
+    # by their weight; without `particles` they fall through it (the test has teeth).
+    resting = _pour(True)
+    y = resting.state["particle_position"][:, 1]
+    assert y.min() == pytest.approx(0.23, abs=2e-3)
+    assert resting.state["body_position"][0, 1] == pytest.approx(0.1, abs=2e-4)
+    through = _pour(False)
+    assert through.state["particle_position"][:, 1].min() < 0.1
+    # No gravity: a particle hitting a free box head-on keeps the total momentum.
+    builder = vv.SceneBuilder(name="hit")
+    builder.set_world(gravity=(0, 0, 0))
+    builder.set_integration(method="velocity_verlet", dt=H, duration=1.0)
+    builder.add_body("box", size=(0.2, 0.2, 0.2), density=100.0, position=(0.5, 0, 0),
+                     restitution=1.0)  # fmt: skip
+    builder.add_particles(positions=[(0, 0, 0)], velocities=[(2.0, 0, 0)], radius=0.05,
+                          mass=0.4, name="shot")  # fmt: skip
+    builder.add_body_contacts(particles=["shot"], particle_restitution=1.0)
+    simulation = vv.Simulation(builder.build())
+    before = simulation.state["body_momentum"][0] + 0.4 * simulation.state["particle_velocity"][0]
+    simulation.step(120)
+    after = simulation.state["body_momentum"][0] + 0.4 * simulation.state["particle_velocity"][0]
+    np.testing.assert_allclose(after, before, atol=1e-12)
+    # Elastic, masses 0.4 and 0.8 kg: v₁' = (m₁ − m₂)/(m₁ + m₂) v = −2/3 m/s.
+    assert simulation.state["particle_velocity"][0, 0] == pytest.approx(-2.0 / 3.0, rel=1e-9)

@@ -52,12 +52,13 @@ from .bvh import MeshBVH
 from .contact_classes import CLASSES, COLLIDING, RESTING, SEPARATING
 from .impact_time import pull_back
 from .manifold import MAX_CONTACTS
+from .movers import Movers
 
 if TYPE_CHECKING:
     from ..ode.state import State
     from ..ode.workspace import Workspace
 
-__all__ = ["BodyContactSet", "BodyContacts", "Planes"]
+__all__ = ["BodyContactSet", "BodyContacts", "Moving", "ParticleMembers", "Planes"]
 
 #: A body's speculative reach beyond its travel in a step, as a fraction of its pieces' size.
 SPECULATIVE = 0.02
@@ -193,16 +194,10 @@ class BodyContacts:
         impacts: str = "sequential",
         time_of_impact: str = "advancement",
         body_time_of_impact: Sequence[str] | None = None,
+        particles: ParticleMembers | None = None,
     ) -> None:
-        self.pieces = pieces
-        self.count = int(np.shape(mass)[0])
-        dynamic = np.asarray(dynamic, dtype=np.bool_)
-        self.inverse_mass = np.where(dynamic, 1.0 / np.asarray(mass, dtype=np.float64), 0.0)
-        self.inertia = np.asarray(inertia, dtype=np.float64)
-        self.inverse_inertia_body = np.where(
-            dynamic[:, None, None], np.linalg.inv(self.inertia), 0.0
-        )
-        self.dynamic = dynamic
+        self.movers = Movers.of_bodies(pieces, mass, inertia, dynamic)
+        self.count = self.movers.count
         self.planes = planes
         self.meshes = tuple(meshes)
         # The scenery a contact's piece A may be instead of a piece, numbered -1 − id: the
@@ -238,15 +233,7 @@ class BodyContacts:
         g = np.asarray(gravity, dtype=np.float64)
         size = float(np.linalg.norm(g))
         self.up = -g / size if size > 0.0 else np.zeros(3)
-        # Each body's size: its largest piece's reach from the centre of mass.
-        size = np.zeros(self.count)
-        for p in range(pieces.count):
-            b = pieces.body[p]
-            if b >= 0:
-                reach = np.linalg.norm(pieces.local_position[p]) + pieces.radius[p]
-                size[b] = max(size[b], reach)
-        self.size = size
-        self.reach = np.linalg.norm(pieces.local_position, axis=1) + pieces.radius
+        self.particles = particles
 
     def carried_start(self) -> dict[str, np.ndarray]:
         """The last step's contacts for the warm start: ``body_contact_key`` ``(C,)`` (the
@@ -257,36 +244,84 @@ class BodyContacts:
                                  np.zeros((0, 3))), strict=True))  # fmt: skip
 
     def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
-        """The state with the bodies' contacts resolved."""
+        """The state with the bodies' contacts resolved (and those of the particles that meet
+        them)."""
         parts = tuple(np.array(part) for part in after.parts)
         result = after.from_parts(after.t, parts)
-        x = result["body_position"]
-        q = result["body_orientation"]
-        momentum = result["body_momentum"]
-        spin = result["body_angular_momentum"]
-        memory = tuple(after[name] for name in MEMORY)
+        bodies = Moving(
+            result["body_position"], result["body_orientation"], result["body_momentum"],
+            result["body_angular_momentum"],
+        )  # fmt: skip
         x0, q0 = before["body_position"], before["body_orientation"]
-        momentum0, spin0 = before["body_momentum"], before["body_angular_momentum"]
-        _, _, v0, w0 = body_frames(q0, self.inverse_inertia_body, self.inverse_mass,
-                                   momentum0, spin0)  # fmt: skip
+        movers = self.movers
+        _, _, v0, w0 = body_frames(q0, movers.inverse_inertia, movers.inverse_mass,
+                                   before["body_momentum"],
+                                   before["body_angular_momentum"])  # fmt: skip
         start = (x0, q0, v0, w0)
-        memory = self.resolve(x, q, momentum, spin, h, memory, start)
+        self.pull_back(x0, q0, bodies.position, bodies.orientation)
+        memory = tuple(after[name] for name in MEMORY)
+        members = self.particles
+        if members is not None:
+            index = np.flatnonzero(after["particle_alive"] & members.mask)
+            if index.size:
+                memory = self._with_particles(bodies, start, result, before, after, index, h,
+                                              memory)  # fmt: skip
+                return result.with_carried(**dict(zip(MEMORY, memory, strict=True)))
+        memory = self.resolve(self.movers, bodies, h, memory, start)
         return result.with_carried(**dict(zip(MEMORY, memory, strict=True)))
+
+    def _with_particles(self, bodies, start, result, before, after, index, h, memory):
+        """Resolve the bodies' contacts with the particles ``index`` that meet them as movers
+        after the bodies; in place on ``result``'s bodies and particles."""
+        members = self.particles
+        inverse = members.inverse_mass[index]
+        movers = self.movers.with_particles(after["particle_radius"][index], inverse,
+                                            members.restitution, members.friction)  # fmt: skip
+        position = result["particle_position"]
+        velocity = result["particle_velocity"]
+        k = index.size
+        identity = np.tile([1.0, 0.0, 0.0, 0.0], (k, 1))
+        with np.errstate(divide="ignore"):
+            mass = np.where(inverse > 0.0, 1.0 / inverse, 0.0)
+        everyone = Moving(
+            np.concatenate([bodies.position, position[index]]),
+            np.concatenate([bodies.orientation, identity]),
+            np.concatenate([bodies.momentum, velocity[index] * mass[:, None]]),
+            np.concatenate([bodies.spin, np.zeros((k, 3))]),
+        )
+        x0, q0, v0, w0 = start
+        everyone_start = (
+            np.concatenate([x0, before["particle_position"][index]]),
+            np.concatenate([q0, identity]),
+            np.concatenate([v0, before["particle_velocity"][index]]),
+            np.concatenate([w0, np.zeros((k, 3))]),
+        )
+        memory = self.resolve(movers, everyone, h, memory, everyone_start)
+        b = self.count
+        bodies.position[...] = everyone.position[:b]
+        bodies.orientation[...] = everyone.orientation[:b]
+        bodies.momentum[...] = everyone.momentum[:b]
+        bodies.spin[...] = everyone.spin[:b]
+        position[index] = everyone.position[b:]
+        moved = inverse > 0.0
+        velocity[index[moved]] = everyone.momentum[b:][moved] * inverse[moved, None]
+        return memory
 
     def contacts(self, state: Mapping[str, np.ndarray], gap: float) -> BodyContactSet:
         """The contacts of ``state``'s bodies (a state, or a mapping of ``body_position``,
         ``body_orientation``, ``body_momentum`` and ``body_angular_momentum``): the pairs of
         pieces within ``gap`` [m] of each other, classified with the stage's resting speed."""
+        movers = self.movers
         x = np.ascontiguousarray(state["body_position"], dtype=np.float64)
         q = np.asarray(state["body_orientation"], dtype=np.float64)
         q = q / np.linalg.norm(q, axis=1, keepdims=True)
         momentum = np.ascontiguousarray(state["body_momentum"], dtype=np.float64)
         spin = np.ascontiguousarray(state["body_angular_momentum"], dtype=np.float64)
-        rotation, _, v, w = body_frames(q, self.inverse_inertia_body, self.inverse_mass,
+        rotation, _, v, w = body_frames(q, movers.inverse_inertia, movers.inverse_mass,
                                         momentum, spin)  # fmt: skip
-        found, _, _ = self.detect(x, rotation, np.full(self.count, 0.5 * gap))
+        found, _, _ = self.detect(movers, x, rotation, np.full(self.count, 0.5 * gap))
         piece_a, piece_b, point, normal, depth = found
-        body_a, body_b = self._bodies_of(piece_a, piece_b)
+        body_a, body_b = _bodies_of(movers, piece_a, piece_b)
         arm_a = np.where((body_a >= 0)[:, None], point - x[body_a], 0.0)
         arm_b = point - x[body_b]
         velocity = normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w)
@@ -296,16 +331,12 @@ class BodyContacts:
         return BodyContactSet(piece_a, piece_b, body_a, body_b, point, normal, depth,
                               velocity, kind)  # fmt: skip
 
-    def _bodies_of(self, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple[np.ndarray, ...]:
-        """The bodies of the contacts' pieces (-1: a plane or the scenery)."""
-        body = self.pieces.body
-        return np.where(piece_a >= 0, body[np.maximum(piece_a, 0)], -1), body[piece_b]
-
-    def detect(self, x: np.ndarray, rotation: np.ndarray, margin: np.ndarray) -> tuple:
-        """The contacts at centres of mass ``x`` ``(B, 3)`` and rotations ``(B, 3, 3)``, with
-        speculative reach ``margin`` ``(B,)`` [m]: ``(piece_a, piece_b, point, normal,
-        depth)`` and the pieces' world poses."""
-        pieces = self.pieces
+    def detect(self, movers: Movers, x: np.ndarray, rotation: np.ndarray,
+               margin: np.ndarray) -> tuple:  # fmt: skip
+        """The contacts of the ``movers`` at centres of mass ``x`` ``(M, 3)`` and rotations
+        ``(M, 3, 3)``, with speculative reach ``margin`` ``(M,)`` [m]: ``(piece_a, piece_b,
+        point, normal, depth)`` and the pieces' world poses."""
+        pieces = movers.pieces
         arrays = pieces.arrays()
         position = pieces.local_position.copy()
         turn = pieces.local_rotation.copy()
@@ -314,50 +345,55 @@ class BodyContacts:
         piece_poses(arrays, pieces.body, x, rotation, margin, position, turn, lo, hi)
         active = np.ones(pieces.count, dtype=np.bool_)
         pairs = overlapping_pairs(lo, hi, active)
-        # Two pieces of bodies that nothing moves never need contacts.
-        moving = np.append(self.dynamic, False)[pieces.body]
-        pairs = pairs[moving[pairs[:, 0]] | moving[pairs[:, 1]]]
+        # Pieces that nothing moves never need contacts, nor do two particles (their own
+        # stage's), nor a particle and the scenery (the colliders' stage's).
+        moving = np.append(movers.dynamic, False)[pieces.body]
+        particle = movers.particle
+        static = pieces.body < 0
+        first, second = pairs[:, 0], pairs[:, 1]
+        keep = (moving[first] | moving[second]) & ~(particle[first] & particle[second])
+        keep &= ~((particle[first] & static[second]) | (particle[second] & static[first]))
+        pairs = pairs[keep]
+        meets = ~particle
         planes = self.planes
         scenery = planes.point.shape[0] + 16 * len(self.meshes)
         capacity = MAX_CONTACTS * (pairs.shape[0] + scenery * pieces.count) + 16
         while True:
             out = contact_arrays(capacity)
             count = pair_contacts(arrays, pieces.body, pairs, position, turn, margin, out)
-            count = plane_contacts(arrays, pieces.body, position, turn, lo, hi, margin,
+            count = plane_contacts(arrays, pieces.body, meets, position, turn, lo, hi, margin,
                                    planes.point, planes.normal, planes.thickness, out,
                                    count)  # fmt: skip
-            for (bvh, _, _), first in zip(self.meshes, self.mesh_first, strict=True):
+            for (bvh, _, _), first_id in zip(self.meshes, self.mesh_first, strict=True):
                 count = mesh_contacts(bvh.node_bounds, bvh.node_links, bvh.triangle_points,
-                                      first, arrays, pieces.body, position, turn, lo, hi,
-                                      margin, out, count)  # fmt: skip
+                                      first_id, arrays, pieces.body, meets, position, turn, lo,
+                                      hi, margin, out, count)  # fmt: skip
             if count < capacity:
                 return tuple(a[:count] for a in out), position, turn
             capacity *= 2  # a mesh gave more contacts than room was made for
 
-    def resolve(self, x, q, momentum, spin, h, memory, start=None):
-        """Resolve one step's contacts in place on the bodies' ``x``, ``q``, ``P``, ``L``
-        (``(B, 3)``, ``(B, 4)``, ``(B, 3)``, ``(B, 3)``); ``memory`` the last step's carried
-        impulses; ``start`` the bodies at the step's start, ``(x, q, v, ω)``, if known: the
-        contacts' depths at the start are then measured from how the bodies moved, and a
-        collision within the step reverses the approach at the moment of impact, not the
-        step's end, and a fast body is first moved back to its first impact of the step
-        (:meth:`pull_back`). Returns this step's contacts and impulses, the carried parts
-        (:data:`MEMORY`) the next step warm-starts from."""
-        if start is not None:
-            self.pull_back(start[0], start[1], x, q)
+    def resolve(self, movers: Movers, moving: Moving, h: float, memory: tuple,
+                start: tuple | None = None) -> tuple:  # fmt: skip
+        """Resolve one step's contacts of the ``movers`` in place on their state ``moving``;
+        ``memory`` the last step's carried impulses; ``start`` the movers at the step's start,
+        ``(x, q, v, ω)``, if known: the contacts' depths at the start are then measured from
+        how the movers moved, and a collision within the step reverses the approach at the
+        moment of impact, not the step's end. Returns this step's contacts and impulses, the
+        carried parts (:data:`MEMORY`) the next step warm-starts from."""
+        x, q, momentum, spin = moving.position, moving.orientation, moving.momentum, moving.spin
         rotation, inverse_inertia, v, w = body_frames(
-            q, self.inverse_inertia_body, self.inverse_mass, momentum, spin
+            q, movers.inverse_inertia, movers.inverse_mass, momentum, spin
         )
-        speed = np.sqrt((v * v).sum(axis=1)) + np.sqrt((w * w).sum(axis=1)) * self.size
-        margin = h * speed + SPECULATIVE * self.size
-        found, position, turn = self.detect(x, rotation, margin)
+        speed = np.sqrt((v * v).sum(axis=1)) + np.sqrt((w * w).sum(axis=1)) * movers.size
+        margin = h * speed + SPECULATIVE * movers.size
+        found, position, turn = self.detect(movers, x, rotation, margin)
         # Bottom up along gravity: a stack's support is met before what rests on it, which
         # is what a sweep needs to carry the weight down in few iterations.
         order = np.argsort(found[2] @ self.up, kind="stable")
         piece_a, piece_b, point, normal, depth = (a[order] for a in found)
-        pieces = self.pieces
-        body_a, body_b = self._bodies_of(piece_a, piece_b)
-        restitution, friction = self._coefficients(piece_a, piece_b)
+        pieces = movers.pieces
+        body_a, body_b = _bodies_of(movers, piece_a, piece_b)
+        restitution, friction = self._coefficients(pieces, piece_a, piece_b)
         key = (piece_a + self.scenery_restitution.shape[0]) * (pieces.count + 1) + piece_b
         anchor = np.einsum("cji,cj->ci", turn[piece_b], point - position[piece_b])
         warm_normal, warm_friction = _warm_start(key, anchor, MATCH * pieces.radius[piece_b],
@@ -369,14 +405,13 @@ class BodyContacts:
         radius = pieces.radius
         smaller = np.minimum(np.where(piece_a >= 0, radius[np.maximum(piece_a, 0)], np.inf),
                              radius[piece_b])  # fmt: skip
-        allowance = ALLOWANCE * smaller
         normal_impulse, friction_impulse = respond(
             body_a, body_b, point, normal, depth, restitution, friction, warm_normal,
             warm_friction, x, q, momentum, spin, rotation, inverse_inertia, v, w,
-            self.inverse_mass, self.inertia, self.dynamic,
+            movers.inverse_mass, movers.inertia, movers.dynamic,
             has_start, x0, q0, v0, w0,
-            h, self.resting_speed, self.iterations, max(self.iterations // 4, 1), allowance,
-            CORRECTION, self.impacts == "simultaneous",
+            h, self.resting_speed, self.iterations, max(self.iterations // 4, 1),
+            ALLOWANCE * smaller, CORRECTION, self.impacts == "simultaneous",
         )  # fmt: skip
         return key, anchor, normal_impulse, friction_impulse
 
@@ -384,12 +419,13 @@ class BodyContacts:
         """Move each fast body (see ``body_time_of_impact``) back along its step from
         ``(x0, q0)`` to ``(x, q)`` to its first impact, in place on ``x`` and ``q``; returns
         how many were moved (:mod:`~visviva.collision.impact_time`)."""
+        movers = self.movers
         travel = np.sqrt(((x - x0) ** 2).sum(axis=1))
         mode = self.fast_mode
-        fast = self.dynamic & ((mode == 1) | ((mode == 0) & (travel > FAST * self.size)))
+        fast = movers.dynamic & ((mode == 1) | ((mode == 0) & (travel > FAST * movers.size)))
         if not fast.any():
             return 0
-        pieces = self.pieces
+        pieces = movers.pieces
         arrays = pieces.arrays()
         bounds = []
         for position, orientation in ((x0, q0), (x, q)):
@@ -404,12 +440,12 @@ class BodyContacts:
         hi = np.maximum(bounds[0][1], bounds[1][1])
         pairs = overlapping_pairs(lo, hi, np.ones(pieces.count, dtype=np.bool_))
         return pull_back(pairs, fast, self.time_of_impact, ALLOWANCE, arrays, pieces.body,
-                         pieces.local_position, pieces.local_rotation, self.reach,
+                         pieces.local_position, pieces.local_rotation, movers.reach,
                          pieces.radius, x0, q0, x, q)  # fmt: skip
 
-    def _coefficients(self, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple[np.ndarray, ...]:
+    def _coefficients(self, pieces: BodyPieces, piece_a: np.ndarray,
+                      piece_b: np.ndarray) -> tuple[np.ndarray, ...]:  # fmt: skip
         """Each contact's restitution and friction (the pair rule, or the stage's value)."""
-        pieces = self.pieces
         scenery = -1 - np.minimum(piece_a, -1)
         on_scenery = piece_a < 0
         index = np.maximum(piece_a, 0)
@@ -425,6 +461,36 @@ class BodyContacts:
         if self.friction is not None:
             mu = np.full_like(mu, self.friction)
         return e, mu
+
+
+@dataclass(frozen=True)
+class Moving:
+    """The movers' state a step changes, in place: centres of mass ``(M, 3)`` [m],
+    orientations ``(M, 4)``, momenta ``(M, 3)`` [kg·m/s] and angular momenta ``(M, 3)``
+    [kg·m²/s] (world frame)."""
+
+    position: np.ndarray
+    orientation: np.ndarray
+    momentum: np.ndarray
+    spin: np.ndarray
+
+
+@dataclass(frozen=True)
+class ParticleMembers:
+    """The particles that meet the bodies: ``mask`` ``(N,)`` over the particle slots, their
+    ``inverse_mass`` ``(N,)`` [1/kg] (0: held), and the ``restitution`` and ``friction`` of
+    their contacts (with a body's, by the pair rule)."""
+
+    mask: np.ndarray
+    inverse_mass: np.ndarray
+    restitution: float
+    friction: float
+
+
+def _bodies_of(movers: Movers, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple:
+    """The movers of the contacts' pieces (-1: a plane or the scenery)."""
+    body = movers.pieces.body
+    return np.where(piece_a >= 0, body[np.maximum(piece_a, 0)], -1), body[piece_b]
 
 
 @njit(cache=True)

@@ -140,10 +140,11 @@ def _ball_contact(i, j, params, piece_position, reach, out, count):
 
 
 @njit(cache=True)
-def plane_contacts(pieces, body, piece_position, piece_rotation, lo, hi, margin,
+def plane_contacts(pieces, body, meets, piece_position, piece_rotation, lo, hi, margin,
                    plane_point, plane_normal, plane_thickness, out, start):  # fmt: skip
-    """The contacts of every moving piece with every plane, appended to ``out`` from row
-    ``start``; the plane is recorded as piece ``-1 − plane``. Returns the new count."""
+    """The contacts of every moving piece that ``meets`` the scenery with every plane,
+    appended to ``out`` from row ``start``; the plane is recorded as piece ``-1 − plane``.
+    Returns the new count."""
     piece_a, piece_b, point, normal, depth = out
     points = np.empty((CANDIDATES, 3))
     depths = np.empty(CANDIDATES)
@@ -151,7 +152,7 @@ def plane_contacts(pieces, body, piece_position, piece_rotation, lo, hi, margin,
     for f in range(plane_point.shape[0]):
         for p in range(body.shape[0]):
             b = body[p]
-            if b < 0:
+            if b < 0 or not meets[p]:
                 continue
             # The bounding box's lowest corner along the normal tells whether it may touch.
             low = 0.0
@@ -212,9 +213,10 @@ def _triangle_shape(corners):
 
 
 @njit(cache=True)
-def mesh_contacts(node_bounds, node_links, triangle_points, first_id, pieces, body,
+def mesh_contacts(node_bounds, node_links, triangle_points, first_id, pieces, body, meets,
                   piece_position, piece_rotation, lo, hi, margin, out, start):  # fmt: skip
-    """The contacts of every moving piece with the triangles of a static mesh (its tree's
+    """The contacts of every moving piece that ``meets`` the scenery with the triangles of a
+    static mesh (its tree's
     arrays, :class:`~visviva.collision.bvh.MeshBVH`) whose boxes its bounding box overlaps,
     appended to ``out`` from row ``start``; triangle slot ``s`` is recorded as piece
     ``-1 − (first_id + s)``. A triangle meets a piece only from the mesh's outside (the piece's
@@ -227,7 +229,7 @@ def mesh_contacts(node_bounds, node_links, triangle_points, first_id, pieces, bo
     count = start
     for p in range(body.shape[0]):
         b = body[p]
-        if b < 0:
+        if b < 0 or not meets[p]:
             continue
         stack[0] = 0
         top = 1

@@ -22,11 +22,12 @@ from scipy.spatial import ConvexHull as Qhull
 
 from ..._registry import did_you_mean
 from ...collision import Box, Capsule, Cone, ConvexHull, Cylinder, Ellipsoid, Plane, Sphere
-from ...collision.body_contacts import BodyContacts, Planes
+from ...collision.body_contacts import BodyContacts, ParticleMembers, Planes
 from ...collision.body_pieces import BodyPieces
 from ...collision.decomposition import convex_decomposition
 from ...errors import ModelError, SceneProblem
 from ...geometry.mesh_topology import enclosed_volume
+from ..checks import check_names
 from ..collider.shapes import collider_shape
 from ..context import BuildContext, Located
 from ..kind import KindBuild
@@ -51,6 +52,7 @@ def _check(entity: BodyContactSettings, where: str, scene: Any) -> list[ScenePro
         for k, name in enumerate(entity.targets or ())
         if name not in bodies
     ]
+    problems += check_names(entity.particles, where, scene, field="particles")
     first = next(i for i, e in enumerate(scene.entities) if e.type == "body_contacts")
     if f"entities[{first}]" != where:
         problems.append(
@@ -116,8 +118,20 @@ def _finish(entries: Sequence[tuple[str, BodyContactSettings]], context: BuildCo
         impacts=entity.impacts,
         time_of_impact=entity.time_of_impact,
         body_time_of_impact=[body.time_of_impact for _, body in chosen],
+        particles=_members(entity, context),
     )
     context.stages.append(stage)
+
+
+def _members(entity: BodyContactSettings, context: BuildContext) -> ParticleMembers | None:
+    """The particles that meet the bodies, if the entity names any."""
+    if entity.particles is None or not context.particle_count:
+        return None
+    mask = np.zeros(context.particle_count, dtype=np.bool_)
+    mask[context.targets(entity.particles).indices] = True
+    arrays = context.arrays
+    inverse = np.where(arrays["pinned"], 0.0, 1.0 / arrays["mass"])
+    return ParticleMembers(mask, inverse, entity.particle_restitution, entity.particle_friction)
 
 
 def _planes(planes: list[tuple[Plane, float, float]]) -> Planes:

@@ -45,6 +45,16 @@ class BodyContactSettings(Strict):
         description="how a fast body's first impact in a step is found: conservative "
         "advancement (sees a body pass through a thin one) or seed 003's bisection",
     )
+    particles: Names | None = Field(
+        None,
+        description="particle entities whose particles collide with the bodies (default: none)",
+    )
+    particle_restitution: Fraction = Field(
+        0.5, description="e of the particles' contacts with bodies (a pair takes the larger)"
+    )
+    particle_friction: NonNegative = Field(
+        0.5, description="μ of the particles' contacts with bodies (a pair takes √(μ_p μ_b))"
+    )
     impacts: Literal["sequential", "simultaneous"] = Field(
         "sequential",
         description="sequential (bounces among the resting contacts' impulses) or "
@@ -65,6 +75,9 @@ class BodyContactMethods:
         resting_speed: float | None = None,
         impacts: str | None = None,
         time_of_impact: str | None = None,
+        particles: Sequence[str] | None = None,
+        particle_restitution: float | None = None,
+        particle_friction: float | None = None,
         name: str | None = None,
     ) -> int:
         """Make the bodies of ``targets`` (default: every body) collide with each other and
@@ -74,5 +87,7 @@ class BodyContactMethods:
         approaches slower than ``resting_speed`` [m/s] rest; ``impacts="simultaneous"``
         resolves a step's impacts together by generalized reflections, as a Newton's cradle
         needs; a fast body's first impact within a step is found by ``time_of_impact``
-        ``"advancement"`` or ``"bisection"`` (:mod:`visviva.collision.impact_time`)."""
+        ``"advancement"`` or ``"bisection"`` (:mod:`visviva.collision.impact_time`); the
+        particles of the entities ``particles`` collide with the bodies too, as spheres of
+        their radii with ``particle_restitution`` and ``particle_friction``."""
         return self.add("body_contacts", **given(locals()))
