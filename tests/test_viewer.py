@@ -472,3 +472,40 @@ def test_colours_display_radii_trails_and_time_unit_reach_the_page(browser, tmp_
         assert ((red > 170) & (green > 120) & (blue < 110)).sum() > 50  # the sun, yellow
     finally:
         opened.page.close()
+
+
+def test_contacts_are_drawn_when_the_box_is_ticked(browser, tmp_path):
+    # A ball dropped on a box on the floor: a recording with its contacts; the page draws
+    # them only while the "contacts" box is ticked, as many as the frame holds.
+    builder = vv.SceneBuilder(name="contacts")
+    builder.set_integration(method="symplectic_euler", dt=1 / 120, duration=1.0)
+    builder.add_collider("plane", point=(0, 0, 0), normal=(0, 1, 0))
+    builder.add_body("box", size=(0.4, 0.4, 0.4), density=500.0, position=(0, 0.2, 0))
+    builder.add_body("sphere", radius=0.1, density=500.0, position=(0.05, 0.8, 0))
+    builder.add_body_contacts()
+    recording = vv.Simulation(builder.build()).record(until=1.0, record_every=12,
+                                                      contacts=True)  # fmt: skip
+    kinds = recording["body_contact_class"]
+    last = int((kinds[-1] >= 0).sum())
+    assert last == 5  # the box's four corners on the floor, the ball on the box
+    page = Opened(browser, write_viewer(recording, tmp_path / "contacts.html", fps=10))
+    try:
+        frames = page.js("visviva.frames")
+        assert page.js(f"visviva.pause(), visviva.setFrame({frames - 1}), visviva.contacts()") == {
+            "recorded": True,
+            "visible": False,
+            "shown": last,
+        }
+        page.page.check("#contacts")
+        assert page.js("visviva.contacts()")["visible"] is True
+        assert page.errors == []
+    finally:
+        page.page.close()
+    plain = vv.Simulation(builder.build()).record(until=0.1)
+    assert "body_contact_point" not in plain
+    page = Opened(browser, write_viewer(plain, tmp_path / "plain.html"))
+    try:
+        assert page.js("visviva.contacts()")["recorded"] is False
+        assert page.page.is_hidden("#contacts")
+    finally:
+        page.page.close()

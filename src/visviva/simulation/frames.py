@@ -85,6 +85,7 @@ UNITS = {
     "body_vertices": "m",
     "body_center": "m",
     "scenery_vertices": "m",
+    "body_contact_point": "m",
     "energy": "J",
     "generalized_position": "",
     "generalized_velocity": "",

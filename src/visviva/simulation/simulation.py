@@ -295,7 +295,12 @@ class Simulation:
         self._advance(schedule, on_frame, record_every, progress)
 
     def record(
-        self, until: float, *, record_every: int | None = None, progress: bool | None = False
+        self,
+        until: float,
+        *,
+        record_every: int | None = None,
+        progress: bool | None = False,
+        contacts: bool = False,
     ) -> Recording:
         """Run to ``until`` [s] like :meth:`run`, keeping the frames in memory.
 
@@ -308,11 +313,18 @@ class Simulation:
             until: The time to reach [s].
             record_every: Keep every k-th step (default: the scene's ``record_every``).
             progress: Show a progress bar (``None``: if stderr is a terminal).
+            contacts: Also keep the rigid bodies' contacts of each frame (a scene with
+                ``body_contacts``): ``body_contact_point`` and ``body_contact_normal``
+                ``(frames, K, 3)`` and ``body_contact_class`` ``(frames, K)`` (0 colliding,
+                1 resting, 2 separating, -1 an empty slot: frames have up to ``K``), which
+                the web viewer draws on demand.
 
         Raises:
             SimulationDiverged, NewtonConvergenceError, Interrupted: As :meth:`run`; the error's
                 ``recording`` holds the frames kept so far.
         """
+        if contacts:
+            self.model.body_contacts(self._current())  # refused here if there are none
         every = self.model.integration.record_every if record_every is None else record_every
         times: list[float] = []
         frames: list[dict[str, np.ndarray]] = []
@@ -323,11 +335,16 @@ class Simulation:
             }
             if energy is not None:
                 fields["energy"] = np.asarray(energy, dtype=np.float64)
+            if contacts:
+                found = self.model.body_contacts(state)
+                fields["body_contact_point"] = found.point
+                fields["body_contact_normal"] = found.normal
+                fields["body_contact_class"] = found.kind
             times.append(state.t)
             frames.append(fields)
 
         def recording() -> Recording:
-            fields = {name: np.stack([f[name] for f in frames]) for name in frames[0]}
+            fields = {name: _stacked([f[name] for f in frames]) for name in frames[0]}
             attrs = {
                 "method": self.integrator.name,
                 "dt": self.dt,
@@ -459,3 +476,17 @@ def fingerprint(model: Model) -> str:
     """A digest of the scene description a model was built from."""
     text = model.scene.model_dump_json()
     return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _stacked(values: list[np.ndarray]) -> np.ndarray:
+    """Frames of one field stacked; frames of different lengths (a field of contacts) padded
+    to the longest, with -1 for whole numbers and NaN for real ones."""
+    longest = max(v.shape[0] if v.ndim else 0 for v in values)
+    if all(v.shape == values[0].shape for v in values):
+        return np.stack(values)
+    padded = []
+    for v in values:
+        fill = -1 if np.issubdtype(v.dtype, np.integer) else np.nan
+        extra = np.full((longest - v.shape[0], *v.shape[1:]), fill, dtype=v.dtype)
+        padded.append(np.concatenate([v, extra]))
+    return np.stack(padded)

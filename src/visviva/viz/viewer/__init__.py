@@ -52,6 +52,11 @@ _BYTES_PER_POINT_FRAME = 12
 _BYTES_PER_BODY_FRAME = 28
 
 
+#: The fields of a recording's rigid-body contacts (:meth:`visviva.Simulation.record`), drawn
+#: by the page when its "contacts" box is ticked.
+CONTACT_FIELDS = ("body_contact_point", "body_contact_normal", "body_contact_class")
+
+
 def _frame_bytes(geometry: Geometry) -> int:
     """Bytes of float32 positions and transforms one frame holds (at least 1)."""
     bodies = 0 if geometry.bodies is None else geometry.bodies.count
@@ -269,6 +274,9 @@ def write_viewer(
         title=page_title,
         attrs=recording.attrs,
         trail_frames=round(trail * rate / speed),
+        contacts={name: recording[name] for name in CONTACT_FIELDS}
+        if all(name in recording for name in CONTACT_FIELDS)
+        else None,
     )
     if scale is not None:
         payload["legend"].append(["colour", scale.caption()])

@@ -230,6 +230,22 @@ def _index_layer(indices: np.ndarray) -> dict[str, Any]:
     return {"count": int(indices.shape[0]), "indices": _base64(indices, "<u4")}
 
 
+def contacts_layer(fields: dict[str, np.ndarray], shown: np.ndarray, size: float) -> dict[str, Any]:
+    """The rigid bodies' contacts of the frames ``shown``, drawn on demand: ``points`` and
+    ``normals`` float32 ``(frames, K, 3)``, ``classes`` int8 ``(frames, K)`` (-1: no contact
+    in that slot), and ``marker``, the drawn size [m] (a hundredth of the scene's ``size``)."""
+    kind = np.asarray(fields["body_contact_class"])[shown]
+    points = np.nan_to_num(np.asarray(fields["body_contact_point"])[shown])
+    normals = np.nan_to_num(np.asarray(fields["body_contact_normal"])[shown])
+    return {
+        "count": int(kind.shape[1]),
+        "points": _base64(points, "<f4"),
+        "normals": _base64(normals, "<f4"),
+        "classes": _base64(kind, "i1"),
+        "marker": 0.01 * size,
+    }
+
+
 def _legend(attrs: dict[str, Any], geometry: Geometry, fps: float) -> list[list[str]]:
     rows = []
     for key, label, unit in _LEGEND_ATTRIBUTES:
@@ -269,6 +285,7 @@ def encode_payload(
     title: str,
     attrs: dict[str, Any],
     trail_frames: int = 0,
+    contacts: dict[str, np.ndarray] | None = None,
 ) -> dict[str, Any]:
     """The viewer's data object for ``geometry`` resampled to the recorded frames ``shown``.
 
@@ -280,6 +297,7 @@ def encode_payload(
         title: Page title.
         attrs: Recording attributes (only the legend's few are read).
         trail_frames: Output frames of each point's path drawn behind it (0: none).
+        contacts: The recording's contact fields (``body_contact_point``, ...), if any.
 
     Returns:
         A JSON-serialisable dict (see the module docstring).
@@ -298,6 +316,8 @@ def encode_payload(
         layers["bodies"] = _bodies_layer(geometry.bodies, shown)
     if geometry.scenery is not None:
         layers["scenery"] = _scenery_layer(geometry.scenery)
+    if contacts:
+        layers["contacts"] = contacts_layer(contacts, shown, float(np.linalg.norm(high - low)))
     return {
         "format": PAYLOAD_FORMAT,
         "version": PAYLOAD_VERSION,

@@ -364,6 +364,65 @@
         }
       };
     },
+    /* The rigid bodies' contacts of each frame, drawn while the "contacts" box is ticked:
+     * a small sphere at each point coloured by Baraff's class (colliding red, resting green,
+     * separating blue) and a line along its normal. */
+    contacts(layer) {
+      const count = layer.count;
+      const points = decode(layer.points, Float32Array); // (frames, K, 3) [m]
+      const normals = decode(layer.normals, Float32Array);
+      const classes = decode(layer.classes, Int8Array); // (frames, K), -1: an empty slot
+      if (points.length !== 3 * frames * count || classes.length !== frames * count) {
+        throw new Error("corrupt contact data");
+      }
+      const marker = layer.marker;
+      const mesh = new THREE.InstancedMesh(
+        new THREE.SphereGeometry(marker, 8, 6), new THREE.MeshLambertMaterial(), Math.max(count, 1));
+      mesh.frustumCulled = false;
+      const linePositions = new Float32Array(6 * Math.max(count, 1));
+      const lineGeometry = new THREE.BufferGeometry();
+      lineGeometry.setAttribute("position", new THREE.BufferAttribute(linePositions, 3));
+      const lines = new THREE.LineSegments(lineGeometry,
+        new THREE.LineBasicMaterial({ color: 0x222222 }));
+      lines.frustumCulled = false;
+      scene.add(mesh);
+      scene.add(lines);
+      const colours = [new THREE.Color(0xd62728), new THREE.Color(0x2ca02c),
+        new THREE.Color(0x1f77b4)];
+      const matrices = mesh.instanceMatrix.array; // column-major 4×4 per instance
+      for (let i = 0; i < Math.max(count, 1); i++) {
+        matrices.fill(0, 16 * i, 16 * i + 16);
+        matrices[16 * i] = matrices[16 * i + 5] = matrices[16 * i + 10] = matrices[16 * i + 15] = 1;
+      }
+      contactView.layer = layer;
+      contactView.mesh = mesh;
+      contactView.lines = lines;
+      return function update() {
+        const on = contactToggle.checked;
+        mesh.visible = lines.visible = on;
+        let n = 0;
+        for (let i = 0; i < count; i++) {
+          const c = classes[frame * count + i];
+          if (c < 0) continue;
+          const j = 3 * (frame * count + i);
+          matrices[16 * n + 12] = points[j];
+          matrices[16 * n + 13] = points[j + 1];
+          matrices[16 * n + 14] = points[j + 2];
+          mesh.setColorAt(n, colours[c]);
+          for (let a = 0; a < 3; a++) {
+            linePositions[6 * n + a] = points[j + a];
+            linePositions[6 * n + 3 + a] = points[j + a] + 5 * marker * normals[j + a];
+          }
+          n++;
+        }
+        mesh.count = n;
+        mesh.instanceMatrix.needsUpdate = true;
+        if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
+        lineGeometry.setDrawRange(0, 2 * n);
+        lineGeometry.attributes.position.needsUpdate = true;
+        contactView.shown = n;
+      };
+    },
     /* Static colliders: one mesh per collider, in the world frame, drawn as placed. */
     scenery(layer) {
       const vertices = decode(layer.vertices, Float32Array);
@@ -391,6 +450,8 @@
     },
   };
 
+  const contactToggle = document.getElementById("contacts");
+  const contactView = { layer: null, shown: 0 }; // read back by visviva.contacts()
   let pointMesh = null; // the points layer's instanced mesh, read back by visviva.drawn()
   const bodyMeshes = []; // the bodies layer's meshes, read back by visviva.bodies()
   const sceneryMeshes = []; // the scenery layer's meshes, read back by visviva.scenery()
@@ -534,6 +595,11 @@
 
   playButton.addEventListener("click", () => setPlaying(!playing));
   slider.addEventListener("input", () => setFrame(Number(slider.value)));
+  contactToggle.parentElement.hidden = !("contacts" in data.layers);
+  contactToggle.addEventListener("change", () => {
+    for (const update of updates) update();
+    needsDraw = true;
+  });
   speedSelect.addEventListener("change", () => {
     speed = Number(speedSelect.value);
     if (playing) anchor();
@@ -604,6 +670,12 @@
       position: mesh.position.toArray(),
       orientation: [mesh.quaternion.w, mesh.quaternion.x, mesh.quaternion.y, mesh.quaternion.z],
     })),
+    /* The contacts as drawn in the frame shown: whether the box is ticked and how many. */
+    contacts: () => ({
+      recorded: contactView.layer !== null,
+      visible: contactView.layer !== null && contactToggle.checked,
+      shown: contactView.shown,
+    }),
     /* The static colliders as drawn: each mesh's name and number of triangles. */
     scenery: () => sceneryMeshes.map((mesh) => ({
       name: mesh.name,
