@@ -54,15 +54,16 @@ def t_handle(
     return prism(outline, cover, thickness)
 
 
-def bunny(size: float = 0.2) -> tuple[np.ndarray, np.ndarray]:
+def bunny(size: float = 0.2, *, detail: int = 96) -> tuple[np.ndarray, np.ndarray]:
     """A rabbit-like lump about ``size`` [m] long, nose along +x, ears up: a sphere whose
     every vertex is pushed along its direction to ``r(d)`` — an ellipsoidal body, a head, two
     long ears and a tail as bumps of ``r`` (a star-shaped surface, so closed and free of
-    crossings whatever the bumps; :func:`visviva.rigid.surfaces.unit_sphere`). Generated, not
-    scanned: nothing downloads."""
+    crossings whatever the bumps; :func:`visviva.rigid.surfaces.unit_sphere`), ``detail``
+    vertices around its equator (a multiple of 4). Generated, not scanned: nothing
+    downloads."""
     from ..rigid.surfaces import unit_sphere
 
-    directions, triangles = unit_sphere(around=96, quarter=24)
+    directions, triangles = unit_sphere(around=detail, quarter=detail // 4)
     x, y, z = directions.T
     body = 1.0 / np.sqrt((x / 0.5) ** 2 + (y / 0.36) ** 2 + (z / 0.32) ** 2)
     radius = body.copy()

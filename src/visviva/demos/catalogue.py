@@ -41,6 +41,11 @@ BUILTIN_DEMOS: dict[str, BuiltinDemo] = {
         "bottle_flip",
         "a flick at a bottle's base gives it spin (τ = r × F); same flick, different I",
     ),
+    "bunny-drop": BuiltinDemo(
+        "bunny_drop",
+        "non-convex bunnies cut into convex pieces (CoACD) fall onto a floor and a step and "
+        "rest on their own surfaces; one as its hull, for comparison",
+    ),
     "bunny-throw": BuiltinDemo(
         "bunny_throw",
         "a rabbit-shaped mesh thrown with spin: parabola for its centre, tumbling about it",
