@@ -50,7 +50,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 __all__ = [
     "correct_positions",
@@ -205,13 +205,17 @@ def levers(body_a, body_b, normal, frame, arm_a, arm_b, inverse_inertia, bodies,
 def solve_impulses(
     body_a, body_b, normal, friction, arm_a, arm_b, frame, mass_n, mass_t, target,
     inverse_mass, inverse_inertia, v, w, normal_impulse, tangent_impulse, iterations,
+    slab_start=None,
 ):  # fmt: skip
     """Sequential impulses: ``iterations`` sweeps over the contacts in order, changing ``v``
     and ``w`` in place (module docstring).
 
     ``normal_impulse`` ``(C,)`` [N·s] and ``tangent_impulse`` ``(C, 2)`` [N·s] hold each
     contact's accumulated impulse; whatever they hold on entry (a warm start) is applied
-    first.
+    first. ``slab_start`` ``(S + 1,)``: the contacts come in slabs of which no two of the
+    same parity share a body (see :func:`sweep_order`); the even slabs are swept at once on
+    every core, then the odd ones, in an order that does not depend on the cores. ``None``:
+    one slab.
     """
     count = body_a.shape[0]
     bodies = v.shape[0]
@@ -227,31 +231,72 @@ def solve_impulses(
         lever_impulse(c, 0, normal_impulse[c], axes, lever, turn, index, weight, vel, spin)
         lever_impulse(c, 1, tangent_impulse[c, 0], axes, lever, turn, index, weight, vel, spin)
         lever_impulse(c, 2, tangent_impulse[c, 1], axes, lever, turn, index, weight, vel, spin)
-    for _ in range(iterations):
-        for c in range(count):
-            # Friction first, bounded by the normal impulse of the last sweep (Catto 2005).
-            limit = friction[c] * normal_impulse[c]
-            old0 = tangent_impulse[c, 0]
-            old1 = tangent_impulse[c, 1]
-            new0 = old0 - mass_t[c, 0] * lever_speed(c, 1, axes, lever, index, vel, spin)
-            new1 = old1 - mass_t[c, 1] * lever_speed(c, 2, axes, lever, index, vel, spin)
-            size = math.sqrt(new0 * new0 + new1 * new1)
-            if size > limit:
-                scale = limit / size if size > 0.0 else 0.0
-                new0 *= scale
-                new1 *= scale
-            tangent_impulse[c, 0] = new0
-            tangent_impulse[c, 1] = new1
-            lever_impulse(c, 1, new0 - old0, axes, lever, turn, index, weight, vel, spin)
-            lever_impulse(c, 2, new1 - old1, axes, lever, turn, index, weight, vel, spin)
-            # The normal impulse toward the target, accumulated and kept ≥ 0.
-            v_n = lever_speed(c, 0, axes, lever, index, vel, spin)
-            old = normal_impulse[c]
-            new = max(old + mass_n[c] * (target[c] - v_n), 0.0)
-            normal_impulse[c] = new
-            lever_impulse(c, 0, new - old, axes, lever, turn, index, weight, vel, spin)
+    if slab_start is None:
+        slab_start = np.array([0, count], dtype=np.int64)
+    sweeps = _sweeps_parallel if count >= PARALLEL_MIN_CONTACTS else _sweeps_serial
+    sweeps(slab_start, iterations, friction, mass_n, mass_t, target, normal_impulse,
+           tangent_impulse, axes, lever, turn, index, weight, vel, spin)  # fmt: skip
     v[:] = vel[:bodies]
     w[:] = spin[:bodies]
+
+
+#: From this many contacts the slabs are swept on every core.
+PARALLEL_MIN_CONTACTS = 1024
+
+
+@njit(cache=True, inline="always")
+def _contact_step(c, friction, mass_n, mass_t, target, normal_impulse, tangent_impulse,
+                  axes, lever, turn, index, weight, vel, spin):  # fmt: skip
+    """One contact's friction and normal impulses in a sweep."""
+    # Friction first, bounded by the normal impulse of the last sweep (Catto 2005).
+    limit = friction[c] * normal_impulse[c]
+    old0 = tangent_impulse[c, 0]
+    old1 = tangent_impulse[c, 1]
+    new0 = old0 - mass_t[c, 0] * lever_speed(c, 1, axes, lever, index, vel, spin)
+    new1 = old1 - mass_t[c, 1] * lever_speed(c, 2, axes, lever, index, vel, spin)
+    size = math.sqrt(new0 * new0 + new1 * new1)
+    if size > limit:
+        scale = limit / size if size > 0.0 else 0.0
+        new0 *= scale
+        new1 *= scale
+    tangent_impulse[c, 0] = new0
+    tangent_impulse[c, 1] = new1
+    lever_impulse(c, 1, new0 - old0, axes, lever, turn, index, weight, vel, spin)
+    lever_impulse(c, 2, new1 - old1, axes, lever, turn, index, weight, vel, spin)
+    # The normal impulse toward the target, accumulated and kept ≥ 0.
+    v_n = lever_speed(c, 0, axes, lever, index, vel, spin)
+    old = normal_impulse[c]
+    new = max(old + mass_n[c] * (target[c] - v_n), 0.0)
+    normal_impulse[c] = new
+    lever_impulse(c, 0, new - old, axes, lever, turn, index, weight, vel, spin)
+
+
+@njit(cache=True)
+def _sweeps_serial(slab_start, iterations, friction, mass_n, mass_t, target, normal_impulse,
+                   tangent_impulse, axes, lever, turn, index, weight, vel, spin):  # fmt: skip
+    slabs = slab_start.shape[0] - 1
+    for _ in range(iterations):
+        for parity in range(2):
+            for q in range((slabs - parity + 1) // 2):
+                k = parity + 2 * q
+                for c in range(slab_start[k], slab_start[k + 1]):
+                    _contact_step(c, friction, mass_n, mass_t, target, normal_impulse,
+                                  tangent_impulse, axes, lever, turn, index, weight, vel,
+                                  spin)  # fmt: skip
+
+
+@njit(cache=True, parallel=True)
+def _sweeps_parallel(slab_start, iterations, friction, mass_n, mass_t, target, normal_impulse,
+                     tangent_impulse, axes, lever, turn, index, weight, vel, spin):  # fmt: skip
+    slabs = slab_start.shape[0] - 1
+    for _ in range(iterations):
+        for parity in range(2):
+            for q in prange((slabs - parity + 1) // 2):
+                k = parity + 2 * q
+                for c in range(slab_start[k], slab_start[k + 1]):
+                    _contact_step(c, friction, mass_n, mass_t, target, normal_impulse,
+                                  tangent_impulse, axes, lever, turn, index, weight, vel,
+                                  spin)  # fmt: skip
 
 
 @njit(cache=True, inline="always")
@@ -277,25 +322,30 @@ def lever_impulse(c, k, size, axes, lever, turn, index, weight, vel, spin):
     """An impulse of ``size`` along contact ``c``'s direction ``k`` on B, its opposite on A."""
     a = index[c, 0]
     b = index[c, 1]
+    world = vel.shape[0] - 1  # never written: slabs swept at once all touch it
     for i in range(3):
         d = size * axes[c, k, i]
-        vel[b, i] += weight[b] * d
-        vel[a, i] -= weight[a] * d
-        spin[b, i] += size * turn[c, 1, k, i]
-        spin[a, i] -= size * turn[c, 0, k, i]
+        if b != world:
+            vel[b, i] += weight[b] * d
+            spin[b, i] += size * turn[c, 1, k, i]
+        if a != world:
+            vel[a, i] -= weight[a] * d
+            spin[a, i] -= size * turn[c, 0, k, i]
 
 
 @njit(cache=True)
 def correct_positions(
     body_a, body_b, normal, depth, arm_a, arm_b, mass_n,
     inverse_mass, inverse_inertia, allowance, fraction, iterations, shift, turn,
+    slab_start=None,
 ):  # fmt: skip
     """Split position correction: sweeps of pseudo-impulses that move the bodies apart where
     they overlap by more than ``allowance[c]`` [m], each removing ``fraction`` of a contact's
     remaining excess depth, the depths updated to first order as the bodies move.
 
-    ``shift`` and ``turn`` ``(B, 3)``, zero on entry, receive each body's translation [m]
-    and small rotation vector [rad] (world frame).
+    ``shift`` and ``turn`` ``(B, 3)`` receive each body's translation [m] and small rotation
+    vector [rad] (world frame), added to what they hold; ``slab_start`` as
+    :func:`solve_impulses`.
     """
     bodies = shift.shape[0]
     axes, lever, turn_of, index = levers(body_a, body_b, normal, normal, arm_a, arm_b,
@@ -306,12 +356,47 @@ def correct_positions(
     moved[:bodies] = shift
     turned[:bodies] = turn
     weight[:bodies] = inverse_mass
-    for _ in range(iterations):
-        for c in range(body_a.shape[0]):
-            # The depth now: less how far the bodies' points moved apart along n so far.
-            excess = depth[c] - lever_speed(c, 0, axes, lever, index, moved, turned) - allowance[c]
-            if excess > 0.0:
-                lever_impulse(c, 0, fraction * excess * mass_n[c], axes, lever, turn_of, index,
-                         weight, moved, turned)  # fmt: skip
+    if slab_start is None:
+        slab_start = np.array([0, body_a.shape[0]], dtype=np.int64)
+    sweeps = _corrections_parallel if body_a.shape[0] >= PARALLEL_MIN_CONTACTS else (
+        _corrections_serial)  # fmt: skip
+    sweeps(slab_start, iterations, depth, allowance, fraction, mass_n, axes, lever, turn_of,
+           index, weight, moved, turned)  # fmt: skip
     shift[:] = moved[:bodies]
     turn[:] = turned[:bodies]
+
+
+@njit(cache=True, inline="always")
+def _correction(c, depth, allowance, fraction, mass_n, axes, lever, turn, index, weight,
+                moved, turned):  # fmt: skip
+    # The depth now: less how far the bodies' points moved apart along n so far.
+    excess = depth[c] - lever_speed(c, 0, axes, lever, index, moved, turned) - allowance[c]
+    if excess > 0.0:
+        lever_impulse(c, 0, fraction * excess * mass_n[c], axes, lever, turn, index, weight,
+                      moved, turned)  # fmt: skip
+
+
+@njit(cache=True)
+def _corrections_serial(slab_start, iterations, depth, allowance, fraction, mass_n, axes, lever,
+                        turn, index, weight, moved, turned):  # fmt: skip
+    slabs = slab_start.shape[0] - 1
+    for _ in range(iterations):
+        for parity in range(2):
+            for q in range((slabs - parity + 1) // 2):
+                k = parity + 2 * q
+                for c in range(slab_start[k], slab_start[k + 1]):
+                    _correction(c, depth, allowance, fraction, mass_n, axes, lever, turn,
+                                index, weight, moved, turned)  # fmt: skip
+
+
+@njit(cache=True, parallel=True)
+def _corrections_parallel(slab_start, iterations, depth, allowance, fraction, mass_n, axes,
+                          lever, turn, index, weight, moved, turned):  # fmt: skip
+    slabs = slab_start.shape[0] - 1
+    for _ in range(iterations):
+        for parity in range(2):
+            for q in prange((slabs - parity + 1) // 2):
+                k = parity + 2 * q
+                for c in range(slab_start[k], slab_start[k + 1]):
+                    _correction(c, depth, allowance, fraction, mass_n, axes, lever, turn,
+                                index, weight, moved, turned)  # fmt: skip

@@ -66,31 +66,39 @@ def overlapping_pairs(lo, hi, active):
         return np.zeros((0, 2), dtype=np.int64)
     axis = int(np.argmax(square / count - (mean / count) ** 2))
     order = np.argsort(lo[:, axis], kind="mergesort")
-    pairs = np.empty((16, 2), dtype=np.int64)
-    found = 0
+    # The active boxes in sweep order, copied so that the sweep reads memory in sequence.
+    m = 0
     for s in range(n):
+        if active[order[s]]:
+            order[m] = order[s]
+            m += 1
+    order = order[:m]
+    box = np.empty((m, 6))
+    for s in range(m):
         i = order[s]
-        if not active[i]:
-            continue
-        end = hi[i, axis]
-        for t in range(s + 1, n):
-            j = order[t]
-            if lo[j, axis] > end:
+        for a in range(3):
+            box[s, a] = lo[i, a]
+            box[s, 3 + a] = hi[i, a]
+    pairs = np.empty((max(16, 4 * m), 2), dtype=np.int64)
+    found = 0
+    for s in range(m):
+        end = box[s, 3 + axis]
+        for t in range(s + 1, m):
+            if box[t, axis] > end:
                 break
-            if not active[j]:
-                continue
             if (
-                lo[i, 0] <= hi[j, 0] and lo[j, 0] <= hi[i, 0]
-                and lo[i, 1] <= hi[j, 1] and lo[j, 1] <= hi[i, 1]
-                and lo[i, 2] <= hi[j, 2] and lo[j, 2] <= hi[i, 2]
+                box[s, 0] <= box[t, 3] and box[t, 0] <= box[s, 3]
+                and box[s, 1] <= box[t, 4] and box[t, 1] <= box[s, 4]
+                and box[s, 2] <= box[t, 5] and box[t, 2] <= box[s, 5]
             ):  # fmt: skip
                 if found == pairs.shape[0]:
                     grown = np.empty((2 * found, 2), dtype=np.int64)
                     grown[:found] = pairs
                     pairs = grown
+                i, j = order[s], order[t]
                 pairs[found, 0] = min(i, j)
                 pairs[found, 1] = max(i, j)
                 found += 1
     pairs = pairs[:found]
     keys = pairs[:, 0] * n + pairs[:, 1]
-    return pairs[np.argsort(keys, kind="mergesort")].copy()
+    return pairs[np.argsort(keys)].copy()  # keys are distinct: any sort gives one order
