@@ -233,9 +233,13 @@ def solve_impulses(
         lever_impulse(c, 2, tangent_impulse[c, 1], axes, lever, turn, index, weight, vel, spin)
     if slab_start is None:
         slab_start = np.array([0, count], dtype=np.int64)
-    sweeps = _sweeps_parallel if count >= PARALLEL_MIN_CONTACTS else _sweeps_serial
-    sweeps(slab_start, iterations, friction, mass_n, mass_t, target, normal_impulse,
-           tangent_impulse, axes, lever, turn, index, weight, vel, spin)  # fmt: skip
+    if count >= PARALLEL_MIN_CONTACTS:
+        _sweeps_parallel(slab_start, iterations, friction, mass_n, mass_t, target,
+                         normal_impulse, tangent_impulse, axes, lever, turn, index, weight, vel,
+                         spin)  # fmt: skip
+    else:
+        _sweeps_serial(slab_start, iterations, friction, mass_n, mass_t, target, normal_impulse,
+                       tangent_impulse, axes, lever, turn, index, weight, vel, spin)  # fmt: skip
     v[:] = vel[:bodies]
     w[:] = spin[:bodies]
 
@@ -358,10 +362,12 @@ def correct_positions(
     weight[:bodies] = inverse_mass
     if slab_start is None:
         slab_start = np.array([0, body_a.shape[0]], dtype=np.int64)
-    sweeps = _corrections_parallel if body_a.shape[0] >= PARALLEL_MIN_CONTACTS else (
-        _corrections_serial)  # fmt: skip
-    sweeps(slab_start, iterations, depth, allowance, fraction, mass_n, axes, lever, turn_of,
-           index, weight, moved, turned)  # fmt: skip
+    if body_a.shape[0] >= PARALLEL_MIN_CONTACTS:
+        _corrections_parallel(slab_start, iterations, depth, allowance, fraction, mass_n, axes,
+                              lever, turn_of, index, weight, moved, turned)  # fmt: skip
+    else:
+        _corrections_serial(slab_start, iterations, depth, allowance, fraction, mass_n, axes,
+                            lever, turn_of, index, weight, moved, turned)  # fmt: skip
     shift[:] = moved[:bodies]
     turn[:] = turned[:bodies]
 
