@@ -249,6 +249,8 @@ class BodyContacts:
     def apply(self, before: State, after: State, h: float, work: Workspace) -> State:
         """The state with the bodies' contacts resolved (and those of the particles that meet
         them)."""
+        if not all(np.isfinite(part).all() for part in after.parts):
+            return after  # diverged: the stepper's watch stops the run and says why
         parts = tuple(np.array(part) for part in after.parts)
         result = after.from_parts(after.t, parts)
         bodies = Moving(

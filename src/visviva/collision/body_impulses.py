@@ -104,6 +104,8 @@ def _tangents(nx, ny, nz):
     else:
         tx, ty, tz = _cross(nx, ny, nz, 0.0, 1.0, 0.0)
     length = math.sqrt(tx * tx + ty * ty + tz * tz)
+    if not length > 0.0:  # a normal that is not a direction (NaN from a diverged state)
+        return 1.0, 0.0, 0.0, 0.0, 0.0, 1.0
     tx, ty, tz = tx / length, ty / length, tz / length
     sx, sy, sz = _cross(nx, ny, nz, tx, ty, tz)
     return tx, ty, tz, sx, sy, sz

@@ -231,10 +231,10 @@ def respond(
     if simultaneous:
         # The impact first, all its contacts together by generalized reflections; what is
         # left for the sweeps is to keep every contact from approaching.
-        touching = np.empty(count, dtype=np.bool_)
+        gap = np.empty(count)
         for c in range(count):
-            touching[c] = depth[c] >= -allowance[c]
-        reflect_impacts(body_a, body_b, normal, arm_a, arm_b, mass_n, restitution, touching,
+            gap[c] = max(-depth[c] - allowance[c], 0.0)
+        reflect_impacts(body_a, body_b, normal, arm_a, arm_b, mass_n, restitution, gap, h,
                         resting_speed, inverse_mass, inverse_inertia, v, w)  # fmt: skip
         for c in range(count):
             if target[c] > 0.0:

@@ -76,12 +76,14 @@ def _project(active, axes, lever, turn, index, mass_n, weight, vel, spin, impuls
 
 @njit(cache=True)
 def reflect_impacts(
-    body_a, body_b, normal, arm_a, arm_b, mass_n, restitution, touching, threshold,
+    body_a, body_b, normal, arm_a, arm_b, mass_n, restitution, gap, reach, threshold,
     inverse_mass, inverse_inertia, v, w,
 ):  # fmt: skip
-    """Resolve the impact of the ``touching`` contacts ``(C,)`` bool by generalized
-    reflections (module docstring), changing ``v`` and ``w`` ``(B, 3)`` in place. A contact
-    is active when it approaches faster than ``threshold`` [m/s].
+    """Resolve the impact of the contacts by generalized reflections (module docstring),
+    changing ``v`` and ``w`` ``(B, 3)`` in place. A contact is active when it approaches
+    faster than ``threshold`` [m/s] and would close its ``gap`` ``(C,)`` [m] (0 for one that
+    touches) within the time ``reach`` [s] (the step) at that speed: a row of balls a
+    millimetre apart passes a blow on as one that touches does.
 
     Returns:
         ``(impulses, rounds, ended)``: each contact's total normal impulse [N·s], the rounds
@@ -108,8 +110,8 @@ def reflect_impacts(
         approach = 0.0
         any_active = False
         for c in range(count):
-            speed = lever_speed(c, 0, axes, lever, index, vel, spin) if touching[c] else 0.0
-            active[c] = touching[c] and speed < -threshold
+            speed = lever_speed(c, 0, axes, lever, index, vel, spin)
+            active[c] = speed < -threshold and -speed * reach >= gap[c]
             if active[c]:
                 any_active = True
                 approach = max(approach, -speed)
@@ -122,7 +124,7 @@ def reflect_impacts(
         if rounds >= MAX_ROUNDS or (same and approach >= previous_speed):
             # The failure case of Vouga et al.: end the impact inelastically, every contact.
             for c in range(count):
-                active[c] = touching[c]
+                active[c] = gap[c] <= 0.0
             _project(active, axes, lever, turn, index, mass_n, weight, vel, spin, impulse)
             for c in range(count):
                 total[c] += impulse[c]

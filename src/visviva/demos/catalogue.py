@@ -28,10 +28,20 @@ class BuiltinDemo(NamedTuple):
 
 #: Every built-in demo by name.
 BUILTIN_DEMOS: dict[str, BuiltinDemo] = {
+    "arch": BuiltinDemo(
+        "arch",
+        "a catenary arch of 17 stone blocks stands with friction 0.6 and slides apart at 0.2; "
+        "the friction it needs against limit analysis",
+    ),
     "ball-pit": BuiltinDemo(
         "ball_pit",
         "balls dropped into a box: sphere collisions (restitution, friction), settling; overlaps, "
         "momentum, the floor's support",
+    ),
+    "billiards": BuiltinDemo(
+        "billiards",
+        "a 15-ball break at 8 m/s: simultaneous impacts spread the rack, sequential ones bounce "
+        "the cue ball off it as one lump; momentum, energy, spread",
     ),
     "boids": BuiltinDemo(
         "boids",
@@ -66,9 +76,19 @@ BUILTIN_DEMOS: dict[str, BuiltinDemo] = {
         "constrained_pendulum",
         "the pendulum as a particle held by f = λ(r − c), beside the θ description",
     ),
+    "cradle": BuiltinDemo(
+        "cradle",
+        "Newton's cradle on anchored strings: simultaneous impacts pass the blow down the row, "
+        "sequential ones share it",
+    ),
     "crowd": BuiltinDemo(
         "crowd",
         "a room of 200 agents evacuating through a door: social forces, flow rate, density",
+    ),
+    "dominoes": BuiltinDemo(
+        "dominoes",
+        "20 dominoes topple in turn: the wave's speed, all fallen; v ∝ √(g h) at four times the "
+        "size",
     ),
     "double-pendulum": BuiltinDemo(
         "double_pendulum",
@@ -134,6 +154,11 @@ BUILTIN_DEMOS: dict[str, BuiltinDemo] = {
     "spring-pendulum": BuiltinDemo(
         "spring_pendulum",
         "a bob on a spring: swing and bounce trade energy (autoparametric resonance)",
+    ),
+    "stack": BuiltinDemo(
+        "stack",
+        "ten boxes stacked on the floor stand for 10 s: every box within 1 mm, at rest "
+        "(issue 27's test)",
     ),
     "stiffness-study": BuiltinDemo(
         "stiffness_study",
