@@ -50,7 +50,7 @@ from .body_pieces import BodyPieces
 from .body_response import body_frames, normal_velocities, respond
 from .broad_phase import overlapping_pairs
 from .bvh import MeshBVH
-from .contact_classes import CLASSES, COLLIDING, RESTING, SEPARATING
+from .contact_classes import COLLIDING, RESTING, SEPARATING, Classified
 from .impact_time import pull_back
 from .manifold import MAX_CONTACTS
 from .movers import Movers
@@ -109,7 +109,7 @@ class Planes:
 
 
 @dataclass(frozen=True)
-class BodyContactSet:
+class BodyContactSet(Classified):
     """The bodies' contacts at one moment, in solve order, for inspection.
 
     Attributes:
@@ -133,17 +133,6 @@ class BodyContactSet:
     depth: np.ndarray
     normal_velocity: np.ndarray
     kind: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.piece_a.shape[0])
-
-    def classes(self) -> list[str]:
-        """Each contact's class by name."""
-        return [CLASSES[k] for k in self.kind]
-
-    def counts(self) -> dict[str, int]:
-        """How many contacts of each class."""
-        return {name: int(np.count_nonzero(self.kind == k)) for k, name in enumerate(CLASSES)}
 
 
 class BodyContacts:

@@ -59,6 +59,7 @@ __all__ = [
     "levers",
     "prepare_contacts",
     "solve_impulses",
+    "with_world",
 ]
 
 
@@ -204,6 +205,20 @@ def levers(body_a, body_b, normal, frame, arm_a, arm_b, inverse_inertia, bodies,
 
 
 @njit(cache=True)
+def with_world(v, w, inverse_mass):
+    """Copies of the per-body rates ``v``, ``w`` ``(B, 3)`` and ``inverse_mass`` ``(B,)`` with
+    one more row, the world's: at rest, of infinite mass (see :func:`levers`)."""
+    bodies = v.shape[0]
+    vel = np.zeros((bodies + 1, 3))
+    spin = np.zeros((bodies + 1, 3))
+    weight = np.zeros(bodies + 1)
+    vel[:bodies] = v
+    spin[:bodies] = w
+    weight[:bodies] = inverse_mass
+    return vel, spin, weight
+
+
+@njit(cache=True)
 def solve_impulses(
     body_a, body_b, normal, friction, arm_a, arm_b, frame, mass_n, mass_t, target,
     inverse_mass, inverse_inertia, v, w, normal_impulse, tangent_impulse, iterations,
@@ -223,12 +238,7 @@ def solve_impulses(
     bodies = v.shape[0]
     axes, lever, turn, index = levers(body_a, body_b, normal, frame, arm_a, arm_b,
                                        inverse_inertia, bodies, 3)  # fmt: skip
-    vel = np.zeros((bodies + 1, 3))
-    spin = np.zeros((bodies + 1, 3))
-    weight = np.zeros(bodies + 1)
-    vel[:bodies] = v
-    spin[:bodies] = w
-    weight[:bodies] = inverse_mass
+    vel, spin, weight = with_world(v, w, inverse_mass)
     for c in range(count):
         lever_impulse(c, 0, normal_impulse[c], axes, lever, turn, index, weight, vel, spin)
         lever_impulse(c, 1, tangent_impulse[c, 0], axes, lever, turn, index, weight, vel, spin)
@@ -356,12 +366,7 @@ def correct_positions(
     bodies = shift.shape[0]
     axes, lever, turn_of, index = levers(body_a, body_b, normal, normal, arm_a, arm_b,
                                           inverse_inertia, bodies, 1)  # fmt: skip
-    moved = np.zeros((bodies + 1, 3))
-    turned = np.zeros((bodies + 1, 3))
-    weight = np.zeros(bodies + 1)
-    moved[:bodies] = shift
-    turned[:bodies] = turn
-    weight[:bodies] = inverse_mass
+    moved, turned, weight = with_world(shift, turn, inverse_mass)
     if slab_start is None:
         slab_start = np.array([0, body_a.shape[0]], dtype=np.int64)
     if body_a.shape[0] >= PARALLEL_MIN_CONTACTS:

@@ -25,6 +25,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..geometry.quaternion_kernels import write_matrix
 from .body_impulses import correct_positions, prepare_contacts, solve_impulses
 from .simultaneous import reflect_impacts
 
@@ -41,19 +42,8 @@ def body_frames(q, inverse_inertia_body, inverse_mass, momentum, spin):
     v = np.empty((count, 3))
     w = np.empty((count, 3))
     for b in range(count):
-        qw, qx, qy, qz = q[b, 0], q[b, 1], q[b, 2], q[b, 3]
-        norm = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-        qw, qx, qy, qz = qw / norm, qx / norm, qy / norm, qz / norm
+        write_matrix(q[b, 0], q[b, 1], q[b, 2], q[b, 3], rotation[b])
         r = rotation[b]
-        r[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
-        r[0, 1] = 2.0 * (qx * qy - qw * qz)
-        r[0, 2] = 2.0 * (qx * qz + qw * qy)
-        r[1, 0] = 2.0 * (qx * qy + qw * qz)
-        r[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
-        r[1, 2] = 2.0 * (qy * qz - qw * qx)
-        r[2, 0] = 2.0 * (qx * qz - qw * qy)
-        r[2, 1] = 2.0 * (qy * qz + qw * qx)
-        r[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
         # R I⁻¹ Rᵀ, written out (small matrix products would allocate)
         body_inverse = inverse_inertia_body[b]
         for i in range(3):
@@ -142,18 +132,7 @@ def _start_depths(body_a, body_b, point, normal, depth, x, rotation, x0, q0):
             if b < 0:
                 continue
             sign = 1.0 if side == 1 else -1.0
-            qw, qx, qy, qz = q0[b, 0], q0[b, 1], q0[b, 2], q0[b, 3]
-            norm = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-            qw, qx, qy, qz = qw / norm, qx / norm, qy / norm, qz / norm
-            start_rotation[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
-            start_rotation[0, 1] = 2.0 * (qx * qy - qw * qz)
-            start_rotation[0, 2] = 2.0 * (qx * qz + qw * qy)
-            start_rotation[1, 0] = 2.0 * (qx * qy + qw * qz)
-            start_rotation[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
-            start_rotation[1, 2] = 2.0 * (qy * qz - qw * qx)
-            start_rotation[2, 0] = 2.0 * (qx * qz - qw * qy)
-            start_rotation[2, 1] = 2.0 * (qy * qz + qw * qx)
-            start_rotation[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
+            write_matrix(q0[b, 0], q0[b, 1], q0[b, 2], q0[b, 3], start_rotation)
             # arm in the body's axes at the end, then turned as the body was at the start
             ax = point[c, 0] - x[b, 0]
             ay = point[c, 1] - x[b, 1]

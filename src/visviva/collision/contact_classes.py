@@ -48,6 +48,7 @@ __all__ = [
     "DEFAULT_GAP",
     "RESTING",
     "SEPARATING",
+    "Classified",
     "ContactSource",
     "Contacts",
 ]
@@ -60,8 +61,25 @@ CLASSES = ("colliding", "resting", "separating")
 DEFAULT_GAP = 1e-6
 
 
+class Classified:
+    """What a set of contacts with Baraff's classes (a ``kind`` array) answers."""
+
+    kind: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.kind.shape[0])
+
+    def classes(self) -> list[str]:
+        """Each contact's class by name."""
+        return [CLASSES[k] for k in self.kind]
+
+    def counts(self) -> dict[str, int]:
+        """How many contacts of each class."""
+        return {name: int(np.count_nonzero(self.kind == k)) for k, name in enumerate(CLASSES)}
+
+
 @dataclass(frozen=True)
-class Contacts:
+class Contacts(Classified):
     """Particle–collider contacts, one entry per touching pair, by particle then collider.
 
     Attributes:
@@ -83,17 +101,6 @@ class Contacts:
     normal_velocity: np.ndarray
     kind: np.ndarray
     labels: tuple[str, ...] = ()
-
-    def __len__(self) -> int:
-        return int(self.particle.shape[0])
-
-    def classes(self) -> list[str]:
-        """Each contact's class by name."""
-        return [CLASSES[k] for k in self.kind]
-
-    def counts(self) -> dict[str, int]:
-        """How many contacts of each class."""
-        return {name: int(np.count_nonzero(self.kind == k)) for k, name in enumerate(CLASSES)}
 
     @classmethod
     def none(cls, labels: Sequence[str] = ()) -> Contacts:

@@ -25,6 +25,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..geometry.quaternion_kernels import write_matrix
 from .body_pieces import piece_shape
 from .separation import shape_distance
 
@@ -60,18 +61,8 @@ def _pose(body, local_position, local_rotation, x0, q0, x1, q1, t, position, rot
         qx = (1.0 - t) * q0[body, 1] - t * q1[body, 1]
         qy = (1.0 - t) * q0[body, 2] - t * q1[body, 2]
         qz = (1.0 - t) * q0[body, 3] - t * q1[body, 3]
-    norm = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-    qw, qx, qy, qz = qw / norm, qx / norm, qy / norm, qz / norm
     r = np.empty((3, 3))
-    r[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
-    r[0, 1] = 2.0 * (qx * qy - qw * qz)
-    r[0, 2] = 2.0 * (qx * qz + qw * qy)
-    r[1, 0] = 2.0 * (qx * qy + qw * qz)
-    r[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
-    r[1, 2] = 2.0 * (qy * qz - qw * qx)
-    r[2, 0] = 2.0 * (qx * qz - qw * qy)
-    r[2, 1] = 2.0 * (qy * qz + qw * qx)
-    r[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
+    write_matrix(qw, qx, qy, qz, r)
     for i in range(3):
         position[i] = (1.0 - t) * x0[body, i] + t * x1[body, i]
         for j in range(3):

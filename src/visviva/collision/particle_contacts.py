@@ -62,7 +62,7 @@ from ..geometry.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid
 from ..ode.stage import Phase
 from . import contact_detection as detection
 from . import contact_kernels as kernels
-from .contact_classes import CLASSES, COLLIDING, DEFAULT_GAP, RESTING, SEPARATING
+from .contact_classes import COLLIDING, DEFAULT_GAP, RESTING, SEPARATING, Classified
 
 if TYPE_CHECKING:
     from ..ode.state import State
@@ -108,7 +108,7 @@ _SLAB_MARGIN = 1.0 + 2.0**-10
 
 
 @dataclass(frozen=True)
-class PairContacts:
+class PairContacts(Classified):
     """Sphere–sphere contacts, one entry per touching pair ``first < second``, in order.
 
     Attributes:
@@ -129,17 +129,6 @@ class PairContacts:
     depth: np.ndarray
     normal_velocity: np.ndarray
     kind: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.first.shape[0])
-
-    def classes(self) -> list[str]:
-        """Each contact's class by name."""
-        return [CLASSES[k] for k in self.kind]
-
-    def counts(self) -> dict[str, int]:
-        """How many contacts of each class."""
-        return {name: int(np.count_nonzero(self.kind == k)) for k, name in enumerate(CLASSES)}
 
 
 class ParticleContacts:

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .body_impulses import lever_impulse, lever_speed, levers
+from .body_impulses import lever_impulse, lever_speed, levers, with_world
 
 __all__ = ["MAX_ROUNDS", "reflect_impacts"]
 
@@ -93,12 +93,7 @@ def reflect_impacts(
     bodies = v.shape[0]
     axes, lever, turn, index = levers(body_a, body_b, normal, normal, arm_a, arm_b,
                                       inverse_inertia, bodies, 1)  # fmt: skip
-    vel = np.zeros((bodies + 1, 3))
-    spin = np.zeros((bodies + 1, 3))
-    weight = np.zeros(bodies + 1)
-    vel[:bodies] = v
-    spin[:bodies] = w
-    weight[:bodies] = inverse_mass
+    vel, spin, weight = with_world(v, w, inverse_mass)
     total = np.zeros(count)
     impulse = np.zeros(count)
     active = np.zeros(count, dtype=np.bool_)

@@ -12,7 +12,7 @@ from numba import njit
 
 from .quaternions import hamilton_product
 
-__all__ = ["multiply", "normalized", "rotate", "rotate_back"]
+__all__ = ["multiply", "normalized", "rotate", "rotate_back", "write_matrix"]
 
 #: The Hamilton product ``a ⊗ b`` of components: the rotation ``b``, then ``a``.
 multiply = njit(cache=True, inline="always")(hamilton_product)
@@ -43,3 +43,18 @@ def normalized(w, x, y, z):  # pragma: no cover - compiled
     """``q / |q|``."""
     inverse = 1.0 / np.sqrt(w * w + x * x + y * y + z * z)
     return w * inverse, x * inverse, y * inverse, z * inverse
+
+
+@njit(cache=True, inline="always")
+def write_matrix(w, x, y, z, out):  # pragma: no cover - compiled
+    """Write the rotation matrix ``R(q)`` of ``q`` (normalized first) into ``out`` ``(3, 3)``."""
+    w, x, y, z = normalized(w, x, y, z)
+    out[0, 0] = 1.0 - 2.0 * (y * y + z * z)
+    out[0, 1] = 2.0 * (x * y - w * z)
+    out[0, 2] = 2.0 * (x * z + w * y)
+    out[1, 0] = 2.0 * (x * y + w * z)
+    out[1, 1] = 1.0 - 2.0 * (x * x + z * z)
+    out[1, 2] = 2.0 * (y * z - w * x)
+    out[2, 0] = 2.0 * (x * z - w * y)
+    out[2, 1] = 2.0 * (y * z + w * x)
+    out[2, 2] = 1.0 - 2.0 * (x * x + y * y)
