@@ -176,3 +176,47 @@ def test_position_correction_removes_the_excess_depth_and_keeps_the_centre_of_ma
                       inverse_inertia, np.array([1e-3]), 0.8, 30, shift, turn)  # fmt: skip
     assert shift[1, 0] - shift[0, 0] == pytest.approx(0.099, rel=1e-9)
     assert shift[0] + shift[1] == pytest.approx(np.zeros(3), abs=1e-15)
+
+
+def test_slab_sweeps_give_the_same_bits_on_one_and_two_threads_and_serially():
+    # A row of 60 unit balls on the floor, touching: contact k joins balls k and k + 1 (and
+    # each ball touches the floor), in slabs of two balls; slabs two apart share no ball, so
+    # the even slabs may be swept at once, then the odd ones: the same order whatever the
+    # threads, hence the same bits.
+    import numba
+
+    from visviva.collision import body_impulses as kernels
+
+    count = 60
+    rng = np.random.default_rng(3)
+    pairs = [(k, k + 1) for k in range(count - 1)] + [(-1, k) for k in range(count)]
+    slab = np.array([k // 2 for k, _ in pairs[: count - 1]] + [k // 2 for k in range(count)])
+    order = np.argsort(slab, kind="stable")
+    body_a = np.array([pairs[i][0] for i in order])
+    body_b = np.array([pairs[i][1] for i in order])
+    normal = np.where((body_a >= 0)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    arm_a = np.where((body_a >= 0)[:, None], [0.1, 0.0, 0.0], 0.0)
+    arm_b = np.where((body_a >= 0)[:, None], [-0.1, 0.0, 0.0], [0.0, -0.1, 0.0])
+    slab_start = np.searchsorted(slab[order], np.arange(slab.max() + 2)).astype(np.int64)
+    v0 = rng.normal(size=(count, 3))
+    w0 = rng.normal(size=(count, 3))
+    inverse_inertia = np.tile(np.eye(3) * 250.0, (count, 1, 1))
+    frame = np.array([[[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]] if a >= 0 else
+                      [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]] for a in body_a])  # fmt: skip
+    n = body_a.size
+    results = []
+    for threads, sweeps in ((1, kernels._sweeps_parallel), (2, kernels._sweeps_parallel),
+                            (1, kernels._sweeps_serial)):  # fmt: skip
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+        axes, lever, turn, index = kernels.levers(body_a, body_b, normal, frame, arm_a, arm_b,
+                                                  inverse_inertia, count, 3)  # fmt: skip
+        vel, spin, weight = kernels.with_world(v0, w0, np.ones(count))
+        impulses, tangents = np.zeros(n), np.zeros((n, 2))
+        sweeps(slab_start, 10, np.full(n, 0.5), np.full(n, 0.5), np.ones((n, 2)), np.zeros(n),
+               impulses, tangents, axes, lever, turn, index, weight, vel, spin)  # fmt: skip
+        results.append((vel.copy(), spin.copy(), impulses.copy()))
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    for other in results[1:]:
+        for a, b in zip(results[0], other, strict=True):
+            np.testing.assert_array_equal(a, b)
+    assert results[0][2].any()

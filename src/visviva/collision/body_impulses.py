@@ -256,8 +256,11 @@ def solve_impulses(
     w[:] = spin[:bodies]
 
 
-#: From this many contacts the slabs are swept on every core.
-PARALLEL_MIN_CONTACTS = 1024
+#: From this many contacts the slabs are swept on every core. Each sweep of a parity is a
+#: parallel region whose threads wake and meet again (2 × 20 of them a step): measured on 2
+#: cores (BENCHMARKS.md, issue 27), that costs more than it gains below about 20,000
+#: contacts (a pile of 10,000 spheres gains 10 %).
+PARALLEL_MIN_CONTACTS = 16384
 
 
 @njit(cache=True, inline="always")
