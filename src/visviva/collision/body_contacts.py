@@ -45,7 +45,6 @@ from .body_detection import (
     piece_poses,
     plane_contacts,
 )
-from .body_impulses import PARALLEL_MIN_CONTACTS
 from .body_pieces import BodyPieces
 from .body_response import body_frames, normal_velocities, respond
 from .broad_phase import overlapping_pairs
@@ -81,8 +80,6 @@ BODY_TIME_OF_IMPACT = ("auto", "always", "never")
 #: A body is fast, and its time of impact looked for by default, when it moves more than this
 #: fraction of its size in a step: then it might pass through something as thin as itself.
 FAST = 0.25
-#: The slabs' width exceeds twice the largest mover's reach by this factor, against rounding.
-SLAB_MARGIN = 1.0 + 2.0**-10
 #: The carried parts, in order (:meth:`BodyContacts.carried_start`).
 MEMORY = (
     "body_contact_key",
@@ -382,8 +379,9 @@ class BodyContacts:
         margin = h * speed + SPECULATIVE * movers.size
         found, position, turn = self.detect(movers, x, rotation, margin)
         pieces = movers.pieces
-        order, slab_start = _sweep_order(found[2], self.up, _bodies_of(movers, *found[:2]),
-                                         movers.size)  # fmt: skip
+        # Bottom up along gravity: a stack's support is met before what rests on it, which
+        # is what a sweep needs to carry the weight down in few iterations.
+        order = np.argsort(found[2] @ self.up, kind="stable")
         piece_a, piece_b, point, normal, depth = (a[order] for a in found)
         body_a, body_b = _bodies_of(movers, piece_a, piece_b)
         restitution, friction = self._coefficients(pieces, piece_a, piece_b)
@@ -404,7 +402,7 @@ class BodyContacts:
             movers.inverse_mass, movers.inertia, movers.dynamic,
             has_start, x0, q0, v0, w0,
             h, self.resting_speed, self.iterations, max(self.iterations // 4, 1),
-            ALLOWANCE * smaller, CORRECTION, self.impacts == "simultaneous", slab_start,
+            ALLOWANCE * smaller, CORRECTION, self.impacts == "simultaneous",
         )  # fmt: skip
         return key, anchor, normal_impulse, friction_impulse
 
@@ -478,35 +476,6 @@ class ParticleMembers:
     inverse_mass: np.ndarray
     restitution: float
     friction: float
-
-
-def _sweep_order(point: np.ndarray, up: np.ndarray, bodies: tuple,
-                 size: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """The order the contacts at ``point`` ``(C, 3)`` are swept in, and the slabs they fall in.
-
-    Bottom up along gravity (``up``): a stack's support is met before what rests on it, which
-    is what a sweep needs to carry the weight down in few iterations. From
-    :data:`~visviva.collision.body_impulses.PARALLEL_MIN_CONTACTS` contacts, first by slab:
-    slices across the horizontal axis along which the contacts spread most, wider than any
-    mover of a contact (``size`` is each mover's reach from its centre), so that a mover's
-    contacts fall in one slab or two neighbours and slabs two apart share none: the even slabs
-    can be swept at once, then the odd ones (:func:`~visviva.collision.body_impulses.
-    solve_impulses`), in an order the number of cores does not change.
-    """
-    count = point.shape[0]
-    height = point @ up
-    if count < PARALLEL_MIN_CONTACTS:
-        return np.argsort(height, kind="stable"), np.array([0, count], dtype=np.int64)
-    body_a, body_b = bodies
-    widest = max(size[body_a[body_a >= 0]].max(initial=0.0), size[body_b].max(initial=0.0))
-    across = np.eye(3) - np.outer(up, up)  # the horizontal part of each axis
-    spread = np.ptp(point @ across.T, axis=0)
-    axis = across[int(np.argmax(spread))]
-    coordinate = point @ axis
-    slab = np.floor((coordinate - coordinate.min()) / (2.0 * widest * SLAB_MARGIN)).astype(np.int64)
-    order = np.lexsort((height, slab))
-    slab_start = np.searchsorted(slab[order], np.arange(slab.max() + 2))
-    return order, slab_start.astype(np.int64)
 
 
 def _bodies_of(movers: Movers, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple:

@@ -50,7 +50,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 __all__ = [
     "correct_positions",
@@ -222,17 +222,13 @@ def with_world(v, w, inverse_mass):
 def solve_impulses(
     body_a, body_b, normal, friction, arm_a, arm_b, frame, mass_n, mass_t, target,
     inverse_mass, inverse_inertia, v, w, normal_impulse, tangent_impulse, iterations,
-    slab_start=None,
 ):  # fmt: skip
     """Sequential impulses: ``iterations`` sweeps over the contacts in order, changing ``v``
     and ``w`` in place (module docstring).
 
     ``normal_impulse`` ``(C,)`` [N·s] and ``tangent_impulse`` ``(C, 2)`` [N·s] hold each
     contact's accumulated impulse; whatever they hold on entry (a warm start) is applied
-    first. ``slab_start`` ``(S + 1,)``: the contacts come in slabs of which no two of the
-    same parity share a body (see :func:`sweep_order`); the even slabs are swept at once on
-    every core, then the odd ones, in an order that does not depend on the cores. ``None``:
-    one slab.
+    first.
     """
     count = body_a.shape[0]
     bodies = v.shape[0]
@@ -243,24 +239,12 @@ def solve_impulses(
         lever_impulse(c, 0, normal_impulse[c], axes, lever, turn, index, weight, vel, spin)
         lever_impulse(c, 1, tangent_impulse[c, 0], axes, lever, turn, index, weight, vel, spin)
         lever_impulse(c, 2, tangent_impulse[c, 1], axes, lever, turn, index, weight, vel, spin)
-    if slab_start is None:
-        slab_start = np.array([0, count], dtype=np.int64)
-    if count >= PARALLEL_MIN_CONTACTS:
-        _sweeps_parallel(slab_start, iterations, friction, mass_n, mass_t, target,
-                         normal_impulse, tangent_impulse, axes, lever, turn, index, weight, vel,
-                         spin)  # fmt: skip
-    else:
-        _sweeps_serial(slab_start, iterations, friction, mass_n, mass_t, target, normal_impulse,
-                       tangent_impulse, axes, lever, turn, index, weight, vel, spin)  # fmt: skip
+    for _ in range(iterations):
+        for c in range(count):
+            _contact_step(c, friction, mass_n, mass_t, target, normal_impulse, tangent_impulse,
+                          axes, lever, turn, index, weight, vel, spin)  # fmt: skip
     v[:] = vel[:bodies]
     w[:] = spin[:bodies]
-
-
-#: From this many contacts the slabs are swept on every core. Each sweep of a parity is a
-#: parallel region whose threads wake and meet again (2 × 20 of them a step): measured on 2
-#: cores (BENCHMARKS.md, issue 27), that costs more than it gains below about 20,000
-#: contacts (a pile of 10,000 spheres gains 10 %).
-PARALLEL_MIN_CONTACTS = 16384
 
 
 @njit(cache=True, inline="always")
@@ -290,34 +274,6 @@ def _contact_step(c, friction, mass_n, mass_t, target, normal_impulse, tangent_i
     lever_impulse(c, 0, new - old, axes, lever, turn, index, weight, vel, spin)
 
 
-@njit(cache=True)
-def _sweeps_serial(slab_start, iterations, friction, mass_n, mass_t, target, normal_impulse,
-                   tangent_impulse, axes, lever, turn, index, weight, vel, spin):  # fmt: skip
-    slabs = slab_start.shape[0] - 1
-    for _ in range(iterations):
-        for parity in range(2):
-            for q in range((slabs - parity + 1) // 2):
-                k = parity + 2 * q
-                for c in range(slab_start[k], slab_start[k + 1]):
-                    _contact_step(c, friction, mass_n, mass_t, target, normal_impulse,
-                                  tangent_impulse, axes, lever, turn, index, weight, vel,
-                                  spin)  # fmt: skip
-
-
-@njit(cache=True, parallel=True)
-def _sweeps_parallel(slab_start, iterations, friction, mass_n, mass_t, target, normal_impulse,
-                     tangent_impulse, axes, lever, turn, index, weight, vel, spin):  # fmt: skip
-    slabs = slab_start.shape[0] - 1
-    for _ in range(iterations):
-        for parity in range(2):
-            for q in prange((slabs - parity + 1) // 2):
-                k = parity + 2 * q
-                for c in range(slab_start[k], slab_start[k + 1]):
-                    _contact_step(c, friction, mass_n, mass_t, target, normal_impulse,
-                                  tangent_impulse, axes, lever, turn, index, weight, vel,
-                                  spin)  # fmt: skip
-
-
 @njit(cache=True, inline="always")
 def lever_speed(c, k, axes, lever, index, vel, spin):
     """Contact ``c``'s relative velocity along its direction ``k``, B's point from A's."""
@@ -341,7 +297,7 @@ def lever_impulse(c, k, size, axes, lever, turn, index, weight, vel, spin):
     """An impulse of ``size`` along contact ``c``'s direction ``k`` on B, its opposite on A."""
     a = index[c, 0]
     b = index[c, 1]
-    world = vel.shape[0] - 1  # never written: slabs swept at once all touch it
+    world = vel.shape[0] - 1  # at rest and of infinite mass: never written
     for i in range(3):
         d = size * axes[c, k, i]
         if b != world:
@@ -356,28 +312,22 @@ def lever_impulse(c, k, size, axes, lever, turn, index, weight, vel, spin):
 def correct_positions(
     body_a, body_b, normal, depth, arm_a, arm_b, mass_n,
     inverse_mass, inverse_inertia, allowance, fraction, iterations, shift, turn,
-    slab_start=None,
 ):  # fmt: skip
     """Split position correction: sweeps of pseudo-impulses that move the bodies apart where
     they overlap by more than ``allowance[c]`` [m], each removing ``fraction`` of a contact's
     remaining excess depth, the depths updated to first order as the bodies move.
 
     ``shift`` and ``turn`` ``(B, 3)`` receive each body's translation [m] and small rotation
-    vector [rad] (world frame), added to what they hold; ``slab_start`` as
-    :func:`solve_impulses`.
+    vector [rad] (world frame), added to what they hold.
     """
     bodies = shift.shape[0]
     axes, lever, turn_of, index = levers(body_a, body_b, normal, normal, arm_a, arm_b,
                                           inverse_inertia, bodies, 1)  # fmt: skip
     moved, turned, weight = with_world(shift, turn, inverse_mass)
-    if slab_start is None:
-        slab_start = np.array([0, body_a.shape[0]], dtype=np.int64)
-    if body_a.shape[0] >= PARALLEL_MIN_CONTACTS:
-        _corrections_parallel(slab_start, iterations, depth, allowance, fraction, mass_n, axes,
-                              lever, turn_of, index, weight, moved, turned)  # fmt: skip
-    else:
-        _corrections_serial(slab_start, iterations, depth, allowance, fraction, mass_n, axes,
-                            lever, turn_of, index, weight, moved, turned)  # fmt: skip
+    for _ in range(iterations):
+        for c in range(body_a.shape[0]):
+            _correction(c, depth, allowance, fraction, mass_n, axes, lever, turn_of, index,
+                        weight, moved, turned)  # fmt: skip
     shift[:] = moved[:bodies]
     turn[:] = turned[:bodies]
 
@@ -390,29 +340,3 @@ def _correction(c, depth, allowance, fraction, mass_n, axes, lever, turn, index,
     if excess > 0.0:
         lever_impulse(c, 0, fraction * excess * mass_n[c], axes, lever, turn, index, weight,
                       moved, turned)  # fmt: skip
-
-
-@njit(cache=True)
-def _corrections_serial(slab_start, iterations, depth, allowance, fraction, mass_n, axes, lever,
-                        turn, index, weight, moved, turned):  # fmt: skip
-    slabs = slab_start.shape[0] - 1
-    for _ in range(iterations):
-        for parity in range(2):
-            for q in range((slabs - parity + 1) // 2):
-                k = parity + 2 * q
-                for c in range(slab_start[k], slab_start[k + 1]):
-                    _correction(c, depth, allowance, fraction, mass_n, axes, lever, turn,
-                                index, weight, moved, turned)  # fmt: skip
-
-
-@njit(cache=True, parallel=True)
-def _corrections_parallel(slab_start, iterations, depth, allowance, fraction, mass_n, axes,
-                          lever, turn, index, weight, moved, turned):  # fmt: skip
-    slabs = slab_start.shape[0] - 1
-    for _ in range(iterations):
-        for parity in range(2):
-            for q in prange((slabs - parity + 1) // 2):
-                k = parity + 2 * q
-                for c in range(slab_start[k], slab_start[k + 1]):
-                    _correction(c, depth, allowance, fraction, mass_n, axes, lever, turn,
-                                index, weight, moved, turned)  # fmt: skip

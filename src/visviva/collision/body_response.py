@@ -168,7 +168,6 @@ def respond(
     inverse_mass, inertia_body, dynamic,
     has_start, x0, q0, v0, w0,
     h, resting_speed, iterations, position_iterations, allowance, fraction, simultaneous,
-    slab_start,
 ):  # fmt: skip
     """Resolve one step's contacts (module docstring) in place on ``x``, ``q``, ``momentum``
     and ``spin``; ``warm_normal`` ``(C,)`` and ``warm_friction`` ``(C, 3)`` (world frame) are
@@ -227,7 +226,7 @@ def respond(
     w_start = w.copy()
     solve_impulses(body_a, body_b, normal, friction, arm_a, arm_b, frame, mass_n, mass_t,
                    target, inverse_mass, inverse_inertia, v, w, normal_impulse,
-                   tangent_impulse, iterations, slab_start)  # fmt: skip
+                   tangent_impulse, iterations)  # fmt: skip
     # The step again for the bodies the impulses changed: as the integrator moved them until
     # their first impact τ, with the new velocity after: x(τ) + (1 − τ) h v, that is, moved by
     # (1 − τ)(h v − Δx) for the step's move Δx (h v before the impulses if the start is
@@ -255,7 +254,7 @@ def respond(
     # The correction measures each depth less what the moves so far took off it.
     correct_positions(body_a, body_b, normal, depth, arm_a, arm_b, mass_n, inverse_mass,
                       inverse_inertia, allowance, fraction, position_iterations, shift,
-                      twist, slab_start)  # fmt: skip
+                      twist)  # fmt: skip
     x += shift
     turned(q, twist)
     # Back to momenta, with the inertia of the step's end (world frame).
