@@ -302,13 +302,13 @@ def test_generalized_reflections_take_a_round_per_ball_and_keep_symmetry():
     assert (v**2).sum() == pytest.approx(1.0, rel=1e-12)
 
 
-def _bullet(mode, method="advancement", thickness=0.01, speed=100.0):
+def _bullet(mode, method="advancement"):
     builder = vv.SceneBuilder(name="bullet")
     builder.set_world(gravity=(0, 0, 0))
     builder.set_integration(method="velocity_verlet", dt=H, duration=1.0)
-    builder.add_collider("box", center=(0, 0, 0), size=(2, 2, thickness), restitution=0.5)
+    builder.add_collider("box", center=(0, 0, 0), size=(2, 2, 0.01), restitution=0.5)
     builder.add_body("sphere", radius=0.05, density=1000.0, position=(0, 0, -1),
-                     velocity=(0, 0, speed), restitution=0.5, time_of_impact=mode)  # fmt: skip
+                     velocity=(0, 0, 100.0), restitution=0.5, time_of_impact=mode)  # fmt: skip
     builder.add_body_contacts(time_of_impact=method)
     return vv.Simulation(builder.build())
 
@@ -327,10 +327,33 @@ def test_a_fast_ball_does_not_pass_through_a_thin_plate_with_time_of_impact():
     assert missed.state["body_position"][0, 2] > 5.0
     # Seed 003's bisection needs the overlap at the step's end: it misses the thin plate...
     assert _advance(_bullet("auto", "bisection"))[2] > 5.0
-    # ...and finds the impact on a thick wall the ball ends a step inside of.
-    thick = _bullet("always", "bisection", thickness=1.0, speed=30.0)
-    thick.step(24)
-    assert thick.state["body_position"][0, 2] < -0.55
+
+
+def test_both_times_of_impact_match_the_closed_form():
+    # A ball of radius 0.1 moving from x = 0 to x = 1 in a step toward a static ball of
+    # radius 0.2 at x = 0.8: they touch when the centres are 0.3 apart, at τ = 0.5. Seed 003's
+    # bisection needs them overlapping at the end (they do: 0.2 apart); conservative
+    # advancement finds it from the start. Both within their tolerance.
+    from visviva.collision import Sphere
+    from visviva.collision.body_pieces import BodyPieces
+    from visviva.collision.impact_time import ADVANCEMENT, BISECTION, impact_fraction
+
+    pieces = BodyPieces.of([Sphere((0, 0, 0), 0.1), Sphere((0.8, 0, 0), 0.2)], [0, -1],
+                           [0.5, 0.5], [0.5, 0.5])  # fmt: skip
+    x0, x1 = np.zeros((1, 3)), np.array([[1.0, 0.0, 0.0]])
+    q = np.array([[1.0, 0.0, 0.0, 0.0]])
+    reach = np.linalg.norm(pieces.local_position, axis=1) + pieces.radius
+    for method in (ADVANCEMENT, BISECTION):
+        tau = impact_fraction(0, 1, method, 1e-6, pieces.arrays(), pieces.body,
+                              pieces.local_position, pieces.local_rotation, reach, x0, q, x1,
+                              q)  # fmt: skip
+        assert tau == pytest.approx(0.5, abs=2e-6)
+    # Missing each other (1 m to the side), neither finds an impact.
+    far = BodyPieces.of([Sphere((0, 0, 0), 0.1), Sphere((0.8, 1.0, 0), 0.2)], [0, -1],
+                        [0.5, 0.5], [0.5, 0.5])  # fmt: skip
+    for method in (ADVANCEMENT, BISECTION):
+        assert impact_fraction(0, 1, method, 1e-6, far.arrays(), far.body, far.local_position,
+                               far.local_rotation, reach, x0, q, x1, q) == 1.0  # fmt: skip
 
 
 def _advance(simulation):

@@ -46,7 +46,6 @@ __all__ = [
     "CYLINDER",
     "ELLIPSOID",
     "HULL",
-    "KIND_NAMES",
     "MAX_FACE_POINTS",
     "ROUND_FACE_POINTS",
     "SPHERE",
@@ -62,8 +61,6 @@ CYLINDER = 3
 CONE = 4
 ELLIPSOID = 5
 HULL = 6
-
-KIND_NAMES = ("sphere", "capsule", "box", "cylinder", "cone", "ellipsoid", "hull")
 
 #: Points on the rim of a cylinder's cap or a cone's base that stand for the circle in a
 #: manifold: eight keep a disc standing on a plane steady and cost little to clip.

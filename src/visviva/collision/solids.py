@@ -42,6 +42,18 @@ def _posed(shape: str, center: Any, orientation: Any) -> tuple[tuple[float, ...]
     return numbers("center", shape, center, 3, " [m]"), unit_quaternion(shape, orientation)
 
 
+def _round_solid(solid: Any, place: str, shape: str, flat_height: bool) -> None:
+    """Validate, in place, a round solid's ``place`` (its centre or base), ``orientation``,
+    ``radius`` (> 0) and ``height`` (> 0, or ≥ 0 with ``flat_height``: a capsule of height
+    zero is a sphere)."""
+    where, q = _posed(shape, getattr(solid, place), solid.orientation)
+    radius = real_number("radius", solid.radius, positive=True, unit=" m")
+    height = real_number("height", solid.height, positive=not flat_height,
+                         nonnegative=flat_height, unit=" m")  # fmt: skip
+    for name, value in ((place, where), ("orientation", q), ("radius", radius), ("height", height)):
+        object.__setattr__(solid, name, value)
+
+
 @dataclass(frozen=True)
 class Capsule:
     """A capsule: the points within ``radius`` of the segment of length ``height`` along its
@@ -60,15 +72,7 @@ class Capsule:
     orientation: tuple[float, float, float, float] = IDENTITY
 
     def __post_init__(self) -> None:
-        center, q = _posed("capsule", self.center, self.orientation)
-        object.__setattr__(self, "center", center)
-        object.__setattr__(self, "orientation", q)
-        object.__setattr__(
-            self, "radius", real_number("radius", self.radius, positive=True, unit=" m")
-        )
-        object.__setattr__(
-            self, "height", real_number("height", self.height, nonnegative=True, unit=" m")
-        )
+        _round_solid(self, "center", "capsule", flat_height=True)
 
 
 @dataclass(frozen=True)
@@ -88,15 +92,7 @@ class Cylinder:
     orientation: tuple[float, float, float, float] = IDENTITY
 
     def __post_init__(self) -> None:
-        center, q = _posed("cylinder", self.center, self.orientation)
-        object.__setattr__(self, "center", center)
-        object.__setattr__(self, "orientation", q)
-        object.__setattr__(
-            self, "radius", real_number("radius", self.radius, positive=True, unit=" m")
-        )
-        object.__setattr__(
-            self, "height", real_number("height", self.height, positive=True, unit=" m")
-        )
+        _round_solid(self, "center", "cylinder", flat_height=False)
 
 
 @dataclass(frozen=True)
@@ -117,15 +113,7 @@ class Cone:
     orientation: tuple[float, float, float, float] = IDENTITY
 
     def __post_init__(self) -> None:
-        base = numbers("base", "cone", self.base, 3, " [m]")
-        object.__setattr__(self, "base", base)
-        object.__setattr__(self, "orientation", unit_quaternion("cone", self.orientation))
-        object.__setattr__(
-            self, "radius", real_number("radius", self.radius, positive=True, unit=" m")
-        )
-        object.__setattr__(
-            self, "height", real_number("height", self.height, positive=True, unit=" m")
-        )
+        _round_solid(self, "base", "cone", flat_height=False)
 
 
 @dataclass(frozen=True)
