@@ -9,9 +9,9 @@ into static convex scenery and into planes:
    ``h (|v| + |ω| r)``, plus :data:`SPECULATIVE` of its size — swept and pruned, then GJK/EPA
    and the contact manifold per candidate pair, and every moving piece against every plane.
 2. **Impulses** (velocities): sequential impulses with restitution and Coulomb friction
-   (:mod:`~visviva.collision.body_impulses`), swept bottom-up along gravity (a stack's support
-   first) and warm-started from the impulses of the last step's contacts at the same place on
-   the same pair of pieces (carried in the state).
+   (:mod:`~visviva.collision.body_impulses`), the contacts in order bottom-up along gravity
+   (a stack's support first, then back down) and warm-started from the impulses of the last
+   step's contacts at the same place on the same pair of pieces (carried in the state).
 3. **The step again**: each body is moved by ``(1 − τ) h Δv`` and turned by ``(1 − τ) h Δω``
    for the velocity change the impulses made, as if it had moved with its old velocity until
    its earliest collision of the step, at the fraction ``τ`` (from the contact's depths at the
@@ -502,12 +502,15 @@ def _warm_start(key, anchor, tolerance, old_key, old_anchor, old_normal, old_fri
         k = np.searchsorted(sorted_keys, key[c])
         while k < sorted_keys.shape[0] and sorted_keys[k] == key[c]:
             o = order[k]
-            d = np.sum((old_anchor[o] - anchor[c]) ** 2)
+            d = 0.0
+            for i in range(3):
+                d += (old_anchor[o, i] - anchor[c, i]) ** 2
             if d <= best_distance:
                 best_distance = d
                 best = o
             k += 1
         if best >= 0:
             normal[c] = old_normal[best]
-            friction[c] = old_friction[best]
+            for i in range(3):
+                friction[c, i] = old_friction[best, i]
     return normal, friction

@@ -3,9 +3,10 @@
 :func:`piece_poses` places every piece (:mod:`~visviva.collision.body_pieces`) in the world
 from its body's centre of mass and rotation, with its bounding box grown by its margin;
 :func:`~visviva.collision.broad_phase.overlapping_pairs` keeps the pairs whose boxes overlap;
-:func:`pair_contacts` runs GJK/EPA and the manifold on each (:mod:`~visviva.collision.separation`,
-:mod:`~visviva.collision.manifold`), :func:`plane_contacts` each piece against each plane and
-:func:`mesh_contacts` against the triangles of a static mesh its box overlaps.
+:func:`pair_contacts` finds each one's contacts (:mod:`~visviva.collision.narrow_phase`: the
+separating axes for two boxes, GJK/EPA and the clipped manifold for the rest),
+:func:`plane_contacts` each piece against each plane and :func:`mesh_contacts` against the
+triangles of a static mesh its box overlaps.
 Contacts come out in the order of their pairs, then of their planes: the same on every run.
 """
 
@@ -17,10 +18,12 @@ import numpy as np
 from numba import njit
 
 from .body_pieces import piece_shape
+from .box_box import clip_work
 from .broad_phase import shape_bounds
 from .bvh import STACK_SIZE
 from .convex import HULL, SPHERE
 from .manifold import CANDIDATES, MAX_CONTACTS, contact_manifold, plane_manifold
+from .narrow_phase import convex_contacts
 from .separation import plane_separation, shape_distance
 
 __all__ = [
@@ -89,6 +92,7 @@ def pair_contacts(pieces, body, pairs, piece_position, piece_rotation, margin, o
     piece_a, piece_b, point, normal, depth = out
     points = np.empty((CANDIDATES, 3))
     depths = np.empty(CANDIDATES)
+    work = clip_work()
     count = 0
     for k in range(pairs.shape[0]):
         i, j = pairs[k, 0], pairs[k, 1]
@@ -102,8 +106,7 @@ def pair_contacts(pieces, body, pairs, piece_position, piece_rotation, margin, o
             continue
         shape_a = piece_shape(i, pieces, piece_position[i], piece_rotation[i])
         shape_b = piece_shape(j, pieces, piece_position[j], piece_rotation[j])
-        separation = shape_distance(shape_a, shape_b)
-        found, nx, ny, nz = contact_manifold(shape_a, shape_b, separation, reach, points, depths)
+        found, nx, ny, nz = convex_contacts(shape_a, shape_b, reach, points, depths, work)
         for c in range(found):
             piece_a[count], piece_b[count] = i, j
             point[count] = points[c]

@@ -26,7 +26,11 @@ impulses, a projected Gauss–Seidel iteration on the contacts' accumulated impu
 "Iterative dynamics with temporal coherence", GDC 2005): each sweep gives each contact the
 impulse that brings its ``v_n`` to its target, keeps the accumulated normal impulse ``λ ≥ 0``
 (contacts push, never pull), and a friction impulse in the tangent plane that opposes the
-sliding, its accumulated size at most ``μ λ`` (Coulomb's cone). The contacts are found at the
+sliding, its accumulated size at most ``μ λ`` (Coulomb's cone). The sweeps go forward and
+backward in turn (symmetric Gauss–Seidel): a contact always met first takes more than its
+share of an unconverged sweep, and on a box's four corners that leaves a twist — a ten-box
+stack swayed 1.4 mm in its first 50 steps with forward sweeps, 0.6 mm with alternating ones
+(measured). The contacts are found at the
 step's end poses, and the bodies are moved again by ``h Δv`` (and turned by ``h Δω``) for the
 velocity change ``Δv`` the impulses make — what the step would have done had the bodies had
 those velocities — so the target is posed on the depth at the step's start ``d₀``
@@ -53,13 +57,14 @@ import numpy as np
 from numba import njit
 
 __all__ = [
+    "ROW",
+    "contact_rows",
     "correct_positions",
     "lever_impulse",
     "lever_speed",
-    "levers",
     "prepare_contacts",
+    "rates_with_world",
     "solve_impulses",
-    "with_world",
 ]
 
 
@@ -172,50 +177,109 @@ def prepare_contacts(
             target[c] = min(start, 0.0) / h
 
 
+#: A contact's row in :func:`contact_rows`: the directions n, t₁, t₂ (3 each), then per side
+#: (A, B) and direction the lever ``r × d`` and the turn ``I⁻¹(r × d)``, then the two inverse
+#: masses; padded to a multiple of a cache line.
+ROW = 48
+AXES, LEVER_A, LEVER_B, TURN_A, TURN_B, WEIGHT_A, WEIGHT_B = 0, 9, 18, 27, 36, 45, 46
+
+
 @njit(cache=True)
-def levers(body_a, body_b, normal, frame, arm_a, arm_b, inverse_inertia, bodies, directions):
-    """Each contact's first ``directions`` of (n, t₁, t₂) and, per body and direction, r × d
-    (what the spin adds to the velocity along d) and I⁻¹(r × d) (how an impulse along d turns
-    the body), computed once so that a sweep is dot products and additions; and each
-    contact's two bodies, the world as the extra body ``bodies`` (at rest, of infinite mass),
-    so that no sweep branches on it."""
+def contact_rows(body_a, body_b, normal, frame, arm_a, arm_b, inverse_mass, inverse_inertia,
+                 bodies, directions):  # fmt: skip
+    """What a sweep needs of each contact, computed once, so that a sweep is dot products and
+    additions: its first ``directions`` of (n, t₁, t₂) and, per body and direction, r × d (what
+    the spin adds to the velocity along d) and I⁻¹(r × d) (how an impulse along d turns the
+    body), and the bodies' inverse masses, in a row of :data:`ROW` ``(C, ROW)``; and each
+    contact's two bodies ``(C, 2)``, the world as the extra body ``bodies`` (at rest, of
+    infinite mass: its weight and turns are zero, so that no sweep branches on it). The
+    tangents ``frame`` ``(C, 2, 3)`` are read only for ``directions`` > 1."""
     count = body_a.shape[0]
-    axes = np.empty((count, 3, 3))
-    lever = np.zeros((count, 2, 3, 3))
-    turn = np.zeros((count, 2, 3, 3))
+    rows = np.zeros((count, ROW))
     index = np.empty((count, 2), dtype=np.int64)
     for c in range(count):
-        axes[c, 0] = normal[c]
-        if directions > 1:
-            axes[c, 1] = frame[c, 0]
-            axes[c, 2] = frame[c, 1]
+        for i in range(3):
+            rows[c, AXES + i] = normal[c, i]
+            if directions > 1:
+                rows[c, AXES + 3 + i] = frame[c, 0, i]
+                rows[c, AXES + 6 + i] = frame[c, 1, i]
         for side in range(2):
             b = body_a[c] if side == 0 else body_b[c]
             index[c, side] = b if b >= 0 else bodies
             if b < 0:
                 continue
             arm = arm_a[c] if side == 0 else arm_b[c]
+            rows[c, WEIGHT_A + side] = inverse_mass[b]
             for k in range(directions):
-                cx, cy, cz = _cross(arm[0], arm[1], arm[2], axes[c, k, 0], axes[c, k, 1],
-                                    axes[c, k, 2])  # fmt: skip
-                lever[c, side, k, 0], lever[c, side, k, 1], lever[c, side, k, 2] = cx, cy, cz
+                d = AXES + 3 * k
+                cx, cy, cz = _cross(arm[0], arm[1], arm[2], rows[c, d], rows[c, d + 1],
+                                    rows[c, d + 2])  # fmt: skip
+                o = (LEVER_A if side == 0 else LEVER_B) + 3 * k
+                rows[c, o], rows[c, o + 1], rows[c, o + 2] = cx, cy, cz
                 tx, ty, tz = _times(inverse_inertia, b, cx, cy, cz)
-                turn[c, side, k, 0], turn[c, side, k, 1], turn[c, side, k, 2] = tx, ty, tz
-    return axes, lever, turn, index
+                o = (TURN_A if side == 0 else TURN_B) + 3 * k
+                rows[c, o], rows[c, o + 1], rows[c, o + 2] = tx, ty, tz
+    return rows, index
 
 
 @njit(cache=True)
-def with_world(v, w, inverse_mass):
-    """Copies of the per-body rates ``v``, ``w`` ``(B, 3)`` and ``inverse_mass`` ``(B,)`` with
-    one more row, the world's: at rest, of infinite mass (see :func:`levers`)."""
+def rates_with_world(v, w):
+    """The per-body rates ``v``, ``w`` ``(B, 3)`` side by side ``(B + 1, 6)``, with one more
+    row, the world's: at rest (see :func:`contact_rows`)."""
     bodies = v.shape[0]
-    vel = np.zeros((bodies + 1, 3))
-    spin = np.zeros((bodies + 1, 3))
-    weight = np.zeros(bodies + 1)
-    vel[:bodies] = v
-    spin[:bodies] = w
-    weight[:bodies] = inverse_mass
-    return vel, spin, weight
+    rates = np.zeros((bodies + 1, 8))
+    rates[:bodies, :3] = v
+    rates[:bodies, 3:6] = w
+    return rates
+
+
+@njit(cache=True, inline="always")
+def lever_speed(rows, c, k, index, rates):
+    """Contact ``c``'s relative velocity along its direction ``k``, B's point from A's."""
+    a = index[c, 0]
+    b = index[c, 1]
+    d = AXES + 3 * k
+    la = LEVER_A + 3 * k
+    lb = LEVER_B + 3 * k
+    # Summed as a tree, not a chain: a sweep waits on each sum (measured: a third faster).
+    linear = (rows[c, d] * (rates[b, 0] - rates[a, 0])
+              + rows[c, d + 1] * (rates[b, 1] - rates[a, 1])) + rows[c, d + 2] * (
+                  rates[b, 2] - rates[a, 2])  # fmt: skip
+    spin_b = (rows[c, lb] * rates[b, 3] + rows[c, lb + 1] * rates[b, 4]) + (
+        rows[c, lb + 2] * rates[b, 5])  # fmt: skip
+    spin_a = (rows[c, la] * rates[a, 3] + rows[c, la + 1] * rates[a, 4]) + (
+        rows[c, la + 2] * rates[a, 5])  # fmt: skip
+    return linear + (spin_b - spin_a)
+
+
+@njit(cache=True, inline="always")
+def lever_impulse(rows, c, k, size, index, rates):
+    """An impulse of ``size`` along contact ``c``'s direction ``k`` on B, its opposite on A."""
+    a = index[c, 0]
+    b = index[c, 1]
+    d = AXES + 3 * k
+    ta = TURN_A + 3 * k
+    tb = TURN_B + 3 * k
+    weight_a = size * rows[c, WEIGHT_A]
+    weight_b = size * rows[c, WEIGHT_B]
+    for i in range(3):
+        rates[b, i] += weight_b * rows[c, d + i]
+        rates[b, 3 + i] += size * rows[c, tb + i]
+        rates[a, i] -= weight_a * rows[c, d + i]
+        rates[a, 3 + i] -= size * rows[c, ta + i]
+
+
+@njit(cache=True, inline="always")
+def _friction_impulse(rows, c, first, second, index, rates):
+    """Impulses of ``first`` and ``second`` along contact ``c``'s tangents t₁, t₂ at once."""
+    a = index[c, 0]
+    b = index[c, 1]
+    for i in range(3):
+        along = first * rows[c, AXES + 3 + i] + second * rows[c, AXES + 6 + i]
+        rates[b, i] += rows[c, WEIGHT_B] * along
+        rates[b, 3 + i] += first * rows[c, TURN_B + 3 + i] + second * rows[c, TURN_B + 6 + i]
+        rates[a, i] -= rows[c, WEIGHT_A] * along
+        rates[a, 3 + i] -= first * rows[c, TURN_A + 3 + i] + second * rows[c, TURN_A + 6 + i]
 
 
 @njit(cache=True)
@@ -223,8 +287,8 @@ def solve_impulses(
     body_a, body_b, normal, friction, arm_a, arm_b, frame, mass_n, mass_t, target,
     inverse_mass, inverse_inertia, v, w, normal_impulse, tangent_impulse, iterations,
 ):  # fmt: skip
-    """Sequential impulses: ``iterations`` sweeps over the contacts in order, changing ``v``
-    and ``w`` in place (module docstring).
+    """Sequential impulses: ``iterations`` sweeps over the contacts, forward and backward in
+    turn, changing ``v`` and ``w`` in place (module docstring).
 
     ``normal_impulse`` ``(C,)`` [N·s] and ``tangent_impulse`` ``(C, 2)`` [N·s] hold each
     contact's accumulated impulse; whatever they hold on entry (a warm start) is applied
@@ -232,80 +296,39 @@ def solve_impulses(
     """
     count = body_a.shape[0]
     bodies = v.shape[0]
-    axes, lever, turn, index = levers(body_a, body_b, normal, frame, arm_a, arm_b,
-                                       inverse_inertia, bodies, 3)  # fmt: skip
-    vel, spin, weight = with_world(v, w, inverse_mass)
+    rows, index = contact_rows(body_a, body_b, normal, frame, arm_a, arm_b, inverse_mass,
+                               inverse_inertia, bodies, 3)  # fmt: skip
+    rates = rates_with_world(v, w)
     for c in range(count):
-        lever_impulse(c, 0, normal_impulse[c], axes, lever, turn, index, weight, vel, spin)
-        lever_impulse(c, 1, tangent_impulse[c, 0], axes, lever, turn, index, weight, vel, spin)
-        lever_impulse(c, 2, tangent_impulse[c, 1], axes, lever, turn, index, weight, vel, spin)
-    for _ in range(iterations):
-        for c in range(count):
-            _contact_step(c, friction, mass_n, mass_t, target, normal_impulse, tangent_impulse,
-                          axes, lever, turn, index, weight, vel, spin)  # fmt: skip
-    v[:] = vel[:bodies]
-    w[:] = spin[:bodies]
-
-
-@njit(cache=True, inline="always")
-def _contact_step(c, friction, mass_n, mass_t, target, normal_impulse, tangent_impulse,
-                  axes, lever, turn, index, weight, vel, spin):  # fmt: skip
-    """One contact's friction and normal impulses in a sweep."""
-    # Friction first, bounded by the normal impulse of the last sweep (Catto 2005).
-    limit = friction[c] * normal_impulse[c]
-    old0 = tangent_impulse[c, 0]
-    old1 = tangent_impulse[c, 1]
-    new0 = old0 - mass_t[c, 0] * lever_speed(c, 1, axes, lever, index, vel, spin)
-    new1 = old1 - mass_t[c, 1] * lever_speed(c, 2, axes, lever, index, vel, spin)
-    size = math.sqrt(new0 * new0 + new1 * new1)
-    if size > limit:
-        scale = limit / size if size > 0.0 else 0.0
-        new0 *= scale
-        new1 *= scale
-    tangent_impulse[c, 0] = new0
-    tangent_impulse[c, 1] = new1
-    lever_impulse(c, 1, new0 - old0, axes, lever, turn, index, weight, vel, spin)
-    lever_impulse(c, 2, new1 - old1, axes, lever, turn, index, weight, vel, spin)
-    # The normal impulse toward the target, accumulated and kept ≥ 0.
-    v_n = lever_speed(c, 0, axes, lever, index, vel, spin)
-    old = normal_impulse[c]
-    new = max(old + mass_n[c] * (target[c] - v_n), 0.0)
-    normal_impulse[c] = new
-    lever_impulse(c, 0, new - old, axes, lever, turn, index, weight, vel, spin)
-
-
-@njit(cache=True, inline="always")
-def lever_speed(c, k, axes, lever, index, vel, spin):
-    """Contact ``c``'s relative velocity along its direction ``k``, B's point from A's."""
-    a = index[c, 0]
-    b = index[c, 1]
-    return (
-        axes[c, k, 0] * (vel[b, 0] - vel[a, 0])
-        + axes[c, k, 1] * (vel[b, 1] - vel[a, 1])
-        + axes[c, k, 2] * (vel[b, 2] - vel[a, 2])
-        + lever[c, 1, k, 0] * spin[b, 0]
-        + lever[c, 1, k, 1] * spin[b, 1]
-        + lever[c, 1, k, 2] * spin[b, 2]
-        - lever[c, 0, k, 0] * spin[a, 0]
-        - lever[c, 0, k, 1] * spin[a, 1]
-        - lever[c, 0, k, 2] * spin[a, 2]
-    )
-
-
-@njit(cache=True, inline="always")
-def lever_impulse(c, k, size, axes, lever, turn, index, weight, vel, spin):
-    """An impulse of ``size`` along contact ``c``'s direction ``k`` on B, its opposite on A."""
-    a = index[c, 0]
-    b = index[c, 1]
-    world = vel.shape[0] - 1  # at rest and of infinite mass: never written
-    for i in range(3):
-        d = size * axes[c, k, i]
-        if b != world:
-            vel[b, i] += weight[b] * d
-            spin[b, i] += size * turn[c, 1, k, i]
-        if a != world:
-            vel[a, i] -= weight[a] * d
-            spin[a, i] -= size * turn[c, 0, k, i]
+        lever_impulse(rows, c, 0, normal_impulse[c], index, rates)
+        _friction_impulse(rows, c, tangent_impulse[c, 0], tangent_impulse[c, 1], index, rates)
+    for sweep in range(iterations):
+        for step in range(count):
+            c = step if sweep % 2 == 0 else count - 1 - step
+            # Friction first, bounded by the normal impulse of the last sweep (Catto 2005);
+            # none while the contact does not push and had none (a gap: idle).
+            limit = friction[c] * normal_impulse[c]
+            old0 = tangent_impulse[c, 0]
+            old1 = tangent_impulse[c, 1]
+            if limit > 0.0 or old0 != 0.0 or old1 != 0.0:
+                new0 = old0 - mass_t[c, 0] * lever_speed(rows, c, 1, index, rates)
+                new1 = old1 - mass_t[c, 1] * lever_speed(rows, c, 2, index, rates)
+                size = math.sqrt(new0 * new0 + new1 * new1)
+                if size > limit:
+                    scale = limit / size if size > 0.0 else 0.0
+                    new0 *= scale
+                    new1 *= scale
+                tangent_impulse[c, 0] = new0
+                tangent_impulse[c, 1] = new1
+                _friction_impulse(rows, c, new0 - old0, new1 - old1, index, rates)
+            # The normal impulse toward the target, accumulated and kept ≥ 0.
+            v_n = lever_speed(rows, c, 0, index, rates)
+            old = normal_impulse[c]
+            new = max(old + mass_n[c] * (target[c] - v_n), 0.0)
+            normal_impulse[c] = new
+            lever_impulse(rows, c, 0, new - old, index, rates)
+    v[:] = rates[:bodies, :3]
+    w[:] = rates[:bodies, 3:6]
 
 
 @njit(cache=True)
@@ -321,22 +344,14 @@ def correct_positions(
     vector [rad] (world frame), added to what they hold.
     """
     bodies = shift.shape[0]
-    axes, lever, turn_of, index = levers(body_a, body_b, normal, normal, arm_a, arm_b,
-                                          inverse_inertia, bodies, 1)  # fmt: skip
-    moved, turned, weight = with_world(shift, turn, inverse_mass)
+    rows, index = contact_rows(body_a, body_b, normal, np.empty((0, 2, 3)), arm_a, arm_b,
+                               inverse_mass, inverse_inertia, bodies, 1)  # fmt: skip
+    moves = rates_with_world(shift, turn)
     for _ in range(iterations):
         for c in range(body_a.shape[0]):
-            _correction(c, depth, allowance, fraction, mass_n, axes, lever, turn_of, index,
-                        weight, moved, turned)  # fmt: skip
-    shift[:] = moved[:bodies]
-    turn[:] = turned[:bodies]
-
-
-@njit(cache=True, inline="always")
-def _correction(c, depth, allowance, fraction, mass_n, axes, lever, turn, index, weight,
-                moved, turned):  # fmt: skip
-    # The depth now: less how far the bodies' points moved apart along n so far.
-    excess = depth[c] - lever_speed(c, 0, axes, lever, index, moved, turned) - allowance[c]
-    if excess > 0.0:
-        lever_impulse(c, 0, fraction * excess * mass_n[c], axes, lever, turn, index, weight,
-                      moved, turned)  # fmt: skip
+            # The depth now: less how far the bodies' points moved apart along n so far.
+            excess = depth[c] - lever_speed(rows, c, 0, index, moves) - allowance[c]
+            if excess > 0.0:
+                lever_impulse(rows, c, 0, fraction * excess * mass_n[c], index, moves)
+    shift[:] = moves[:bodies, :3]
+    turn[:] = moves[:bodies, 3:6]

@@ -34,7 +34,9 @@ import numpy as np
 
 from .._validation import real_number
 from ..errors import ModelError
-from .manifold import CANDIDATES, contact_manifold, plane_manifold
+from .box_box import clip_work
+from .manifold import CANDIDATES, plane_manifold
+from .narrow_phase import convex_contacts
 from .separation import plane_separation, shape_distance
 from .shapes import Plane
 from .solids import ConvexShape, posed_shape
@@ -137,11 +139,11 @@ def contacts(
     """
     limit = real_number("max_separation", max_separation, nonnegative=True, unit=" m")
     first, second, is_plane = _pair(a, b)
-    separation = _separation(first, second, is_plane)
     points = np.empty((CANDIDATES, 3))
     depths = np.empty(CANDIDATES)
     if is_plane:
+        separation = _separation(first, second, is_plane)
         count, nx, ny, nz = plane_manifold(separation, second, limit, points, depths)
     else:
-        count, nx, ny, nz = contact_manifold(first, second, separation, limit, points, depths)
+        count, nx, ny, nz = convex_contacts(first, second, limit, points, depths, clip_work())
     return ContactPatch(np.array([nx, ny, nz]), points[:count].copy(), depths[:count].copy())

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .body_impulses import lever_impulse, lever_speed, levers, with_world
+from .body_impulses import contact_rows, lever_impulse, lever_speed, rates_with_world
 
 __all__ = ["MAX_ROUNDS", "reflect_impacts"]
 
@@ -43,26 +43,27 @@ PROJECTION_SWEEPS = 500
 
 
 @njit(cache=True)
-def _project(active, axes, lever, turn, index, mass_n, weight, vel, spin, impulse):
+def _project(active, rows, index, mass_n, rates, impulse):
     """The inelastic impulses ``impulse`` ``(C,)`` (≥ 0, zero off ``active``) that stop the
-    approach of the active contacts, by projected Gauss–Seidel to convergence, applied to
-    ``vel`` and ``spin``. Returns the largest approach speed left."""
+    approach of the active contacts, by projected Gauss–Seidel to convergence, applied to the
+    ``rates`` (:func:`~visviva.collision.body_impulses.rates_with_world`). Returns the largest
+    approach speed left."""
     impulse[:] = 0.0
     scale = 0.0
     for c in range(active.shape[0]):
         if active[c]:
-            scale = max(scale, abs(lever_speed(c, 0, axes, lever, index, vel, spin)))
+            scale = max(scale, abs(lever_speed(rows, c, 0, index, rates)))
     for _ in range(PROJECTION_SWEEPS):
         largest = 0.0
         for c in range(active.shape[0]):
             if not active[c]:
                 continue
-            speed = lever_speed(c, 0, axes, lever, index, vel, spin)
+            speed = lever_speed(rows, c, 0, index, rates)
             new = max(impulse[c] - mass_n[c] * speed, 0.0)
             change = new - impulse[c]
             if change != 0.0:
                 impulse[c] = new
-                lever_impulse(c, 0, change, axes, lever, turn, index, weight, vel, spin)
+                lever_impulse(rows, c, 0, change, index, rates)
             # Converged: a pushing contact stops approaching, an idle one does not approach.
             largest = max(largest, abs(speed) if new > 0.0 else -speed)
         if largest <= 1e-13 * scale:
@@ -70,7 +71,7 @@ def _project(active, axes, lever, turn, index, mass_n, weight, vel, spin, impuls
     left = 0.0
     for c in range(active.shape[0]):
         if active[c]:
-            left = max(left, -lever_speed(c, 0, axes, lever, index, vel, spin))
+            left = max(left, -lever_speed(rows, c, 0, index, rates))
     return left
 
 
@@ -91,9 +92,9 @@ def reflect_impacts(
     """
     count = body_a.shape[0]
     bodies = v.shape[0]
-    axes, lever, turn, index = levers(body_a, body_b, normal, normal, arm_a, arm_b,
-                                      inverse_inertia, bodies, 1)  # fmt: skip
-    vel, spin, weight = with_world(v, w, inverse_mass)
+    rows, index = contact_rows(body_a, body_b, normal, np.empty((0, 2, 3)), arm_a, arm_b,
+                               inverse_mass, inverse_inertia, bodies, 1)  # fmt: skip
+    rates = rates_with_world(v, w)
     total = np.zeros(count)
     impulse = np.zeros(count)
     active = np.zeros(count, dtype=np.bool_)
@@ -105,7 +106,7 @@ def reflect_impacts(
         approach = 0.0
         any_active = False
         for c in range(count):
-            speed = lever_speed(c, 0, axes, lever, index, vel, spin)
+            speed = lever_speed(rows, c, 0, index, rates)
             active[c] = speed < -threshold and -speed * reach >= gap[c]
             if active[c]:
                 any_active = True
@@ -120,7 +121,7 @@ def reflect_impacts(
             # The failure case of Vouga et al.: end the impact inelastically, every contact.
             for c in range(count):
                 active[c] = gap[c] <= 0.0
-            _project(active, axes, lever, turn, index, mass_n, weight, vel, spin, impulse)
+            _project(active, rows, index, mass_n, rates, impulse)
             for c in range(count):
                 total[c] += impulse[c]
             ended = True
@@ -128,13 +129,13 @@ def reflect_impacts(
         previous[:] = active
         previous_speed = approach
         # The inelastic projection, then as much again times e: a reflection.
-        _project(active, axes, lever, turn, index, mass_n, weight, vel, spin, impulse)
+        _project(active, rows, index, mass_n, rates, impulse)
         for c in range(count):
             if impulse[c] > 0.0:
                 extra = restitution[c] * impulse[c]
-                lever_impulse(c, 0, extra, axes, lever, turn, index, weight, vel, spin)
+                lever_impulse(rows, c, 0, extra, index, rates)
                 total[c] += impulse[c] + extra
         rounds += 1
-    v[:] = vel[:bodies]
-    w[:] = spin[:bodies]
+    v[:] = rates[:bodies, :3]
+    w[:] = rates[:bodies, 3:6]
     return total, rounds, ended

@@ -80,6 +80,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 
 from ..collision.colliders import ColliderSet
+from ..errors import ModelError, SimulationError
 from ..geometry.neighbour_grid import PARALLEL_MIN_POINTS, NeighbourGrid
 from ..ode.stage import Phase
 from .crowd_kernels import exit_agents, social_forces, walk
@@ -230,7 +231,11 @@ class Crowd:
             self.agents, alive, x, v, self.crowd, self.exits, self.exit_start, exit_time, after.t
         )
         scratch = work.get(self, self._scratch)
-        self._evaluate(scratch, x, v, alive, height, h)
+        try:
+            self._evaluate(scratch, x, v, alive, height, h)
+        except ModelError as error:  # an agent beyond the grid's reach of the origin
+            names = ", ".join(g.name for g in self.groups)
+            raise SimulationError(f"crowd {names}: {error}", t=after.t, step=None) from None
         walk(
             self.agents, alive, x, v, height, self.mass, scratch.drive, scratch.social,
             scratch.wall, self.max_speed, self.crowd, h,
