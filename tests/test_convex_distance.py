@@ -29,6 +29,8 @@ from visviva.collision import (
     Sphere,
     distance,
 )
+from visviva.collision.convex import BOX, CONE
+from visviva.collision.separation import shape_distance
 from visviva.errors import ModelError
 
 
@@ -280,3 +282,29 @@ def test_any_pose_and_scale_gives_a_finite_answer(centre, q, size_a, size_b, kin
     assert np.linalg.norm(result.normal) == pytest.approx(1.0, abs=1e-9)
     patch = vv.collision.contacts(a, b)
     assert np.isfinite(patch.points).all() and len(patch.points) <= 4
+
+
+def test_epa_keeps_its_last_good_face_when_rounding_breaks_the_polytope():
+    # A box pressed 1.3 mm into a cone's side, posed as a pile of mixed shapes had them (to
+    # the bit: the breakage is rounding's): the polytope's new points fell almost in its
+    # faces' planes, the nearest face came nearer than the one before — impossible for a
+    # convex polytope growing outward — and EPA used to end with an infinite depth and no
+    # normal, which turned a body of the pile into NaNs.
+    no_hull = (np.zeros((0, 3)), np.zeros((0, 4)), np.zeros(0, np.int64), np.zeros(0, np.int64))
+    box = (BOX, np.array([0.0, 0.08, 0.06, 0.05]), *no_hull,
+           np.array([-1.7442973943380524, 0.27096553281986624, 0.9989881457086917]),
+           np.array([[0.9343503268410063, 0.05461043222271722, -0.352146514145111],
+                     [-0.2940744520580116, 0.6762908972859467, -0.6753893979734578],
+                     [0.20127017508534417, 0.734607597932813, 0.6479521538512684]]))  # fmt: skip
+    cone = (CONE, np.array([0.0, 0.08, 0.14, 0.0]), *no_hull,
+            np.array([-1.7487637440747368, 0.3139585631014506, 0.8516152314195027]),
+            np.array([[0.8345091250678202, -0.5172639823480564, -0.1898222661964897],
+                      [0.31832975338027725, 0.7338084815233135, -0.6001593792962839],
+                      [0.4497340194952938, 0.440412403333374, 0.7770303898167228]]))  # fmt: skip
+    depth, nx, ny, nz, ax, ay, az, bx, by, bz = shape_distance(box, cone)
+    # The same pair posed through the public shapes (other roundings) converges to 1.2789 mm;
+    # the last good face here is within 2 µm of it.
+    assert depth == pytest.approx(-1.2789e-3, abs=2e-6)
+    normal = np.array([nx, ny, nz])
+    assert np.linalg.norm(normal) == pytest.approx(1.0, abs=1e-12)
+    assert np.array([bx - ax, by - ay, bz - az]) == pytest.approx(depth * normal, abs=1e-9)

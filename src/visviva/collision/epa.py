@@ -192,16 +192,20 @@ def penetration(shape_a, shape_b, simplex, simplex_a, simplex_b, count):
         alive[f] = True
     edges = np.empty((3 * MAX_FACES, 2), dtype=np.int64)
     tolerance = RELATIVE_TOLERANCE * scale
-    best = 0
+    # The answer so far: the nearest face's corners, normal and distance. A nearest face
+    # never comes nearer as the polytope grows; one that does is rounding having broken the
+    # polytope (a new point almost in a face's plane), and the last good face is the answer.
+    chosen = np.empty(3, dtype=np.int64)
+    chosen_normal = np.empty(4)
+    found = False
     for _ in range(MAX_VERTICES):
-        best = -1
-        best_distance = math.inf
-        for f in range(face_count):
-            if alive[f] and normals[f, 3] < best_distance:
-                best_distance = normals[f, 3]
-                best = f
-        if best < 0:
-            return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        best = _nearest_face(alive, normals, face_count)
+        if best < 0 or (found and normals[best, 3] < chosen_normal[3] - tolerance):
+            break
+        chosen[:] = faces[best]
+        chosen_normal[:] = normals[best]
+        found = True
+        best_distance = normals[best, 3]
         fx, fy, fz = normals[best, 0], normals[best, 1], normals[best, 2]
         if n == MAX_VERTICES:
             break
@@ -249,10 +253,12 @@ def penetration(shape_a, shape_b, simplex, simplex_a, simplex_b, count):
             _set_face(points, faces, normals, face_count, edges[k, 0], edges[k, 1], new)
             alive[face_count] = True
             face_count += 1
-    depth = normals[best, 3]
-    fx, fy, fz = normals[best, 0], normals[best, 1], normals[best, 2]
+    if not found:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    depth = chosen_normal[3]
+    fx, fy, fz = chosen_normal[0], chosen_normal[1], chosen_normal[2]
     # The origin's projection on the face, in barycentric weights, gives the deepest points.
-    i0, i1, i2 = faces[best, 0], faces[best, 1], faces[best, 2]
+    i0, i1, i2 = chosen[0], chosen[1], chosen[2]
     px, py, pz = depth * fx, depth * fy, depth * fz
     u, v, w = _barycentric(points, i0, i1, i2, px, py, pz)
     ax = u * points_a[i0, 0] + v * points_a[i1, 0] + w * points_a[i2, 0]
@@ -262,6 +268,18 @@ def penetration(shape_a, shape_b, simplex, simplex_a, simplex_b, count):
     by = u * points_b[i0, 1] + v * points_b[i1, 1] + w * points_b[i2, 1]
     bz = u * points_b[i0, 2] + v * points_b[i1, 2] + w * points_b[i2, 2]
     return True, max(depth, 0.0), fx, fy, fz, ax, ay, az, bx, by, bz
+
+
+@njit(cache=True)
+def _nearest_face(alive, normals, face_count):
+    """The live face nearest the origin (of finite distance: one with area), or -1."""
+    best = -1
+    best_distance = math.inf
+    for f in range(face_count):
+        if alive[f] and normals[f, 3] < best_distance:
+            best_distance = normals[f, 3]
+            best = f
+    return best
 
 
 @njit(cache=True)
