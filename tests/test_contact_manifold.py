@@ -17,6 +17,7 @@ from visviva.collision import (
     Plane,
     Sphere,
     contacts,
+    distance,
 )
 
 FLOOR = Plane(point=(0.0, 0.0, 0.0), normal=(0.0, 1.0, 0.0))
@@ -140,3 +141,19 @@ def test_speculative_contacts_report_a_gap():
     assert len(contacts(FLOOR, box).points) == 0
     near = contacts(FLOOR, box, max_separation=0.02)
     assert near.depths == pytest.approx([-0.01] * 4, abs=1e-12)
+
+
+def test_a_face_far_off_the_normal_is_not_taken_as_the_reference():
+    # A box's corner region 27 mm into a cylinder's side (from a pile of mixed shapes): the
+    # normal of least penetration is 44° from the box's nearest face. Clipping against that
+    # face used to give its normal and a 38 mm depth, which pushed the two along the wrong
+    # direction and kept them overlapped; the nearest points stand instead.
+    box = Box(center=(-0.3399, 0.176605, -0.353939), size=(0.16, 0.12, 0.1),
+              orientation=(-0.562011, -0.183699, -0.387919, 0.707048))  # fmt: skip
+    cylinder = Cylinder(center=(-0.293994, 0.251859, -0.439336), radius=0.07, height=0.12,
+                        orientation=(-0.167001, 0.748689, 0.407317, 0.49565))  # fmt: skip
+    least = distance(box, cylinder)
+    patch = contacts(box, cylinder)
+    assert least.distance == pytest.approx(-0.027257, abs=1e-6)
+    assert patch.normal == pytest.approx(least.normal, abs=1e-12)
+    assert patch.depths == pytest.approx([-least.distance], abs=1e-12)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from .body_pieces import piece_shape
 from .box_box import clip_work
@@ -75,12 +75,21 @@ def piece_poses(pieces, body, position, rotation, margin, piece_position, piece_
         shape_bounds(shape[0], shape[1], shape[2], shape[6], shape[7], grow, lo, hi, p)
 
 
-@njit(cache=True)
+#: Candidate pairs from which the narrow phase runs on every thread (below, one is faster).
+PARALLEL_MIN_PAIRS = 1024
+#: Pairs a thread takes at a time (each chunk allocates its own work arrays once).
+_CHUNK = 64
+
+
 def pair_contacts(pieces, body, pairs, piece_position, piece_rotation, margin, out):
-    """The contacts of each candidate pair of pieces, appended to ``out``.
+    """The contacts of each candidate pair of pieces, written to ``out`` in the pairs' order
+    (the same on any number of threads).
 
     Args:
+        pieces: :meth:`~visviva.collision.body_pieces.BodyPieces.arrays`.
+        body: ``(P,)`` each piece's body (``-1``: static).
         pairs: ``(K, 2)`` piece pairs from the broad phase.
+        piece_position, piece_rotation: ``(P, 3)``, ``(P, 3, 3)`` world poses.
         margin: ``(B,)`` speculative reach of each body [m]: a pair keeps contacts whose gap
             is at most the sum of its bodies'.
         out: ``(piece_a, piece_b, point (C, 3), normal (C, 3), depth (C,))`` of capacity
@@ -89,57 +98,107 @@ def pair_contacts(pieces, body, pairs, piece_position, piece_rotation, margin, o
     Returns:
         How many contacts were written.
     """
-    piece_a, piece_b, point, normal, depth = out
-    points = np.empty((CANDIDATES, 3))
-    depths = np.empty(CANDIDATES)
+    count = pairs.shape[0]
+    found = np.empty(count, dtype=np.int64)
+    points = np.empty((count, MAX_CONTACTS, 3))
+    normals = np.empty((count, 3))
+    depths = np.empty((count, MAX_CONTACTS))
+    run = _pairs_parallel if count >= PARALLEL_MIN_PAIRS else _pairs_serial
+    run(pieces, body, pairs, piece_position, piece_rotation, margin, found, points, normals,
+        depths)  # fmt: skip
+    return _gathered(pairs, found, points, normals, depths, out)
+
+
+# A serial and a parallel driver, separate functions so that each has its own entry in
+# Numba's cache.
+@njit(cache=True)
+def _pairs_serial(pieces, body, pairs, piece_position, piece_rotation, margin, found, points,
+                  normals, depths):  # fmt: skip
+    _pair_chunk(0, pairs.shape[0], pieces, body, pairs, piece_position, piece_rotation, margin,
+                found, points, normals, depths)  # fmt: skip
+
+
+@njit(cache=True, parallel=True)
+def _pairs_parallel(pieces, body, pairs, piece_position, piece_rotation, margin, found, points,
+                    normals, depths):  # fmt: skip
+    count = pairs.shape[0]
+    for chunk in prange((count + _CHUNK - 1) // _CHUNK):
+        first = chunk * _CHUNK
+        _pair_chunk(first, min(first + _CHUNK, count), pieces, body, pairs, piece_position,
+                    piece_rotation, margin, found, points, normals, depths)  # fmt: skip
+
+
+@njit(cache=True)
+def _pair_chunk(first, last, pieces, body, pairs, piece_position, piece_rotation, margin,
+                found, points, normals, depths):  # fmt: skip
+    """Pairs ``first`` to ``last − 1``: each one's contact count ``found[k]``, points, normal
+    and depths in its row of the outputs."""
+    candidates = np.empty((CANDIDATES, 3))
+    candidate_depths = np.empty(CANDIDATES)
     work = clip_work()
-    count = 0
-    for k in range(pairs.shape[0]):
+    params = pieces[1]
+    for k in range(first, last):
         i, j = pairs[k, 0], pairs[k, 1]
         a, b = body[i], body[j]
+        found[k] = 0
         if a == b:
             continue
         reach = (margin[a] if a >= 0 else 0.0) + (margin[b] if b >= 0 else 0.0)
         if pieces[0][i] == SPHERE and pieces[0][j] == SPHERE:
             # Two balls: along the line of centres, no iteration needed.
-            count = _ball_contact(i, j, pieces[1], piece_position, reach, out, count)
+            found[k] = _ball_contact(params[i, 0], params[j, 0], piece_position[i],
+                                     piece_position[j], reach, points[k], normals[k],
+                                     depths[k])  # fmt: skip
             continue
         shape_a = piece_shape(i, pieces, piece_position[i], piece_rotation[i])
         shape_b = piece_shape(j, pieces, piece_position[j], piece_rotation[j])
-        found, nx, ny, nz = convex_contacts(shape_a, shape_b, reach, points, depths, work)
-        for c in range(found):
-            piece_a[count], piece_b[count] = i, j
-            point[count] = points[c]
-            normal[count, 0], normal[count, 1], normal[count, 2] = nx, ny, nz
-            depth[count] = depths[c]
+        count, nx, ny, nz = convex_contacts(shape_a, shape_b, reach, candidates,
+                                            candidate_depths, work)  # fmt: skip
+        found[k] = count
+        normals[k, 0], normals[k, 1], normals[k, 2] = nx, ny, nz
+        for c in range(count):
+            points[k, c] = candidates[c]
+            depths[k, c] = candidate_depths[c]
+
+
+@njit(cache=True)
+def _gathered(pairs, found, points, normals, depths, out):
+    """The pairs' contacts, in order, into ``out``; returns how many."""
+    piece_a, piece_b, point, normal, depth = out
+    count = 0
+    for k in range(pairs.shape[0]):
+        for c in range(found[k]):
+            piece_a[count], piece_b[count] = pairs[k, 0], pairs[k, 1]
+            point[count] = points[k, c]
+            normal[count] = normals[k]
+            depth[count] = depths[k, c]
             count += 1
     return count
 
 
 @njit(cache=True)
-def _ball_contact(i, j, params, piece_position, reach, out, count):
-    """Append the contact of balls ``i`` and ``j`` if their gap is at most ``reach``."""
-    piece_a, piece_b, point, normal, depth = out
-    dx = piece_position[j, 0] - piece_position[i, 0]
-    dy = piece_position[j, 1] - piece_position[i, 1]
-    dz = piece_position[j, 2] - piece_position[i, 2]
+def _ball_contact(radius_a, radius_b, centre_a, centre_b, reach, points, normal, depths):
+    """The contact of two balls if their gap is at most ``reach`` (1, its point, normal
+    and depth in the outputs), else 0."""
+    dx = centre_b[0] - centre_a[0]
+    dy = centre_b[1] - centre_a[1]
+    dz = centre_b[2] - centre_a[2]
     distance = math.sqrt(dx * dx + dy * dy + dz * dz)
-    gap = distance - params[i, 0] - params[j, 0]
+    gap = distance - radius_a - radius_b
     if gap > reach:
-        return count
+        return 0
     if distance > 0.0:
         nx, ny, nz = dx / distance, dy / distance, dz / distance
     else:
         nx, ny, nz = 0.0, 1.0, 0.0
     # Midway between the two surfaces along the line of centres.
-    along = params[i, 0] + 0.5 * gap
-    piece_a[count], piece_b[count] = i, j
-    point[count, 0] = piece_position[i, 0] + along * nx
-    point[count, 1] = piece_position[i, 1] + along * ny
-    point[count, 2] = piece_position[i, 2] + along * nz
-    normal[count, 0], normal[count, 1], normal[count, 2] = nx, ny, nz
-    depth[count] = -gap
-    return count + 1
+    along = radius_a + 0.5 * gap
+    points[0, 0] = centre_a[0] + along * nx
+    points[0, 1] = centre_a[1] + along * ny
+    points[0, 2] = centre_a[2] + along * nz
+    normal[0], normal[1], normal[2] = nx, ny, nz
+    depths[0] = -gap
+    return 1
 
 
 @njit(cache=True)

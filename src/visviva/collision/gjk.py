@@ -197,13 +197,15 @@ def _closest_on_simplex(w, count, lam):
 def core_distance(
     kind_a, params_a, vertices_a, position_a, rotation_a,
     kind_b, params_b, vertices_b, position_b, rotation_b,
-    simplex, simplex_a, simplex_b,
+    simplex, simplex_a, simplex_b, limit=math.inf, tolerance=RELATIVE_TOLERANCE,
 ):  # fmt: skip
     """GJK on two posed cores (see :mod:`~visviva.collision.convex` for the arguments).
 
     ``simplex``, ``simplex_a`` and ``simplex_b`` are ``(4, 3)`` work arrays; on return their
     first ``count`` rows hold the final simplex of ``D = A − B`` and the support points of
-    ``A`` and ``B`` that made it (EPA starts from them).
+    ``A`` and ``B`` that made it (EPA starts from them). ``tolerance`` is the stopping test's
+    relative tolerance; once the cores are surely farther apart than ``limit`` [m] (a support
+    plane of ``D`` lies beyond it) the search stops with that lower bound as the distance.
 
     Returns:
         ``(status, distance, count, ax, ay, az, bx, by, bz)``: :data:`SEPARATED` with the
@@ -227,7 +229,12 @@ def core_distance(
         wx, wy, wz = pax - pbx, pay - pby, paz - pbz
         scale = max(scale, wx * wx + wy * wy + wz * wz)
         vv = vx * vx + vy * vy + vz * vz
-        if count > 0 and vv - (vx * wx + vy * wy + vz * wz) <= RELATIVE_TOLERANCE * vv:
+        vw = vx * wx + vy * wy + vz * wz
+        if vw > 0.0 and vw * vw > limit * limit * vv:
+            # Every point of D lies beyond the plane v·x = v·w: the cores are farther apart
+            # than v·w/|v| > limit.
+            return SEPARATED, vw / math.sqrt(vv), count, pax, pay, paz, pbx, pby, pbz
+        if count > 0 and vv - vw <= tolerance * vv:
             break
         repeated = False
         for i in range(count):

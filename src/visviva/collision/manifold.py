@@ -31,6 +31,10 @@ __all__ = ["CANDIDATES", "MAX_CONTACTS", "contact_manifold", "plane_manifold"]
 MAX_CONTACTS = 4
 #: Edges whose directions' cosine exceeds this are parallel (the manifold keeps two points).
 PARALLEL = 0.995
+#: A face is a reference only if its normal is this near the contact normal (cosine, about
+#: 11°): a box's nearest face 45° off a normal that comes from one of its edges would push
+#: along the wrong direction and measure the wrong depth; the nearest points stand then.
+ALIGNED = 0.98
 #: Rows of the work arrays a manifold is built in: every clipped point before the reduction.
 CANDIDATES = 2 * MAX_FACE_POINTS + 8
 
@@ -179,14 +183,14 @@ def contact_manifold(shape_a, shape_b, separation, max_separation, points, depth
     face_b = np.empty((MAX_FACE_POINTS, 3))
     count_a = _world_face(shape_a, nx, ny, nz, shape_a[1][0], face_a)
     count_b = _world_face(shape_b, -nx, -ny, -nz, shape_b[1][0], face_b)
-    if count_a >= 3 or count_b >= 3:
-        ra = rb = -1.0
-        if count_a >= 3:
-            rx, ry, rz = _polygon_normal(face_a, count_a)
-            ra = rx * nx + ry * ny + rz * nz
-        if count_b >= 3:
-            rx, ry, rz = _polygon_normal(face_b, count_b)
-            rb = -(rx * nx + ry * ny + rz * nz)
+    ra = rb = -1.0
+    if count_a >= 3:
+        rx, ry, rz = _polygon_normal(face_a, count_a)
+        ra = rx * nx + ry * ny + rz * nz
+    if count_b >= 3:
+        rx, ry, rz = _polygon_normal(face_b, count_b)
+        rb = -(rx * nx + ry * ny + rz * nz)
+    if max(ra, rb) >= ALIGNED:
         if ra >= rb:
             reference, reference_count, incident, incident_count = face_a, count_a, face_b, count_b
             sign = 1.0

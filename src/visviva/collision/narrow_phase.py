@@ -17,7 +17,12 @@ from .convex import BOX
 from .manifold import contact_manifold
 from .separation import shape_distance
 
-__all__ = ["convex_contacts"]
+__all__ = ["GJK_TOLERANCE", "convex_contacts"]
+
+#: GJK's relative tolerance for contacts: a gap exact to this fraction of itself (a nanometre
+#: on a millimetre's gap; the distance queries take 1e-13). On round cores GJK converges
+#: linearly, and the last digits cost most of its iterations.
+GJK_TOLERANCE = 1e-6
 
 
 @njit(cache=True)
@@ -34,5 +39,5 @@ def convex_contacts(shape_a, shape_b, max_separation, points, depths, work):
                                              depths, work)  # fmt: skip
         if count >= 0:
             return count, nx, ny, nz
-    separation = shape_distance(shape_a, shape_b)
+    separation = shape_distance(shape_a, shape_b, max_separation, GJK_TOLERANCE)
     return contact_manifold(shape_a, shape_b, separation, max_separation, points, depths)

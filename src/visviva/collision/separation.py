@@ -18,7 +18,7 @@ from numba import njit
 
 from .convex import world_support
 from .epa import penetration
-from .gjk import SEPARATED, core_distance
+from .gjk import RELATIVE_TOLERANCE, SEPARATED, core_distance
 
 __all__ = ["plane_separation", "shape_distance"]
 
@@ -37,19 +37,26 @@ def _fallback_normal(shape_a, shape_b):
 
 
 @njit(cache=True)
-def shape_distance(shape_a, shape_b):
+def shape_distance(shape_a, shape_b, limit=math.inf, tolerance=RELATIVE_TOLERANCE):
     """``(distance, nx, ny, nz, ax, ay, az, bx, by, bz)`` of two posed convex shapes (module
-    docstring for the convention), lengths in metres, world frame."""
+    docstring for the convention), lengths in metres, world frame. Shapes surely farther
+    apart than ``limit`` [m] get a lower bound of their distance (above ``limit``) and
+    points and normal of no meaning; ``tolerance`` is GJK's
+    (:func:`~visviva.collision.gjk.core_distance`)."""
     kind_a, params_a, vertices_a, _, _, _, position_a, rotation_a = shape_a
     kind_b, params_b, vertices_b, _, _, _, position_b, rotation_b = shape_b
+    margin_a = params_a[0]
+    margin_b = params_b[0]
     simplex = np.empty((4, 3))
     simplex_a = np.empty((4, 3))
     simplex_b = np.empty((4, 3))
     status, core, count, ax, ay, az, bx, by, bz = core_distance(
         kind_a, params_a, vertices_a, position_a, rotation_a,
         kind_b, params_b, vertices_b, position_b, rotation_b,
-        simplex, simplex_a, simplex_b,
+        simplex, simplex_a, simplex_b, limit + margin_a + margin_b, tolerance,
     )  # fmt: skip
+    if status == SEPARATED and core - margin_a - margin_b > limit:
+        return core - margin_a - margin_b, 0.0, 0.0, 0.0, ax, ay, az, bx, by, bz
     if status == SEPARATED and core > 0.0:
         nx, ny, nz = (bx - ax) / core, (by - ay) / core, (bz - az) / core
     else:
@@ -63,8 +70,6 @@ def shape_distance(shape_a, shape_b):
                 # The flat difference's own point nearest the origin: the cores cross at it.
                 ax, ay, az = simplex_a[0, 0], simplex_a[0, 1], simplex_a[0, 2]
                 bx, by, bz = ax, ay, az
-    margin_a = params_a[0]
-    margin_b = params_b[0]
     return (
         core - margin_a - margin_b,
         nx, ny, nz,

@@ -147,6 +147,11 @@ BUILTIN_DEMOS: dict[str, BuiltinDemo] = {
         "rotation_drift",
         "rotation matrices and quaternions under explicit Euler, renormalized or not",
     ),
+    "pile": BuiltinDemo(
+        "pile",
+        "10,000 spheres, boxes, capsules, cylinders, cones and rocks fall into a bin and come "
+        "to rest: the whole contact pipeline at scale",
+    ),
     "snow": BuiltinDemo(
         "snow",
         "snowflakes in wind and a gust settle on a ball and the ground (drag, vortex, friction)",
