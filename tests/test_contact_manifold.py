@@ -19,6 +19,8 @@ from visviva.collision import (
     contacts,
     distance,
 )
+from visviva.collision.manifold import CANDIDATES, contact_manifold
+from visviva.collision.solids import posed_shape
 
 FLOOR = Plane(point=(0.0, 0.0, 0.0), normal=(0.0, 1.0, 0.0))
 
@@ -157,3 +159,22 @@ def test_a_face_far_off_the_normal_is_not_taken_as_the_reference():
     assert least.distance == pytest.approx(-0.027257, abs=1e-6)
     assert patch.normal == pytest.approx(least.normal, abs=1e-12)
     assert patch.depths == pytest.approx([-least.distance], abs=1e-12)
+
+
+def test_the_patch_is_never_shallower_than_the_shapes_depth():
+    # In a pile of rocks (hulls) one's corner sat 4 mm inside another just beside the face
+    # the manifold clipped against: clipping dropped it and left a point 1 µm apart, and the
+    # solver held two overlapping rocks as if they barely touched. The contract: when the
+    # clipped points are shallower than the separation's depth, its nearest points' pair
+    # joins the patch. Here two boxes overlap by 1 mm face to face and the separation handed
+    # to the manifold says 5 mm at a point: the patch keeps that point and depth.
+    a = posed_shape(Box(center=(0.0, -0.5, 0.0), size=(1.0, 1.0, 1.0)))
+    b = posed_shape(Box(center=(0.0, 0.499, 0.0), size=(1.0, 1.0, 1.0)))
+    separation = (-0.005, 0.0, 1.0, 0.0, 0.1, 0.0, 0.1, 0.1, -0.005, 0.1)
+    points = np.empty((CANDIDATES, 3))
+    depths = np.empty(CANDIDATES)
+    count, *normal = contact_manifold(a, b, separation, 0.0, points, depths)
+    assert normal == pytest.approx([0.0, 1.0, 0.0])
+    assert depths[:count].max() == pytest.approx(0.005, abs=1e-15)
+    assert points[int(np.argmax(depths[:count]))] == pytest.approx([0.1, -0.0025, 0.1])
+    assert np.sort(depths[:count])[:-1] == pytest.approx([0.001] * (count - 1), abs=1e-12)

@@ -30,7 +30,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .manifold import MAX_CONTACTS
+from .manifold import LOST_DEPTH, MAX_CONTACTS
 
 __all__ = ["CLIP_POINTS", "box_box_contacts", "clip_work"]
 
@@ -83,9 +83,8 @@ def box_box_contacts(pa, ra, ea, pb, rb, eb, max_separation, points, depths, wor
     Returns:
         ``(count, nx, ny, nz)``: how many contacts and their unit normal from A toward B;
         ``count`` is ``-1`` when the chosen feature gives no point within ``max_separation``
-        though every axis does, or when the boxes are apart and their nearest features were
-        clipped away (a corner passing beside a face): the caller then asks GJK for the
-        nearest points.
+        though every axis does, or when the boxes' nearest (deepest) features were clipped
+        away (a corner beside a face): the caller then asks GJK and EPA.
     """
     scale = TIE * min(ea[0], ea[1], ea[2], eb[0], eb[1], eb[2])
     # Faces of A, then faces of B: the deepest (largest gap) of each.
@@ -135,14 +134,15 @@ def box_box_contacts(pa, ra, ea, pb, rb, eb, max_separation, points, depths, wor
         count, nx, ny, nz = _face_contacts(pb, rb, eb, face_axis, -face_sign, pa, ra, ea,
                                            max_separation, points, depths, work)  # fmt: skip
         nx, ny, nz = -nx, -ny, -nz
-    if best > 0.0 and count > 0:
-        # Apart: the axis's gap is that of the two nearest features along it. If they were
-        # clipped away (a corner beside the face), the points' gaps exceed the distance:
-        # let GJK find the nearest points instead.
+    if count > 0:
+        # The axis's gap is that of the two nearest (deepest) features along it. If they were
+        # clipped away (a corner beside the face), the points are farther apart (shallower)
+        # than the boxes: let GJK and EPA find the nearest points instead.
         nearest = math.inf
         for i in range(count):
             nearest = min(nearest, -depths[i])
-        if nearest > best + 1e-9 * scale / TIE:
+        lost = 1e-9 * scale / TIE if best > 0.0 else -LOST_DEPTH * best
+        if nearest > best + lost:
             return -1, nx, ny, nz
     return count, nx, ny, nz
 

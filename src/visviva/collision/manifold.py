@@ -35,6 +35,9 @@ PARALLEL = 0.995
 #: 11°): a box's nearest face 45° off a normal that comes from one of its edges would push
 #: along the wrong direction and measure the wrong depth; the nearest points stand then.
 ALIGNED = 0.98
+#: A clipped patch whose deepest point is shallower than the shapes' depth by more than this
+#: fraction of it has lost its deepest point (see :func:`contact_manifold`).
+LOST_DEPTH = 0.1
 #: Rows of the work arrays a manifold is built in: every clipped point before the reduction.
 CANDIDATES = 2 * MAX_FACE_POINTS + 8
 
@@ -202,7 +205,18 @@ def contact_manifold(shape_a, shape_b, separation, max_separation, points, depth
             count = _clip_to_face(reference, reference_count, rx, ry, rz, incident,
                                   incident_count, max_separation, points, depths)  # fmt: skip
             if count > 0:
-                return _reduce(points, depths, count), sign * rx, sign * ry, sign * rz
+                nx, ny, nz = sign * rx, sign * ry, sign * rz
+                # The deepest point may lie beside the reference face and be clipped away (a
+                # corner of one rock in another, off its face's edge): the nearest points'
+                # pair is then a contact too, with its depth along this normal.
+                deepest = depths[:count].max()
+                if deepest < -distance - LOST_DEPTH * abs(distance) and count < CANDIDATES:
+                    points[count, 0] = 0.5 * (ax + bx)
+                    points[count, 1] = 0.5 * (ay + by)
+                    points[count, 2] = 0.5 * (az + bz)
+                    depths[count] = (ax - bx) * nx + (ay - by) * ny + (az - bz) * nz
+                    count += 1
+                return _reduce(points, depths, count), nx, ny, nz
     elif count_a == 2 and count_b == 2:
         count = _parallel_edges(face_a, face_b, nx, ny, nz, points, depths)
         if count > 0:
