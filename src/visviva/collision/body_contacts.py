@@ -58,7 +58,7 @@ if TYPE_CHECKING:
     from ..ode.state import State
     from ..ode.workspace import Workspace
 
-__all__ = ["BodyContactSet", "BodyContacts", "Moving", "ParticleMembers", "Planes"]
+__all__ = ["BodyContactSet", "BodyContacts", "Moving", "ParticleMembers", "Planes", "bodies_of"]
 
 #: A body's speculative reach beyond its travel in a step, as a fraction of its pieces' size.
 SPECULATIVE = 0.02
@@ -312,7 +312,7 @@ class BodyContacts:
                                         momentum, spin)  # fmt: skip
         found, _, _ = self.detect(movers, x, rotation, np.full(self.count, 0.5 * gap))
         piece_a, piece_b, point, normal, depth = found
-        body_a, body_b = _bodies_of(movers, piece_a, piece_b)
+        body_a, body_b = bodies_of(movers, piece_a, piece_b)
         arm_a = np.where((body_a >= 0)[:, None], point - x[body_a], 0.0)
         arm_b = point - x[body_b]
         velocity = normal_velocities(body_a, body_b, normal, arm_a, arm_b, v, w)
@@ -383,8 +383,8 @@ class BodyContacts:
         # is what a sweep needs to carry the weight down in few iterations.
         order = np.argsort(found[2] @ self.up, kind="stable")
         piece_a, piece_b, point, normal, depth = (a[order] for a in found)
-        body_a, body_b = _bodies_of(movers, piece_a, piece_b)
-        restitution, friction = self._coefficients(pieces, piece_a, piece_b)
+        body_a, body_b = bodies_of(movers, piece_a, piece_b)
+        restitution, friction = self.coefficients(pieces, piece_a, piece_b)
         key = (piece_a + self.scenery_restitution.shape[0]) * (pieces.count + 1) + piece_b
         anchor = np.einsum("cji,cj->ci", turn[piece_b], point - position[piece_b])
         warm_normal, warm_friction = _warm_start(key, anchor, MATCH * pieces.radius[piece_b],
@@ -434,7 +434,7 @@ class BodyContacts:
                          pieces.local_position, pieces.local_rotation, movers.reach,
                          pieces.radius, x0, q0, x, q)  # fmt: skip
 
-    def _coefficients(self, pieces: BodyPieces, piece_a: np.ndarray,
+    def coefficients(self, pieces: BodyPieces, piece_a: np.ndarray,
                       piece_b: np.ndarray) -> tuple[np.ndarray, ...]:  # fmt: skip
         """Each contact's restitution and friction (the pair rule, or the stage's value)."""
         scenery = -1 - np.minimum(piece_a, -1)
@@ -478,7 +478,7 @@ class ParticleMembers:
     friction: float
 
 
-def _bodies_of(movers: Movers, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple:
+def bodies_of(movers: Movers, piece_a: np.ndarray, piece_b: np.ndarray) -> tuple:
     """The movers of the contacts' pieces (-1: a plane or the scenery)."""
     body = movers.pieces.body
     return np.where(piece_a >= 0, body[np.maximum(piece_a, 0)], -1), body[piece_b]

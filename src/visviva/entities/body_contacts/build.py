@@ -23,6 +23,7 @@ from scipy.spatial import ConvexHull as Qhull
 from ..._registry import did_you_mean
 from ...collision import Box, Capsule, Cone, ConvexHull, Cylinder, Ellipsoid, Plane, Sphere
 from ...collision.body_contacts import BodyContacts, ParticleMembers, Planes
+from ...collision.body_penalty import BodyPenalty
 from ...collision.body_pieces import BodyPieces
 from ...collision.decomposition import convex_decomposition
 from ...errors import ModelError, SceneProblem
@@ -53,6 +54,19 @@ def _check(entity: BodyContactSettings, where: str, scene: Any) -> list[ScenePro
         if name not in bodies
     ]
     problems += check_names(entity.particles, where, scene, field="particles")
+    if entity.response == "penalty":
+        if entity.stiffness is None:
+            problems.append(SceneProblem(
+                f"{where}.stiffness",
+                'response = "penalty" needs `stiffness`, k per contact point [N/m]: a body '
+                "of mass m sinks m g / k on one point and rings at √(k/m) rad/s",
+            ))  # fmt: skip
+        if entity.particles is not None:
+            problems.append(SceneProblem(
+                f"{where}.particles",
+                'particles meet bodies by impulses only: drop `particles` or use response = '
+                '"impulses"',
+            ))  # fmt: skip
     first = next(i for i, e in enumerate(scene.entities) if e.type == "body_contacts")
     if f"entities[{first}]" != where:
         problems.append(
@@ -120,7 +134,14 @@ def _finish(entries: Sequence[tuple[str, BodyContactSettings]], context: BuildCo
         body_time_of_impact=[body.time_of_impact for _, body in chosen],
         particles=_members(entity, context),
     )
-    context.stages.append(stage)
+    if entity.response == "penalty":
+        damping = entity.damping
+        if damping is None:
+            lightest = float(bodies.mass[dynamic].min()) if dynamic.any() else 1.0
+            damping = 2.0 * math.sqrt(entity.stiffness * lightest)  # critical, for the lightest
+        context.body_forces.append(BodyPenalty(stage, entity.stiffness, damping))
+    else:
+        context.stages.append(stage)
 
 
 def _members(entity: BodyContactSettings, context: BuildContext) -> ParticleMembers | None:

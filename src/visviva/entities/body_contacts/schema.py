@@ -15,7 +15,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field
 
-from ..fields import Fraction, Name, Names, NonNegative, Strict
+from ..fields import Fraction, Name, Names, NonNegative, Positive, Strict
 from ..methods import Builds, given
 
 __all__ = ["BodyContactSettings"]
@@ -55,6 +55,19 @@ class BodyContactSettings(Strict):
     particle_friction: NonNegative = Field(
         0.5, description="μ of the particles' contacts with bodies (a pair takes √(μ_p μ_b))"
     )
+    response: Literal["impulses", "penalty"] = Field(
+        "impulses",
+        description="impulses (rest, restitution, friction; the default) or penalty springs "
+        "at the overlapping contact points (seeds 000 and 002)",
+    )
+    stiffness: Positive | None = Field(
+        None, description="penalty: k per contact point [N/m] (required with penalty)"
+    )
+    damping: NonNegative | None = Field(
+        None,
+        description="penalty: c per contact point [N·s/m] (default: 2√(k m) for the lightest "
+        "body, critical)",
+    )
     impacts: Literal["sequential", "simultaneous"] = Field(
         "sequential",
         description="sequential (bounces among the resting contacts' impulses) or "
@@ -78,6 +91,9 @@ class BodyContactMethods:
         particles: Sequence[str] | None = None,
         particle_restitution: float | None = None,
         particle_friction: float | None = None,
+        response: str | None = None,
+        stiffness: float | None = None,
+        damping: float | None = None,
         name: str | None = None,
     ) -> int:
         """Make the bodies of ``targets`` (default: every body) collide with each other and
@@ -89,5 +105,8 @@ class BodyContactMethods:
         needs; a fast body's first impact within a step is found by ``time_of_impact``
         ``"advancement"`` or ``"bisection"`` (:mod:`visviva.collision.impact_time`); the
         particles of the entities ``particles`` collide with the bodies too, as spheres of
-        their radii with ``particle_restitution`` and ``particle_friction``."""
+        their radii with ``particle_restitution`` and ``particle_friction``.
+        ``response="penalty"`` replaces the impulses by springs of ``stiffness`` k [N/m] and
+        ``damping`` c [N·s/m] at each overlapping contact point, with Coulomb friction
+        (:mod:`visviva.collision.body_penalty`)."""
         return self.add("body_contacts", **given(locals()))
