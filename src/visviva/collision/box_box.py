@@ -30,7 +30,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .manifold import LOST_DEPTH, MAX_CONTACTS
+from .manifold import LOST_DEPTH, MAX_CONTACTS, clip_polygon
 
 __all__ = ["CLIP_POINTS", "box_box_contacts", "clip_work"]
 
@@ -188,10 +188,11 @@ def _face_contacts(pr, rr, er, axis, sign, pi, ri, ei, max_separation, points, d
     count = 4
     source, target = work[0], work[1]
     for side in range(4):
-        coordinate = side // 2
-        limit = eu if coordinate == 0 else ev
+        # The side line direction · (x or y) ≤ e, as a plane of the face's frame.
+        limit = eu if side < 2 else ev
         direction = 1.0 if side % 2 == 0 else -1.0
-        count = _clip_line(source, count, coordinate, direction, limit, target)
+        sx, sy = (direction, 0.0) if side < 2 else (0.0, direction)
+        count = clip_polygon(source, count, sx * limit, sy * limit, 0.0, sx, sy, 0.0, target)
         source, target = target, source
         if count == 0:
             return -1, nx, ny, nz
@@ -214,27 +215,6 @@ def _face_contacts(pr, rr, er, axis, sign, pi, ri, ei, max_separation, points, d
             points[i, r] = centre + x * rr[r, u] + y * rr[r, v] + 0.5 * gap * normal
         depths[i] = -gap
     return kept, nx, ny, nz
-
-
-@njit(cache=True)
-def _clip_line(source, count, coordinate, direction, limit, target):
-    """Sutherland–Hodgman in the face's plane: the part of polygon ``source[:count]`` where
-    ``direction · source[:, coordinate] ≤ limit`` (heights interpolated), into ``target``."""
-    kept = 0
-    for i in range(count):
-        j = (i + 1) % count
-        di = direction * source[i, coordinate] - limit
-        dj = direction * source[j, coordinate] - limit
-        if di <= 0.0:
-            target[kept, 0], target[kept, 1], target[kept, 2] = (
-                source[i, 0], source[i, 1], source[i, 2])  # fmt: skip
-            kept += 1
-        if (di < 0.0 < dj) or (dj < 0.0 < di):
-            t = di / (di - dj)
-            for r in range(3):
-                target[kept, r] = source[i, r] + t * (source[j, r] - source[i, r])
-            kept += 1
-    return kept
 
 
 @njit(cache=True)

@@ -25,7 +25,7 @@ from numba import njit
 
 from .convex import MAX_FACE_POINTS, supporting_face
 
-__all__ = ["CANDIDATES", "MAX_CONTACTS", "contact_manifold", "plane_manifold"]
+__all__ = ["CANDIDATES", "MAX_CONTACTS", "clip_polygon", "contact_manifold", "plane_manifold"]
 
 #: The most contacts one pair of convex shapes gets: four span any flat patch.
 MAX_CONTACTS = 4
@@ -83,7 +83,7 @@ def _polygon_normal(points, count):
 
 
 @njit(cache=True)
-def _clip(points, count, ox, oy, oz, sx, sy, sz, out):
+def clip_polygon(points, count, ox, oy, oz, sx, sy, sz, out):
     """Sutherland–Hodgman: the part of polygon (or segment, or point) ``points[:count]`` on the
     side ``s·(p − o) ≤ 0`` of a plane, into ``out``; returns its count."""
     kept = 0
@@ -246,7 +246,7 @@ def _clip_to_face(reference, reference_count, rx, ry, rz, incident, incident_cou
         sx = ey * rz - ez * ry
         sy = ez * rx - ex * rz
         sz = ex * ry - ey * rx
-        count = _clip(work, count, reference[i, 0], reference[i, 1], reference[i, 2],
+        count = clip_polygon(work, count, reference[i, 0], reference[i, 1], reference[i, 2],
                       sx, sy, sz, other)  # fmt: skip
         work, other = other, work
         if count == 0:
