@@ -196,6 +196,10 @@ def test_demos_record_how_they_play(tmp_path):
         (["view", "--speed", "1e-300"], ""),  # the viewer lowers its rate to fit, with a warning
         (["export", "--to", "gif", "--fps", "0.001"], "at least 0.0015"),
         (["export", "--to", "mp4", "--trail", "nan"], "`trail` must be finite"),
+        # --fps 0 is refused as view and demo refuse it (it used to give a 30 fps video).
+        (["export", "--to", "mp4", "--fps", "0"], "`fps` must be"),
+        (["export", "--to", "gif", "--fps", "0"], "`fps` must be"),
+        (["view", "--fps", "0"], "`fps` must be"),
     ],
 )
 def test_playback_numbers_at_the_edge_of_a_float(monkeypatch, capsys, tmp_path, args, fragment):

@@ -264,7 +264,7 @@ def export_command(
             render_video(
                 source,
                 target,
-                fps=fps or 30.0,
+                fps=30.0 if fps is None else fps,
                 size=pixels,
                 speed=chosen.speed,
                 trail=chosen.trail,
