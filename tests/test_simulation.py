@@ -190,7 +190,9 @@ def test_explicit_euler_on_a_stiff_spring_diverges_with_advice():
     assert isinstance(error, vv.SimulationDiverged)
     assert error.component.startswith(("q[0]", "v[0]"))
     assert error.suggested_dt == 0.0
-    assert f"step {error.step}" in solution.message
+    assert f"step {error.step + 1}" in solution.message  # counted from 1 for people
+    # t = (index + 1) dt: the failing step's end.
+    assert error.t == pytest.approx((error.step + 1) * 0.05)
     assert "undamped oscillating modes" in solution.message
     # The frames before the blow-up are kept and finite.
     assert solution.t[-1] < error.t and np.isfinite(solution.q).all()

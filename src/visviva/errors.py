@@ -116,8 +116,9 @@ class SimulationError(VisvivaError, RuntimeError):
 
     Attributes:
         t: Simulation time of the failure [s].
-        step: Index of the step that failed (0 is the first step), or ``None`` when the failure
-            was raised outside a simulation loop (a direct ``Integrator.step`` call).
+        step: Index of the step that failed (0 is the first step; messages count from 1), or
+            ``None`` when the failure was raised outside a simulation loop (a direct
+            ``Integrator.step`` call).
     """
 
     def __init__(self, message: str, *, t: float, step: int | None) -> None:

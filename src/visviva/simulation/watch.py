@@ -70,14 +70,15 @@ class DivergenceWatch:
         return all(bool(np.max(np.abs(part)) <= self.limit) for part in state.parts)
 
     def diverged(self, state: State, step: int, last_good: State) -> SimulationDiverged:
-        """The exception describing why ``state`` (reached by step ``step``) is not healthy."""
+        """The exception describing why ``state`` (reached by the step of index ``step``, 0
+        for the first) is not healthy; its message counts steps from 1, as people do."""
         component, value, system_index, entry = self._first_offender(state)
         suggestion = suggested_dt(self.system, self.method, last_good, system_index)
         problem = (
             "is not finite" if not np.isfinite(value) else (f"exceeds the limit {self.limit:.3g}")
         )
         message = (
-            f"simulation diverged at t={state.t:.6g} s (step {step}): {component} = {value!r} "
+            f"simulation diverged at t={state.t:.6g} s (step {step + 1}): {component} = {value!r} "
             f"{problem}. {divergence_advice(self.method, self.dt, suggestion)}"
         )
         return SimulationDiverged(
