@@ -351,3 +351,17 @@ def test_user_errors_leave_the_working_directory_clean(executable, tmp_path):
     completed = run_executable(executable, tmp_path, "demo", "circular", "--duration", "nan")
     assert_user_error(completed.returncode, completed.stderr, "`duration`", "nan")
     assert os.listdir(tmp_path) == []
+
+
+def test_run_reports_steps_of_dt_and_their_substeps_apart(tmp_path, monkeypatch, capsys):
+    # 0.1 s at dt = 0.01 s in 4 substeps: 10 steps of dt (40 substeps), not "40 steps (dt =
+    # 0.01 s)" as the report used to say.
+    scene = tmp_path / "drop.toml"
+    scene.write_text(
+        '[scene]\nname = "drop"\n[integration]\nmethod = "symplectic_euler"\ndt = 0.01\n'
+        'substeps = 4\nduration = 0.1\n[[entities]]\ntype = "particles"\n'
+        "positions = [[0.0, 1.0, 0.0]]\nmass = 1.0\n"
+    )
+    status, out, err = run_main(monkeypatch, capsys, "run", scene, "-o", tmp_path / "out")
+    assert status == 0, err
+    assert "drop: 10 steps of symplectic_euler (dt = 0.01 s, 4 substeps each) in" in out

@@ -451,6 +451,7 @@ def _summary(
         "success": failure is None,
         "message": "completed" if failure is None else str(failure),
         "steps": int(run.counters.get("steps", 0)),
+        "substeps": settings.substeps,
         "energy_drift": drift,
         "max_energy_error": largest,
         "energy_tolerance": tolerance,

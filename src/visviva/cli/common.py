@@ -57,8 +57,7 @@ def print_report(report: Any) -> None:
     """
     summary = report.summary
     what = summary.get("scene") or summary.get("demo")
-    method = f" of {summary['method']} (dt = {summary['dt']:g} s)" if "method" in summary else ""
-    typer.echo(f"{what}: {summary['steps']} steps{method} in {summary['wall_time_s']:.3g} s")
+    typer.echo(f"{what}: {_steps(summary)} in {summary['wall_time_s']:.3g} s")
     if "interrupted" in summary:
         reached = summary.get("t_reached_s")
         at = f" at t = {reached:.6g} s of {summary['duration_s']:.6g} s" if reached else ""
@@ -93,3 +92,19 @@ def print_report(report: Any) -> None:
         folder = report.files[0].parent
         names = ", ".join(f.name + ("/" if f.is_dir() else "") for f in report.files)
         typer.echo(f"wrote {names} into {folder}{'/' if str(folder) != '/' else ''}")
+
+
+def _steps(summary: dict[str, Any]) -> str:
+    """How many steps a job took, each of ``dt`` (its substeps, ``steps`` in the summary
+    counts, said apart): "240 steps of symplectic_euler (dt = 0.0167 s, 80 substeps each)"."""
+    runs = summary.get("runs") or {"": summary}
+    steps = sum(int(r.get("steps", 0)) // max(int(r.get("substeps", 1)), 1) for r in runs.values())
+    text = f"{steps} steps"
+    if "method" in summary:
+        text += f" of {summary['method']} (dt = {summary['dt']:g} s"
+        substeps = int(summary.get("substeps", 1))
+        text += f", {substeps} substeps each)" if substeps > 1 else ")"
+    elif any(int(r.get("substeps", 1)) > 1 for r in runs.values()):
+        total = sum(int(r.get("steps", 0)) for r in runs.values())
+        text += f" ({total} substeps)"
+    return text
