@@ -3,10 +3,10 @@ in the same order, to the bit, serially and on one or two threads."""
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from thread_counts import assert_same_bits, on_one_and_two_threads
 from visviva.collision import Box, Capsule, Cone, Cylinder, Sphere, body_detection
 from visviva.collision.body_detection import contact_arrays, pair_contacts, piece_poses
 from visviva.collision.body_pieces import BodyPieces
@@ -38,23 +38,14 @@ def _crowded_pieces(count: int, seed: int):
 def test_the_narrow_phase_is_the_same_on_any_number_of_threads(monkeypatch):
     pieces, position, turn, margin, pairs = _crowded_pieces(1500, 27)
     assert pairs.shape[0] > 2 * body_detection.PARALLEL_MIN_PAIRS
-    results = []
 
     def run():
         out = contact_arrays(MAX_CONTACTS * pairs.shape[0])
         count = pair_contacts(pieces.arrays(), pieces.body, pairs, position, turn, margin, out)
-        results.append(tuple(np.array(a[:count]) for a in out))
+        return tuple(np.array(a[:count]) for a in out)
 
-    threads = numba.get_num_threads()
-    try:
-        for count in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
-            numba.set_num_threads(count)
-            run()
-    finally:
-        numba.set_num_threads(threads)
+    results = on_one_and_two_threads(run)
     monkeypatch.setattr(body_detection, "PARALLEL_MIN_PAIRS", 10**12)  # the serial driver
-    run()
+    results.append(run())
     assert results[0][0].size > 1000  # contacts found
-    for other in results[1:]:
-        for a, b in zip(results[0], other, strict=True):
-            assert a.dtype == b.dtype and np.array_equal(a, b)
+    assert_same_bits(results)

@@ -7,7 +7,6 @@ of sets, with no tolerance, including points exactly on cell borders and exactly
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -15,6 +14,7 @@ from hypothesis import strategies as st
 from numba import njit
 
 import visviva as vv
+from thread_counts import assert_same_bits, on_one_and_two_threads
 from visviva.errors import ModelError
 from visviva.geometry import neighbour_grid
 from visviva.geometry.neighbour_cells import cell_of, cell_range, neighbour_runs
@@ -272,7 +272,6 @@ def test_same_arrays_whatever_the_thread_count(monkeypatch):
     for bit (the sort is stable, so its result is unique)."""
     points = uniform_cloud(3 * PARALLEL_MIN_POINTS // 2, 15.0)
     alive = RNG.random(points.shape[0]) < 0.95
-    results = []
 
     def run():
         grid = NeighbourGrid(1.0)
@@ -280,20 +279,12 @@ def test_same_arrays_whatever_the_thread_count(monkeypatch):
         arrays = tuple(np.array(a, copy=True) for a in grid.arrays[:5])
         lists = tuple(np.array(a, copy=True) for a in grid.neighbours())
         pairs = tuple(np.array(a, copy=True) for a in grid.pairs())
-        results.append(arrays + lists + pairs)
+        return arrays + lists + pairs
 
-    threads = numba.get_num_threads()
-    try:
-        for count in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
-            numba.set_num_threads(count)
-            run()
-    finally:
-        numba.set_num_threads(threads)
+    results = on_one_and_two_threads(run)
     monkeypatch.setattr(neighbour_grid, "PARALLEL_MIN_POINTS", 10**12)
-    run()
-    for other in results[1:]:
-        for a, b in zip(results[0], other, strict=True):
-            assert a.dtype == b.dtype and np.array_equal(a, b)
+    results.append(run())
+    assert_same_bits(results)
 
 
 # --------------------------------------------------------------------------------------------

@@ -86,7 +86,8 @@ def box_box_contacts(pa, ra, ea, pb, rb, eb, max_separation, points, depths, wor
         though every axis does, or when the boxes' nearest (deepest) features were clipped
         away (a corner beside a face): the caller then asks GJK and EPA.
     """
-    scale = TIE * min(ea[0], ea[1], ea[2], eb[0], eb[1], eb[2])
+    size = min(ea[0], ea[1], ea[2], eb[0], eb[1], eb[2])
+    tie = TIE * size
     # Faces of A, then faces of B: the deepest (largest gap) of each.
     best_face = -math.inf
     face_owner = 0
@@ -99,7 +100,7 @@ def box_box_contacts(pa, ra, ea, pb, rb, eb, max_separation, points, depths, wor
                              rotation[2, k])  # fmt: skip
             if gap > max_separation:
                 return 0, 0.0, 0.0, 0.0
-            if gap > best_face + (scale if owner == 1 else 0.0):
+            if gap > best_face + (tie if owner == 1 else 0.0):
                 best_face, face_owner, face_axis, face_sign = gap, owner, k, sign
     best_edge = -math.inf
     edge_i = edge_j = 0
@@ -120,7 +121,7 @@ def box_box_contacts(pa, ra, ea, pb, rb, eb, max_separation, points, depths, wor
             if gap > best_edge:
                 best_edge, edge_i, edge_j = gap, i, j
                 ex, ey, ez = sign * lx, sign * ly, sign * lz
-    if best_edge > best_face + scale:
+    if best_edge > best_face + tie:
         best = best_edge
         count, nx, ny, nz = _edge_contact(pa, ra, ea, pb, rb, eb, edge_i, edge_j, ex, ey, ez,
                                           max_separation, points, depths)  # fmt: skip
@@ -141,7 +142,7 @@ def box_box_contacts(pa, ra, ea, pb, rb, eb, max_separation, points, depths, wor
         nearest = math.inf
         for i in range(count):
             nearest = min(nearest, -depths[i])
-        lost = 1e-9 * scale / TIE if best > 0.0 else -LOST_DEPTH * best
+        lost = 1e-9 * size if best > 0.0 else -LOST_DEPTH * best
         if nearest > best + lost:
             return -1, nx, ny, nz
     return count, nx, ny, nz
