@@ -365,3 +365,63 @@ def test_run_reports_steps_of_dt_and_their_substeps_apart(tmp_path, monkeypatch,
     status, out, err = run_main(monkeypatch, capsys, "run", scene, "-o", tmp_path / "out")
     assert status == 0, err
     assert "drop: 10 steps of symplectic_euler (dt = 0.01 s, 4 substeps each) in" in out
+
+
+@pytest.mark.parametrize(("substeps", "verdict"), [(1, "dt is above it!"), (4, "is within it")])
+def test_dry_run_advises_against_the_step_the_integrator_takes(
+    tmp_path, monkeypatch, capsys, substeps, verdict
+):
+    # Symplectic Euler on q'' = −ω²q is stable for ω h ≤ 2: h ≤ 0.2 s at ω = 10 rad/s. At
+    # dt = 0.5 s the integrator's step is h = dt / substeps: unstable alone, stable in 4.
+    scene = tmp_path / "spring.toml"
+    scene.write_text(
+        '[scene]\nname = "spring"\n[integration]\nmethod = "symplectic_euler"\ndt = 0.5\n'
+        f"substeps = {substeps}\nduration = 5.0\n[[entities]]\ntype = \"system\"\n"
+        'system = "oscillator"\nparameters = { omega = 10.0 }\n'
+    )
+    status, out, err = run_main(monkeypatch, capsys, "run", scene, "--dry-run")
+    assert status == 0, err
+    assert "largest stable step for symplectic_euler ≈ 0.2 s" in out
+    assert verdict in out
+
+
+def test_energy_drift_is_reported_only_for_conservative_runs(tmp_path, monkeypatch, capsys):
+    # An undamped spring conserves E = ½v² + ½ω²q²: its change is the integrator's error, a
+    # drift. With air drag (force −c v) the energy falls by physics: reported as dissipated.
+    spring = (
+        '[integration]\nmethod = "velocity_verlet"\ndt = 0.01\nduration = 2.0\n'
+        '[[entities]]\ntype = "particles"\npositions = [[0.0, 1.0, 0.0]]\n'
+        "velocities = [[1.0, 0.0, 0.0]]\nmass = 1.0\n"
+    )
+    drag = '[[entities]]\ntype = "force"\nkind = "damping"\nrate = 0.5\n'
+    for name, text in {"free": spring, "dragged": spring + drag}.items():
+        (tmp_path / f"{name}.toml").write_text(f'[scene]\nname = "{name}"\n' + text)
+    status, out, err = run_main(
+        monkeypatch, capsys, "run", tmp_path / "free.toml", "-o", tmp_path / "free"
+    )
+    assert status == 0, err
+    assert "energy drift:" in out and "dissipated" not in out
+    status, out, err = run_main(
+        monkeypatch, capsys, "run", tmp_path / "dragged.toml", "-o", tmp_path / "dragged"
+    )
+    assert status == 0, err
+    assert "energy drift" not in out
+    assert "energy dissipated:" in out and "not conservative" in out
+    summary = json.loads((tmp_path / "dragged" / "summary.json").read_text())
+    assert summary["conservative"] is False
+
+
+def test_energy_lines_tell_the_runs_of_a_demo_apart():
+    from visviva.cli.common import _energy_lines
+
+    runs = {
+        "verlet": {"conservative": True, "energy_drift": 1e-4},
+        "euler": {"conservative": True, "energy_drift": 0.5},
+        "damped": {"conservative": False, "energy_drift": -0.75},
+        "silent": {"conservative": True, "energy_drift": None},
+    }
+    assert _energy_lines({"runs": runs}) == [
+        "energy drift: up to +50 % of the initial energy (euler)",
+        "energy dissipated: 75 % of the initial energy "
+        "(not conservative: the forces do this, not the integrator)",
+    ]

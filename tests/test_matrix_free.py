@@ -169,7 +169,7 @@ def test_star_cluster_dry_run_is_matrix_free(tmp_path):
         ["run", str(EXAMPLES / "star_cluster.toml"), "--dry-run"], tmp_path
     )
     assert result.returncode == 0, result.stderr
-    assert "largest stable dt for velocity_verlet ≈" in result.stdout
+    assert "largest stable step for velocity_verlet ≈" in result.stdout
     assert gigabytes < 1.5
 
 

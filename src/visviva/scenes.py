@@ -452,6 +452,7 @@ def _summary(
         "message": "completed" if failure is None else str(failure),
         "steps": int(run.counters.get("steps", 0)),
         "substeps": settings.substeps,
+        "conservative": model.conservative,
         "energy_drift": drift,
         "max_energy_error": largest,
         "energy_tolerance": tolerance,

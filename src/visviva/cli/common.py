@@ -64,19 +64,8 @@ def print_report(report: Any) -> None:
         typer.echo(f"interrupted by {summary['interrupted']}{at}; kept what was finished")
     elif not summary.get("success", True):
         typer.echo(f"failed: {summary['message']}")
-    drift = summary.get("energy_drift")
-    drifts = {
-        name: run["energy_drift"]
-        for name, run in summary.get("runs", {}).items()
-        if run.get("energy_drift") is not None
-    }
-    if len(drifts) > 1:
-        worst = max(drifts, key=lambda name: abs(drifts[name]))
-        typer.echo(
-            f"energy drift: up to {100 * drifts[worst]:+.3g} % of the initial energy ({worst})"
-        )
-    elif drift is not None:
-        typer.echo(f"energy drift: {100 * drift:+.3g} % of the initial energy")
+    for line in _energy_lines(summary):
+        typer.echo(line)
     for warning in summary.get("warnings", []):
         count = f" ({warning['count']}×)" if warning.get("count", 1) > 1 else ""
         typer.echo(f"warning: {warning['message']}{count}")
@@ -92,6 +81,34 @@ def print_report(report: Any) -> None:
         folder = report.files[0].parent
         names = ", ".join(f.name + ("/" if f.is_dir() else "") for f in report.files)
         typer.echo(f"wrote {names} into {folder}{'/' if str(folder) != '/' else ''}")
+
+
+def _energy_lines(summary: dict[str, Any]) -> list[str]:
+    """The energy change of conservative runs as a drift (the integrator's error); of the
+    others as energy dissipated or gained, which is the physics and not an error."""
+    runs = summary.get("runs") or {"": summary}
+    changes: dict[bool, dict[str, float]] = {True: {}, False: {}}
+    for name, run in runs.items():
+        if run.get("energy_drift") is not None:
+            changes[bool(run.get("conservative", True))][name] = float(run["energy_drift"])
+    lines = []
+    for conservative, found in changes.items():
+        if not found:
+            continue
+        worst = max(found, key=lambda name: abs(found[name]))
+        change, many = found[worst], len(found) > 1
+        of = f" ({worst})" if many else ""
+        if conservative:
+            size = f"{'up to ' if many else ''}{100 * change:+.3g} %"
+            lines.append(f"energy drift: {size} of the initial energy{of}")
+        else:
+            size = f"{'up to ' if many else ''}{100 * abs(change):.3g} %"
+            word = "dissipated" if change < 0 else "gained"
+            lines.append(
+                f"energy {word}: {size} of the initial energy{of} "
+                "(not conservative: the forces do this, not the integrator)"
+            )
+    return lines
 
 
 def _steps(summary: dict[str, Any]) -> str:

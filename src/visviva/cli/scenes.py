@@ -83,14 +83,18 @@ def run_command(
         estimate = plan(model, duration=duration, formats=formats or ())
         held = [f"{estimate.particles} particles"] if estimate.particles else []
         what = ", ".join(held + [f"system {name}" for name in estimate.systems])
-        limit = estimate.max_stable_dt
+        limit, settings = estimate.max_stable_dt, model.integration
+        # The integrator takes steps of h = dt / substeps: that is what must be stable.
+        h = settings.dt / settings.substeps
+        step = f"h = dt / {settings.substeps} = {h:.4g} s" if settings.substeps > 1 else "dt"
         advice = (
             "no step limit from the linearization"
             if math.isinf(limit)
-            else f"largest stable dt for {model.integration.method} ≈ {limit:.4g} s"
-            + (" (dt is above it!)" if model.integration.dt > limit else "")
+            else f"largest stable step for {settings.method} ≈ {limit:.4g} s"
+            + (f" ({step} is above it!)" if h > limit else f" ({step} is within it)")
         )
-        typer.echo(f"{scene}: {what}, {estimate.steps} steps of dt = {model.integration.dt} s")
+        substeps = f" ({settings.substeps} substeps each)" if settings.substeps > 1 else ""
+        typer.echo(f"{scene}: {what}, {estimate.steps} steps of dt = {settings.dt:.6g} s{substeps}")
         typer.echo(f"recording: {estimate.frames} frames; {advice}")
         typer.echo(f"would write: {', '.join(estimate.outputs)} into {output}")
         return

@@ -45,12 +45,16 @@ STAGING_PREFIX = ".visviva-"
 
 
 def run_summary(recording: Recording) -> dict[str, Any]:
-    """The per-run entry of ``summary.json``: method, step, work, energy drift, outcome."""
+    """The per-run entry of ``summary.json``: method, step, work, energy drift, outcome.
+
+    ``conservative`` says whether the run's energy change measures the integrator's error
+    (absent when the recording does not say)."""
     attrs = recording.attrs
     keys = (
         "method",
         "dt",
         "substeps",
+        "conservative",
         "steps",
         "f_evaluations",
         "jacobian_evaluations",

@@ -79,6 +79,12 @@ class FirstOrderProblem:
         return self.y0.shape[0] if self.y0.ndim == 2 else None
 
     @property
+    def conservative(self) -> bool:
+        """True if an energy is given: a quantity the exact flow conserves, so its change
+        measures the integrator's error."""
+        return self.energy is not None
+
+    @property
     def size(self) -> int:
         """Number of state components ``n`` of one system."""
         return self.y0.shape[-1]
@@ -231,6 +237,12 @@ class SecondOrderProblem:
     def velocity_dependent(self) -> bool:
         """True if the force (acceleration) takes the velocities as an argument."""
         return self.force.state_arguments == 2
+
+    @property
+    def conservative(self) -> bool:
+        """True if the recorded energy measures the integrator's error: an energy is given
+        and the force does not read the velocities (no damping or drag to remove energy)."""
+        return self.energy is not None and not self.velocity_dependent
 
     def system(self) -> SecondOrderSystem:
         """A fresh run-time system (with zeroed work counters) for this problem."""

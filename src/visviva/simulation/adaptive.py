@@ -209,6 +209,7 @@ def integrate_adaptive(
         "until": until,
         "problem": problem.name,
         "kind": problem.kind,
+        "conservative": problem.conservative,
         "batch_size": problem.batch_size,
         "visviva_version": __version__,
         "wall_time_s": time.perf_counter() - started,

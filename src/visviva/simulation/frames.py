@@ -56,7 +56,7 @@ exports would also repeat every spring beside the mesh, as curves and lines.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -218,8 +218,9 @@ def _body_surfaces(bodies: RigidBodies) -> dict[str, np.ndarray]:
     }
 
 
-def recording_attrs(model: Model) -> dict[str, list[str]]:
-    """Attributes a recording keeps of the scene besides its arrays: the bodies' names, the
+def recording_attrs(model: Model) -> dict[str, Any]:
+    """Attributes a recording keeps of the scene besides its arrays: whether it is
+    conservative (its energy change is then the integrator's error), the bodies' names, the
     drawn colliders' names."""
     bodies = {} if model.bodies is None else {"body_names": list(model.bodies.names)}
-    return bodies | dict(model.recorded_attrs)
+    return {"conservative": model.conservative} | bodies | dict(model.recorded_attrs)

@@ -204,6 +204,7 @@ def run_fixed_steps(
         "until": until,
         "problem": problem.name,
         "kind": problem.kind,
+        "conservative": problem.conservative,
         "batch_size": problem.batch_size,
         "compiled": compiled_step is not None,
         "visviva_version": __version__,
