@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import subprocess
 import sys
 import tomllib
 from concurrent.futures import Executor, Future
@@ -25,7 +26,14 @@ import visviva as vv
 from visviva.cli.main import main
 from visviva.errors import ModelError, SweepError
 from visviva.io.recording import load_recording
-from visviva.sweeps import SweepInterrupted, expand, load_sweep, parse_sweep, run_values
+from visviva.sweeps import (
+    SweepFailed,
+    SweepInterrupted,
+    expand,
+    load_sweep,
+    parse_sweep,
+    run_values,
+)
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sweeps" / "pendulum_steps.toml"
 
@@ -458,6 +466,41 @@ def test_cli_sweep_dry_run_runs_and_refuses(tmp_path, monkeypatch, capsys):
         assert status == 2, args
         assert stderr.startswith("error: ") and stderr.count("\n") == 1, stderr
         assert "Traceback" not in stderr
+
+
+ALL_DIVERGE = """
+[[parameters]]
+path = "entities[pair].stiffness"
+values = [1e6, 4e6]
+"""
+
+
+def test_a_sweep_whose_every_run_failed_is_an_error_after_its_table(tmp_path, monkeypatch, capsys):
+    # k = 1e6 and 4e6 N/m, m = 1 kg, dt = 0.01 s: ωh = 10 and 20, far beyond symplectic
+    # Euler's ωh < 2; both runs diverge, and the sweep says so instead of a quiet success.
+    path = write(tmp_path, spring_sweep(ALL_DIVERGE))
+    with pytest.raises(SweepFailed, match=r"all 2 runs of the sweep failed; run 0-.*diverged"):
+        vv.sweep(path, tmp_path / "api", executor="serial")
+    assert (tmp_path / "api" / "results.csv").exists()  # every run's error stays readable
+    status, stdout, stderr = run_main(
+        monkeypatch, capsys, "sweep", path, "-o", tmp_path / "cli", "--serial"
+    )
+    assert status == 1, stderr
+    assert "2 runs; 0 succeeded, 2 failed" in stdout
+    assert "all 2 runs of the sweep failed" in stderr and "Traceback" not in stderr
+
+
+def test_a_script_without_a_main_guard_is_told_to_add_one(tmp_path):
+    # The pool's workers import the script that started them; unguarded, that import starts
+    # the sweep again inside a worker, which dies. The script must fail, saying why.
+    path = write(tmp_path, spring_sweep(GRID))
+    script = tmp_path / "script.py"
+    script.write_text(f"import visviva as vv\nvv.sweep({str(path)!r}, 'out', workers=2)\n")
+    done = subprocess.run(
+        [sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode != 0
+    assert 'if __name__ == "__main__":' in done.stderr.splitlines()[-1]
 
 
 # ---------------------------------------------------------------- hostile files

@@ -52,7 +52,7 @@ def sweep_command(
     """Run a sweep: every run into DIR/runs/, the table into DIR/results.csv, .json and .h5, the
     plots into DIR/plots/ and a page of it all, DIR/index.html."""
     from ..errors import ModelError
-    from ..sweeps import dask_executor, expand, load_sweep, sweep
+    from ..sweeps import SweepFailed, dask_executor, expand, load_sweep, sweep
 
     on_dask = dask or scheduler is not None
     if serial and (workers is not None or on_dask):
@@ -84,22 +84,26 @@ def sweep_command(
         for run in runs:
             typer.echo("\t".join([str(run.index), *(_shown(run.values[p]) for p in paths)]))
         return
-    if on_dask:
-        # Connected (or started) before the sweep begins: a scheduler that does not answer
-        # is reported before anything is written.
-        with dask_executor(scheduler, workers=workers) as executor:
+    try:
+        if on_dask:
+            # Connected (or started) before the sweep begins: a scheduler that does not
+            # answer is reported before anything is written.
+            with dask_executor(scheduler, workers=workers) as executor:
+                result = sweep(
+                    chosen, output, executor=executor, resume=not no_resume, batch=not no_batch
+                )
+        else:
             result = sweep(
-                chosen, output, executor=executor, resume=not no_resume, batch=not no_batch
+                chosen,
+                output,
+                executor="serial" if serial else None,
+                workers=workers,
+                resume=not no_resume,
+                batch=not no_batch,
             )
-    else:
-        result = sweep(
-            chosen,
-            output,
-            executor="serial" if serial else None,
-            workers=workers,
-            resume=not no_resume,
-            batch=not no_batch,
-        )
+    except SweepFailed as failure:  # the table first, then the error line and exit status 1
+        _print_result(failure.result)
+        raise
     _print_result(result)
 
 

@@ -17,7 +17,7 @@ from .description import Outputs, Parameter, Sweep, SweepInfo, load_sweep, parse
 from .design import SweepRun, expand, run_values
 from .plot_spec import Plot
 from .results_h5 import read_results_h5
-from .runner import SweepInterrupted, SweepResult, sweep
+from .runner import SweepFailed, SweepInterrupted, SweepResult, sweep
 from .tasks import BatchTask, RunTask, run_batch, run_task
 
 __all__ = [
@@ -28,6 +28,7 @@ __all__ = [
     "RunTask",
     "Sweep",
     "SweepInfo",
+    "SweepFailed",
     "SweepInterrupted",
     "SweepResult",
     "SweepRun",

@@ -33,12 +33,13 @@ from concurrent.futures import (
     as_completed,
     wait,
 )
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
 from .._validation import whole_number
-from ..errors import ModelError
+from ..errors import ModelError, SimulationError
 from ..io.files import check_directory
 from ..simulation.interrupt import Interrupted
 from ..simulation.progress import Progress
@@ -49,7 +50,7 @@ from .results import write_results
 from .shared_files import SharedFiles
 from .tasks import RUN_FILE, BatchTask, RunTask, finished_row, perform, start_worker
 
-__all__ = ["SweepInterrupted", "SweepResult", "sweep"]
+__all__ = ["SweepFailed", "SweepInterrupted", "SweepResult", "sweep"]
 
 #: Modules the pool's fork server imports once, so that each worker starts with them loaded.
 WORKER_PRELOAD = (
@@ -103,6 +104,28 @@ class SweepInterrupted(Interrupted):
         self.result = result
 
 
+class SweepFailed(SimulationError):
+    """Every run of a sweep failed (raised after the results table was written, so each
+    run's error can be read there).
+
+    Attributes:
+        result: The :class:`SweepResult` of the failed runs.
+    """
+
+    def __init__(self, result: SweepResult) -> None:
+        first = result.rows[0]
+        reason = str(first["error"]).splitlines()[0]
+        total = len(result.rows)
+        every = "the only run" if total == 1 else f"all {total} runs"
+        super().__init__(
+            f"{every} of the sweep failed; run {first['run']}: {reason} "
+            f"(every run's error is in {result.files[0]})",
+            t=float("nan"),
+            step=None,
+        )
+        self.result = result
+
+
 def sweep(
     description: Sweep | str | os.PathLike[str],
     directory: str | os.PathLike[str],
@@ -141,6 +164,7 @@ def sweep(
             before anything is run or written.
         ModelError: An unwritable directory or bad ``workers``, before anything is run.
         SweepInterrupted: On SIGINT/SIGTERM, after writing the results of the finished runs.
+        SweepFailed: If every run failed, after writing the results (each run's error).
     """
     chosen = description if isinstance(description, Sweep) else load_sweep(description)
     if workers is not None:
@@ -212,6 +236,8 @@ def sweep(
     )
     if stopped is not None:
         raise SweepInterrupted(stopped, result, len(runs))
+    if ordered and result.failed == len(ordered):
+        raise SweepFailed(result)
     return result
 
 
@@ -333,6 +359,12 @@ def _outcome(
         return future.result()
     except CancelledError:
         error = "the executor cancelled the run before it finished; run the sweep again"
+    except BrokenProcessPool as failure:
+        error = (
+            f"BrokenProcessPool: {failure} A worker process died: it was killed (out of "
+            "memory?), or the script that called vv.sweep has no `if __name__ == "
+            '"__main__":` guard around the call (the workers import that script)'
+        )
     except Exception as failure:  # a broken worker fails its task's runs only
         error = f"{type(failure).__name__}: {failure}"
     return [
