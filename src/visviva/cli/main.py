@@ -364,9 +364,12 @@ def main() -> None:
     """Entry point: run the app; user errors exit 2 with one line, failures exit 1, a run
     stopped by SIGINT/SIGTERM exits 128 + the signal's number (130 for Ctrl-C) after saying
     what it kept."""
+    from .._compiling import tell
     from ..errors import ModelError, SimulationError
     from ..simulation.interrupt import Interrupted, exit_status
 
+    if sys.stderr.isatty():  # a first run compiles for a while: say so on a terminal
+        tell(_terminal_line)
     try:
         app()
     except ModelError as error:
@@ -384,6 +387,12 @@ def main() -> None:
     except KeyboardInterrupt:
         typer.echo("interrupted; no partial file was left", err=True)
         sys.exit(130)
+
+
+def _terminal_line(line: str, transient: bool) -> None:
+    """Write ``line`` over the transient line before it; leave it for the next if transient."""
+    sys.stderr.write(f"\r\x1b[2K{line}" + ("" if transient else "\n"))
+    sys.stderr.flush()
 
 
 def _print_kept(error: Exception) -> None:

@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from .._compiling import watch_compiles
 from .._validation import describe
 from ..entities import entity_kinds
 from ..entities.checks import entity_names
@@ -53,6 +54,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
     Raises:
         SceneError: Listing every problem found.
     """
+    watch_compiles()  # building and running a scene may compile its kernels: say so
     scene = prepared(scene)
     problems = _check(scene)
     if problems:

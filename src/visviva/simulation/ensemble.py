@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._compiling import watch_compiles
 from ..errors import ModelError, SimulationDiverged, SimulationError
 from ..integrators import Integrator, get
 from ..ode.stacking import equations_key, stack
@@ -192,6 +193,7 @@ def run_ensemble(
             :class:`~visviva.simulation.interrupt.StopOnSignal`), after the current step; the
             frames up to it were passed to ``on_frame``.
     """
+    watch_compiles()
     if not models:
         raise ModelError("`models` is empty: an ensemble needs at least one model")
     key = ensemble_key(models[0])

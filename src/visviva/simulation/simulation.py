@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._compiling import watch_compiles
 from .._validation import real_number, whole_number
 from ..collision.body_contacts import BodyContactSet
 from ..collision.contact_classes import DEFAULT_GAP, Contacts
@@ -141,6 +142,7 @@ class Simulation:
         from ..particles.fused import FusedParticles
         from ..rigid.fused import FusedBodies
 
+        watch_compiles()
         settings = model.integration
         self.model = model
         self.integrator = get(settings.method if method is None else method)

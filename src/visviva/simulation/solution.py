@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._compiling import watch_compiles
 from .._validation import describe, real_number, whole_number
 from ..errors import ModelError, SimulationError
 from ..integrators import Integrator, get, names
@@ -162,6 +163,7 @@ def solve(
         >>> sol.success, sol.q.shape, sol.counters["f_evaluations"]
         (True, (11, 1), 100)
     """
+    watch_compiles()  # the first solve of a problem may compile for a while: say so
     check_problem(problem)
     integrator = get(method)
     use_adaptive = integrator.adaptive if adaptive is None else bool(adaptive)
