@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry.quaternions import quaternion_matrix, quaternion_multiply
+from ..geometry.quaternions import quaternion_matrix, quaternion_multiply, quaternion_rotate
 from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
@@ -57,7 +57,8 @@ def build_scene(duration: float) -> SceneBuilder:
     apex = quaternion_matrix(q) @ [0.0, HEIGHT, 0.0]
     builder = SceneBuilder(name="spinning top")
     builder.set_world(gravity=(0.0, -G, 0.0))
-    builder.set_integration(method="symplectic_euler", dt=DT, duration=duration)
+    every = round(1.0 / (SAMPLES_PER_SECOND * DT))  # steps between recorded frames
+    builder.set_integration(method="symplectic_euler", dt=DT, duration=duration, record_every=every)
     builder.add_body(
         "cone", radius=RADIUS, height=HEIGHT, density=DENSITY, orientation=q,
         position=-apex, angular_velocity=SPIN * axis, color=(0.75, 0.5, 0.25), name="top",
@@ -71,16 +72,13 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     from matplotlib.figure import Figure
 
     model = build_scene(duration).build()
-    output.recordings["symplectic_euler"] = Simulation(model).record(until=duration)
-    simulation = Simulation(model)
+    # One simulation, recorded SAMPLES_PER_SECOND times a second: the video and the figure.
+    recording = Simulation(model).record(until=duration)
+    output.recordings["symplectic_euler"] = recording
     mass = float(model.bodies.mass[0])
-    every = round(1.0 / (SAMPLES_PER_SECOND * DT))
-    t, centre = [], []
-    for _ in range(int(duration * SAMPLES_PER_SECOND) + 1):
-        t.append(simulation.time)
-        centre.append(simulation.state["body_position"][0].copy())
-        simulation.step(every)
-    t, centre = np.array(t), np.array(centre)
+    # The centre of mass: the recorded origin plus the rotated body-frame offset to it.
+    offset = quaternion_rotate(recording["body_orientation"][:, 0], model.bodies.center[0])
+    t, centre = recording.time, recording["body_origin"][:, 0] + offset
     d = np.linalg.norm(centre, axis=1)  # the centre of mass from the apex at the origin
     tilt = np.arccos(np.clip(centre[:, 1] / d, -1.0, 1.0))
     azimuth = np.unwrap(np.arctan2(-centre[:, 2], centre[:, 0]))  # about +y
