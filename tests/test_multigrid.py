@@ -71,7 +71,7 @@ def test_aggregates_cover_the_points_and_coarse_matrices_are_galerkins():
     assert all(coarse <= 0.6 * fine for fine, coarse in itertools.pairwise(sizes))
     fine = matrix.tocsr()
     for (aggregate, rows, columns, _), blocks in zip(
-        hierarchy.levels, list(cycle.arrays[2])[1:], strict=True
+        hierarchy.levels, list(cycle.arrays[3])[1:], strict=True
     ):
         assert (aggregate >= 0).all()
         coarse = rows.shape[0] - 1

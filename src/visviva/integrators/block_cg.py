@@ -78,9 +78,31 @@ def _new_direction(beta, z, p):  # pragma: no cover - compiled
 @njit(cache=True)
 def _precondition(cycle, normals, r, z):  # pragma: no cover - compiled
     """``z ← B r`` (filtered across ``normals`` if any); returns ``r · z``."""
-    indptr, indices, blocks, inverses, aggregates, factor, residuals, corrections, scratch = cycle
+    (
+        levels,
+        indptr,
+        indices,
+        blocks,
+        inverses,
+        aggregates,
+        factor,
+        residuals,
+        corrections,
+        scratch,
+    ) = cycle
     vcycle(
-        indptr, indices, blocks, inverses, aggregates, factor, residuals, corrections, scratch, r, z
+        levels,
+        indptr,
+        indices,
+        blocks,
+        inverses,
+        aggregates,
+        factor,
+        residuals,
+        corrections,
+        scratch,
+        r,
+        z,
     )
     if normals.shape[0] > 0:
         _filter(normals, z)

@@ -47,14 +47,16 @@ References:
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 from numba import njit, prange
-from numba.typed import List
 
+from .._blas import one_blas_thread
 from .bsr import block_product, diagonal_inverse
 
 __all__ = ["Cycle", "Hierarchy", "jacobi", "vcycle"]
+
+#: One array per level, finest first.
+Levels = tuple[np.ndarray, ...]
 
 #: Points at the coarsest level at most (solved there by a dense Cholesky factor: ≤ 384 rows).
 COARSEST = 128
@@ -79,7 +81,8 @@ class Hierarchy:
 
     def __init__(self, indptr: np.ndarray, indices: np.ndarray) -> None:
         self.indptr, self.indices = indptr, indices
-        # One integer type on every level (the kernels take the levels as typed lists).
+        # One integer type on every level: the kernels take the levels as tuples of arrays of
+        # one type (not typed lists, whose methods Numba compiles anew in every process).
         self._pattern = (indptr.astype(np.int64), indices.astype(np.int64))
         self.levels: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         rows, columns = self._pattern
@@ -96,8 +99,8 @@ class Hierarchy:
             rows, columns = level[1], level[2]
         # What every cycle of this pattern shares, made once: the levels' patterns and the
         # V-cycle's work space (scratch: nothing in it outlives a cycle's application).
-        self._rows = List([self._pattern[0], *(level[1] for level in self.levels)])
-        self._columns = List([self._pattern[1], *(level[2] for level in self.levels)])
+        self._rows = (self._pattern[0], *(level[1] for level in self.levels))
+        self._columns = (self._pattern[1], *(level[2] for level in self.levels))
         self._work = _work_space(self._rows)
 
     def matches(self, indptr: np.ndarray, indices: np.ndarray) -> bool:
@@ -111,7 +114,7 @@ class Hierarchy:
         Jacobi if the coarsest level is not positive definite (then neither is the matrix, and
         CG is to find a direction of negative curvature, not to converge fast)."""
         indptr, indices = self._rows, self._columns
-        blocks, aggregates = List([data]), List.empty_list(numba.int64[::1])
+        blocks, aggregates = [data], []
         for level, (aggregate, rows, columns, block_map) in enumerate(self.levels):
             if level == 0:
                 # Points held by pins have rows without coupling: keep them out.
@@ -122,7 +125,7 @@ class Hierarchy:
             _sum_blocks(block_map, blocks[-1], rows, columns, coarse)
             blocks.append(coarse)
             aggregates.append(aggregate)
-        inverses = List()
+        inverses = []
         for rows, columns, values in zip(indptr, indices, blocks, strict=True):
             inverse = np.empty((rows.shape[0] - 1, 3, 3))
             diagonal_inverse(rows, columns, values, inverse)
@@ -130,10 +133,13 @@ class Hierarchy:
         factor = np.empty((0, 0))  # the coarsest level too large to solve: one sweep there
         if indptr[-1].shape[0] - 1 <= COARSEST:
             try:
-                factor = np.linalg.cholesky(_dense(indptr[-1], indices[-1], blocks[-1]))
+                with one_blas_thread():  # ≤ 384 rows: threads only wait on each other
+                    factor = np.linalg.cholesky(_dense(indptr[-1], indices[-1], blocks[-1]))
             except np.linalg.LinAlgError:
                 return jacobi(self.indptr, self.indices, data)
-        return Cycle(indptr, indices, blocks, inverses, aggregates, factor, self._work)
+        return Cycle(
+            indptr, indices, tuple(blocks), tuple(inverses), aggregates, factor, self._work
+        )
 
 
 class Cycle:
@@ -143,20 +149,18 @@ class Cycle:
 
     def __init__(
         self,
-        indptr: List,
-        indices: List,
-        blocks: List,
-        inverses: List,
-        aggregates: List,
+        indptr: Levels,
+        indices: Levels,
+        blocks: Levels,
+        inverses: Levels,
+        aggregates: list[np.ndarray],
         factor: np.ndarray,
-        work: tuple[List, List, List],
+        work: tuple[Levels, Levels, Levels],
     ) -> None:
-        self.arrays = (indptr, indices, blocks, inverses, aggregates, factor, *work)
-
-    @property
-    def levels(self) -> int:
-        """Coarse levels below the matrix's own."""
-        return len(self.arrays[4])
+        self.levels = len(aggregates)
+        # A tuple of one type for the kernels, even without coarse levels (never read then).
+        between = tuple(aggregates) or (np.empty(0, dtype=np.int64),)
+        self.arrays = (self.levels, indptr, indices, blocks, inverses, between, factor, *work)
 
     def apply(self, r: np.ndarray, z: np.ndarray) -> None:
         """``z ← B r`` (``(N, 3)`` each), ``B`` the cycle's approximate inverse of ``A``."""
@@ -168,15 +172,13 @@ def jacobi(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray) -> Cycle:
     iterates)."""
     inverse = np.empty((indptr.shape[0] - 1, 3, 3))
     diagonal_inverse(indptr, indices, data, inverse)
-    rows, columns = List([indptr.astype(np.int64)]), List([indices.astype(np.int64)])
-    aggregates = List.empty_list(numba.int64[::1])
-    blocks, inverses = List([data]), List([inverse])
-    return Cycle(rows, columns, blocks, inverses, aggregates, np.empty((0, 0)), _work_space(rows))
+    rows, columns = (indptr.astype(np.int64),), (indices.astype(np.int64),)
+    return Cycle(rows, columns, (data,), (inverse,), [], np.empty((0, 0)), _work_space(rows))
 
 
-def _work_space(indptr: List) -> tuple[List, List, List]:
+def _work_space(indptr: Levels) -> tuple[Levels, Levels, Levels]:
     """The V-cycle's residuals, corrections and scratch, ``(n_l, 3)`` per level."""
-    return tuple(List([np.empty((rows.shape[0] - 1, 3)) for rows in indptr]) for _ in range(3))  # type: ignore[return-value]
+    return tuple(tuple(np.empty((rows.shape[0] - 1, 3)) for rows in indptr) for _ in range(3))  # type: ignore[return-value]
 
 
 @njit(cache=True)
@@ -358,11 +360,22 @@ def _cholesky_solve(factor, r, z):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def vcycle(
-    indptr, indices, blocks, inverses, aggregates, factor, residuals, corrections, scratch, r, z
+    levels,
+    indptr,
+    indices,
+    blocks,
+    inverses,
+    aggregates,
+    factor,
+    residuals,
+    corrections,
+    scratch,
+    r,
+    z,
 ):  # pragma: no cover - compiled
-    """``z ← B r``, one V(1, 1) cycle (see the module docstring); the lists hold each level's
-    arrays, finest first, and ``residuals``/``corrections``/``scratch`` are work space."""
-    levels = len(aggregates)
+    """``z ← B r``, one V(1, 1) cycle (see the module docstring) over ``levels`` coarse levels;
+    the tuples hold each level's arrays, finest first, and ``residuals``/``corrections``/
+    ``scratch`` are work space."""
     residuals[0][:] = r
     for level in range(levels):
         rl, zl, work = residuals[level], corrections[level], scratch[level]
