@@ -211,3 +211,9 @@ def test_playback_numbers_at_the_edge_of_a_float(monkeypatch, capsys, tmp_path, 
         assert status == 2 and fragment in err, err
     else:
         assert status == 0, err
+
+
+def test_full_is_refused_by_a_demo_without_a_long_version(monkeypatch, capsys, tmp_path):
+    status, _, err = run_main(monkeypatch, capsys, "demo", "pendulum", "--full", "-o", tmp_path)
+    assert status == 2 and "demo 'pendulum' has no long version" in err
+    assert not any(tmp_path.iterdir())

@@ -337,6 +337,12 @@ def demo_command(
         ),
     ] = None,
     fps: Annotated[float, typer.Option(help="Frame rate of -f outputs [frames/s].")] = 30.0,
+    full: Annotated[
+        bool,
+        typer.Option(
+            "--full", help="The long version of a demo cut down to finish within a minute."
+        ),
+    ] = False,
     force: ForceOption = False,
 ) -> None:
     """Run a demonstration and write its recording, summary and figures (no NAME: list them)."""
@@ -350,7 +356,7 @@ def demo_command(
 
     directory = output if output is not None else Path("out") / name
     report = run_demo(
-        name, directory, duration=duration, formats=formats or (), fps=fps, force=force
+        name, directory, duration=duration, formats=formats or (), fps=fps, force=force, full=full
     )
     print_report(report)
 

@@ -41,6 +41,8 @@ class Demo:
             viewer (0: none).
         color_by: What colours the points of the video and the viewer: ``"scene"`` (the
             recorded colours) or ``"speed"``.
+        full: The long version's ``run`` (``visviva demo NAME --full``), for a demo whose
+            default is cut down to finish within a minute; ``None`` if there is none.
     """
 
     name: str
@@ -51,6 +53,7 @@ class Demo:
     speed: float = 1.0
     trail: float = 0.0
     color_by: str = "scene"
+    full: Callable[[JobOutput, float], dict[str, Any]] | None = None
 
 
 _DEMOS: Registry[Demo] = Registry("demo")

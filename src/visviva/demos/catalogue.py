@@ -149,8 +149,8 @@ BUILTIN_DEMOS: dict[str, BuiltinDemo] = {
     ),
     "pile": BuiltinDemo(
         "pile",
-        "10,000 spheres, boxes, capsules, cylinders, cones and rocks fall into a bin and come "
-        "to rest: the whole contact pipeline at scale",
+        "4,096 spheres, boxes, capsules, cylinders, cones and rocks (10,000 with --full) fall "
+        "into a bin and come to rest: the whole contact pipeline at scale",
     ),
     "snow": BuiltinDemo(
         "snow",

@@ -30,6 +30,7 @@ def run_demo(
     formats: Iterable[str] = (),
     fps: float = 30.0,
     force: bool = False,
+    full: bool = False,
 ) -> JobReport:
     """Run demo ``name`` and write its outputs into ``directory``.
 
@@ -41,6 +42,8 @@ def run_demo(
             ``glb``, ``obj``, ``pc2``), for demos with a picture.
         fps: Frame rate of those outputs [frames/s].
         force: Replace outputs that already exist.
+        full: Run the demo's long version (:attr:`Demo.full`), where its default is cut down
+            to finish within a minute.
 
     Returns:
         The files written and the summary (also in ``summary.json``).
@@ -51,6 +54,10 @@ def run_demo(
             ``-interrupted``) and the summary were written (``error.report``).
     """
     demo = find_demo(name)
+    if full and demo.full is None:
+        raise ModelError(
+            f"demo {name!r} has no long version: its default is the whole demo (drop --full)"
+        )
     seconds = (
         demo.duration
         if duration is None
@@ -82,7 +89,7 @@ def run_demo(
         extra: dict[str, Any] = {}
         try:
             with stops.polled():
-                extra = demo.run(output, seconds)
+                extra = (demo.full if full and demo.full else demo.run)(output, seconds)
         except Interrupted as error:
             interrupted = error
             if error.recording is not None:
@@ -96,6 +103,8 @@ def run_demo(
                 "playback_color_by": demo.color_by,
             }
         summary = _summary(demo, output, seconds, interrupted) | extra
+        if full:
+            summary["full"] = True
         if extras and interrupted is None:
             run, primary = next(iter(output.recordings.items()))
             summary["outputs_show_run"] = run
