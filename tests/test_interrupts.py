@@ -196,3 +196,97 @@ def test_a_killed_process_leaves_a_readable_recording_in_its_staging(tmp_path):
     assert result.returncode == 0, result.stderr
     assert "left by a run that was killed" in result.stdout
     assert not list(out.glob(f"{STAGING_PREFIX}*"))
+
+
+def _stop_at_poll(monkeypatch, polls: int) -> None:
+    """The simulation loop sees Ctrl-C at its ``polls``-th look, as if the key was pressed
+    there: deterministic, where a real signal lands wherever the machine's speed puts it."""
+    from visviva.simulation import loop
+
+    seen = 0
+
+    def requested():
+        nonlocal seen
+        seen += 1
+        return "SIGINT" if seen >= polls else None
+
+    monkeypatch.setattr(loop, "stop_requested", requested)
+
+
+DRAWN = {"particle_position", "system_points", "body_origin"}
+
+
+def _exports(monkeypatch, capsys, path: Path, run: str, tmp_path: Path) -> None:
+    """Run ``run`` of the recording at ``path`` exports to a video and to glTF."""
+    from visviva.cli.main import main
+
+    for kind in ("mp4", "glb"):
+        target = tmp_path / f"{run}.{kind}"
+        args = ["export", str(path), "--run", run, "--to", kind, "-o", str(target)]
+        monkeypatch.setattr(sys, "argv", ["visviva", *args])
+        try:
+            main()
+        except SystemExit as exit_:
+            assert not exit_.code, capsys.readouterr().err
+        assert target.stat().st_size > 1000
+
+
+@pytest.mark.parametrize(
+    "demo, polls, finished",
+    [
+        # A study of many runs, cut in its second: the first is kept whole.
+        ("refinement-study", 150, ["corners_6"]),
+        # An abstract system drawn after its run (stars as points): cut, still drawn.
+        ("galaxy", 40, []),
+        # Two pendulums drawn together, then more solves: cut in a later one.
+        ("double-pendulum", 1000, ["rk4"]),
+    ],
+)
+def test_a_demo_cut_short_keeps_its_finished_runs_drawable(
+    tmp_path, monkeypatch, capsys, demo, polls, finished
+):
+    _stop_at_poll(monkeypatch, polls)
+    out = tmp_path / "out"
+    with pytest.raises(Interrupted):
+        run_demo(demo, out)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["complete"] is False and summary["interrupted"] == "SIGINT"
+    runs = vv.io.read_recordings(out / "recording.h5")
+    cut = [name for name in runs if name.endswith("-interrupted")]
+    assert len(cut) == 1 and runs[cut[0]].attrs["complete"] is False
+    assert list(runs)[: len(finished)] == finished  # in the order they finished
+    for name in finished:
+        assert runs[name].attrs.get("complete", True) is not False
+    drawn = [name for name, run in runs.items() if DRAWN & set(run.fields)]
+    assert drawn[0] == next(iter(runs))  # the run the video shows can be drawn
+    for name in drawn:  # and whatever can be drawn exports, cut short or not
+        _exports(monkeypatch, capsys, out / "recording.h5", name, tmp_path)
+
+
+@pytest.fixture(scope="module")
+def mixed_recording():
+    """Particles falling beside a tumbling box, 12 frames."""
+    builder = vv.SceneBuilder(name="mixed")
+    builder.set_integration(method="symplectic_euler", dt=0.01, duration=0.11)
+    builder.add_particles(positions=[[0.0, 1.0, 0.0], [0.5, 1.5, 0.0]], radius=0.05)
+    builder.add_body("box", size=(0.2, 0.1, 0.3), position=(1.0, 1.0, 0.0), density=500.0,
+                     angular_velocity=(1.0, 2.0, 0.0))  # fmt: skip
+    builder.add_collider("plane")
+    return vv.Simulation(builder.build()).record(until=0.11)
+
+
+@pytest.mark.parametrize("frames", [1, 2, 7])
+def test_a_recording_cut_at_any_frame_exports_to_video_and_gltf(
+    tmp_path, monkeypatch, capsys, mixed_recording, frames
+):
+    full = mixed_recording
+    cut = vv.Recording(
+        full.time[:frames],
+        {name: value[:frames] for name, value in full.fields.items()},
+        units=dict(full.units),
+        attrs=dict(full.attrs) | {"complete": False, "interrupted": "SIGINT"},
+        static=dict(full.static),
+    )
+    path = tmp_path / "cut.h5"
+    vv.io.write_recordings(path, {"cut": cut})
+    _exports(monkeypatch, capsys, path, "cut", tmp_path)

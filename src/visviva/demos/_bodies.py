@@ -2,10 +2,27 @@
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Callable, Iterator
+
 import numpy as np
 
 from ..mechanics.lagrangian import LagrangianSystem
+from ..simulation.interrupt import Interrupted
 from ..simulation.recording import Recording
+
+
+@contextlib.contextmanager
+def drawn_if_interrupted(draw: Callable[[Recording], Recording]) -> Iterator[None]:
+    """Inside, a run that Ctrl-C cuts short keeps its frames drawn by ``draw`` as the finished
+    run's would have been: its video, viewer and exports show the same points."""
+    try:
+        yield
+    except Interrupted as stop:
+        cut = getattr(stop, "recording", None)
+        if cut is not None and cut.frames:
+            stop.recording = draw(cut)
+        raise
 
 
 def drawn_system(system: LagrangianSystem, recording: Recording) -> Recording:

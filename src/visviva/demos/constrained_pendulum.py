@@ -18,6 +18,7 @@ from ..mechanics import classic
 from ..simulation.recording import Recording
 from ..simulation.solution import solve
 from . import Demo, register_demo
+from ._bodies import drawn_if_interrupted
 from .catalogue import BUILTIN_DEMOS
 
 LENGTH = 1.0  # [m]
@@ -57,7 +58,8 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
         problem, multiplier = classic.constrained_pendulum(
             THETA0, length=LENGTH, stabilization_rate=alpha
         )
-        particle = solve(problem, "rk4", dt=DT, until=duration)
+        with drawn_if_interrupted(_drawn):
+            particle = solve(problem, "rk4", dt=DT, until=duration)
         label = "particle + λ(r − c)" + (f", Baumgarte α = {alpha:g}/s" if alpha else "")
         output.recordings["constrained" if alpha == 0 else "stabilized"] = _drawn(
             particle.recording

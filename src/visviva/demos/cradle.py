@@ -42,6 +42,7 @@ from ..model import SceneBuilder
 from ..simulation import Simulation
 from ..simulation.recording import Recording
 from . import Demo, register_demo
+from ._bodies import drawn_if_interrupted
 from .catalogue import BUILTIN_DEMOS
 
 COUNT = 5
@@ -172,7 +173,8 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     found = {}
     for impacts in IMPACTS:
         model = scene(impacts, duration).build()
-        recording = with_strings(Simulation(model).record(until=duration))
+        with drawn_if_interrupted(with_strings):
+            recording = with_strings(Simulation(model).record(until=duration))
         output.recordings[impacts] = recording
         found[impacts] = analyse(recording)
 

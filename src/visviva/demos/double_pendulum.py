@@ -9,6 +9,7 @@ on one pivot. Energy: RK4 in ``(θ, θ̇)`` loses it slowly; implicit midpoint i
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -17,8 +18,9 @@ from ..analysis.chaos import lyapunov_exponent
 from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.recording import Recording
-from ..simulation.solution import Solution, solve
+from ..simulation.solution import solve
 from . import Demo, register_demo
+from ._bodies import drawn_if_interrupted
 from .catalogue import BUILTIN_DEMOS
 
 Q0 = np.array([2.0, 1.0])  # released from rest [rad]
@@ -31,19 +33,19 @@ PIVOT_AND_BOBS = (
 )
 
 
-def _together(system: Any, pair: Solution) -> Recording:
+def _together(system: Any, pair: Recording) -> Recording:
     """Both pendulums in one recording: the first one's ``q`` and ``v``, six points and four
     rods, lifted above the ground."""
-    points = np.concatenate([system.points(pair.q[:, i], pair.t) for i in range(2)], axis=1)
+    q, t = pair["q"], pair.time
+    points = np.concatenate([system.points(q[:, i], t) for i in range(2)], axis=1)
     points[..., 1] += 2.2
     edges = np.array(system.edges, dtype=np.int64)
     static = {
         "edges": np.concatenate([edges, edges + 3]),
         "system_color": np.array(PIVOT_AND_BOBS[0] + PIVOT_AND_BOBS[1]),
     }
-    fields = {"q": pair.q[:, 0], "v": pair.v[:, 0], "system_points": points}
-    attrs = pair.recording.attrs
-    return Recording(pair.t, fields, units={"system_points": "m"}, attrs=attrs, static=static)
+    fields = {"q": q[:, 0], "v": pair["v"][:, 0], "system_points": points}
+    return Recording(t, fields, units={"system_points": "m"}, attrs=pair.attrs, static=static)
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
@@ -53,8 +55,10 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     output.stage("equations.txt").write_text(system.text() + "\n")
     output.stage("equations.tex").write_text(system.latex() + "\n")
     problem = system.problem(np.stack([Q0, Q0 + [0.0, DELTA]]), np.zeros((2, 2)))
-    pair = solve(problem, "rk4", dt=DT, until=duration, record_every=10)
-    output.recordings["rk4"] = _together(system, pair)
+    together = functools.partial(_together, system)
+    with drawn_if_interrupted(together):
+        pair = solve(problem, "rk4", dt=DT, until=duration, record_every=10)
+    output.recordings["rk4"] = together(pair.recording)
     difference = np.concatenate([pair.q[:, 1] - pair.q[:, 0], pair.v[:, 1] - pair.v[:, 0]], axis=1)
     separation = np.linalg.norm(difference, axis=1)
     estimate = lyapunov_exponent(

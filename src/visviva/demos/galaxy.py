@@ -19,7 +19,7 @@ from ..io.job import JobOutput
 from ..mechanics import colliding_disks, tree_force_error
 from ..simulation.solution import solve
 from . import Demo, register_demo
-from ._bodies import body_states, drawn_bodies
+from ._bodies import body_states, drawn_bodies, drawn_if_interrupted
 from .catalogue import BUILTIN_DEMOS
 
 BODIES_PER_DISK = 3000
@@ -49,7 +49,8 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     problem = bodies.problem(
         softening=SOFTENING, method="barnes_hut", theta=THETA, name="colliding galaxies"
     )
-    solution = solve(problem, "velocity_verlet", dt=DT, until=duration, record_every=5)
+    with drawn_if_interrupted(drawn_bodies):
+        solution = solve(problem, "velocity_verlet", dt=DT, until=duration, record_every=5)
     output.recordings["velocity_verlet"] = drawn_bodies(solution.recording)
     x, _ = body_states(solution.recording)
     figure = Figure(figsize=(14, 3.8), layout="constrained")

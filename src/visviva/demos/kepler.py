@@ -9,6 +9,7 @@ energy drifts slowly; explicit Euler spirals outwards.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -18,7 +19,7 @@ from ..io.job import JobOutput
 from ..mechanics import kepler_orbit
 from ..simulation.solution import solve
 from . import Demo, register_demo
-from ._bodies import body_states, drawn_bodies
+from ._bodies import body_states, drawn_bodies, drawn_if_interrupted
 from .catalogue import BUILTIN_DEMOS
 
 ECCENTRICITY = 0.5
@@ -51,8 +52,10 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     )
     figures = {}
     for name in METHODS:
-        solution = solve(problem, name, dt=dt, until=duration, record_every=10)
-        output.recordings[name] = drawn_bodies(solution.recording, color=COLORS)
+        draw = functools.partial(drawn_bodies, color=COLORS)
+        with drawn_if_interrupted(draw):
+            solution = solve(problem, name, dt=dt, until=duration, record_every=10)
+        output.recordings[name] = draw(solution.recording)
         x, v = body_states(solution.recording)
         relative_energy = solution.energy / orbit.energy - 1.0
         spin = angular_momentum(masses, x, v)[:, 1]

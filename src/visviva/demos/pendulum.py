@@ -9,6 +9,7 @@ against amplitude, measured from simulations, follows the elliptic curve up to n
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -18,7 +19,7 @@ from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.solution import solve
 from . import Demo, register_demo
-from ._bodies import drawn_system
+from ._bodies import drawn_if_interrupted, drawn_system
 from .catalogue import BUILTIN_DEMOS
 
 LENGTH = 1.0  # [m]
@@ -31,7 +32,8 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     from matplotlib.figure import Figure
 
     system = classic.pendulum(length=LENGTH)
-    solution = solve(system.problem([THETA0], [0.0]), "rk4", dt=DT, until=duration)
+    with drawn_if_interrupted(functools.partial(drawn_system, system)):
+        solution = solve(system.problem([THETA0], [0.0]), "rk4", dt=DT, until=duration)
     output.recordings["rk4"] = drawn_system(system, solution.recording)
     output.stage("equations.txt").write_text(system.text() + "\n")
     output.stage("equations.tex").write_text(system.latex() + "\n")

@@ -4,10 +4,10 @@ settle into a pile.
 Spheres, boxes, capsules, cylinders, cones and convex rocks (the hull of fourteen random
 points), a sixth of each, start on a 16 × 16 × 16 lattice 0.24 m apart (25 × 16 × 25 with
 ``--full``), each turned at random, and fall into a square bin 4.2 m wide (6.4 m): a floor
-and four walls, planes, with restitution 0.1 and friction 0.5. Every pair goes through the whole contact pipeline of issue 27: sweep
-and prune, the analytic ball and box pairs, GJK and EPA with the clipped manifold for the
-rest, sequential impulses warm-started step to step, and the split position correction
-(:mod:`visviva.collision.body_contacts`).
+and four walls, planes, with restitution 0.1 and friction 0.5. Every pair goes through the
+whole contact pipeline of issue 27: sweep and prune, the analytic ball and box pairs, GJK and
+EPA with the clipped manifold for the rest, sequential impulses warm-started step to step,
+and the split position correction (:mod:`visviva.collision.body_contacts`).
 
 The summary gives how many bodies of each shape, the contacts at the end by Baraff's class,
 the deepest overlap, the top of the pile, the fastest body, how many bodies left the bin or

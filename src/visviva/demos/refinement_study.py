@@ -126,7 +126,7 @@ def membrane_moduli(stiffness: float = STIFFNESS, shear: float = STIFFNESS) -> d
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
-    runs: dict[str, Recording] = {}
+    runs = output.recordings  # each run kept as it finishes, so that Ctrl-C keeps it
     corners, curtain, speeds = {}, {}, []
     with one_thread():
         for n in RESOLUTIONS:
@@ -137,10 +137,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
             runs[f"curtain_{n}"], curtain[n] = recording, x.reshape(n, n, 3)
             speeds.append(speed)
         structure = _structure_study(runs, duration, speeds)
-    largest = f"corners_{RESOLUTIONS[-1]}"  # the video shows the finest cloth first
-    output.recordings[largest] = runs.pop(largest)
-    for name, recording in runs.items():
-        output.recordings[name] = recording
+    output.show_first(f"corners_{RESOLUTIONS[-1]}")  # the video shows the finest cloth
     sag = {n: HEIGHT - float(grid[0, n // 2, 1]) for n, grid in corners.items()}
     drop = {n: HEIGHT - SIZE - float(grid[-1, :, 1].mean()) for n, grid in curtain.items()}
     moduli = membrane_moduli()

@@ -8,6 +8,7 @@ velocity at the start of each step), symplectic Euler's too low by the same.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -16,7 +17,7 @@ from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.solution import solve
 from . import Demo, register_demo
-from ._bodies import drawn_system
+from ._bodies import drawn_if_interrupted, drawn_system
 from .catalogue import BUILTIN_DEMOS
 
 DT = 0.05  # step [s]
@@ -34,7 +35,8 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     path, error = figure.subplots(1, 2)
     errors = {}
     for name in METHODS:
-        solution = solve(problem, name, dt=DT, until=duration)
+        with drawn_if_interrupted(functools.partial(drawn_system, system)):
+            solution = solve(problem, name, dt=DT, until=duration)
         output.recordings[name] = drawn_system(system, solution.recording)
         exact = classic.rock_trajectory(solution.t, Q0, V0)
         height_error = solution.q[:, 1] - exact[:, 1]

@@ -7,6 +7,7 @@ autoparametric resonance); the total stays constant, which RK4 at h = 1 ms keeps
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -16,7 +17,7 @@ from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.solution import solve
 from . import Demo, register_demo
-from ._bodies import drawn_system
+from ._bodies import drawn_if_interrupted, drawn_system
 from .catalogue import BUILTIN_DEMOS
 
 MASS, REST = 1.0, 1.0  # [kg], [m]
@@ -31,13 +32,14 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 
     system = classic.spring_pendulum(mass=MASS, stiffness=STIFFNESS, rest_length=REST)
     hanging = REST + MASS * G / STIFFNESS  # equilibrium length [m]
-    solution = solve(
-        system.problem([hanging + 0.05, 0.3], [0.0, 0.0]),
-        "rk4",
-        dt=DT,
-        until=duration,
-        record_every=10,
-    )
+    with drawn_if_interrupted(functools.partial(drawn_system, system)):
+        solution = solve(
+            system.problem([hanging + 0.05, 0.3], [0.0, 0.0]),
+            "rk4",
+            dt=DT,
+            until=duration,
+            record_every=10,
+        )
     output.recordings["rk4"] = drawn_system(system, solution.recording)
     r, theta = solution.q[:, 0], solution.q[:, 1]
     rdot, omega = solution.v[:, 0], solution.v[:, 1]

@@ -102,7 +102,7 @@ def _run(stiffness: float, method: str, duration: float) -> tuple[Simulation, Re
 
 
 def run(output: JobOutput, duration: float) -> dict[str, Any]:
-    runs: dict[str, Recording] = {}
+    runs = output.recordings  # each run kept as it finishes, so that Ctrl-C keeps it
     table = []
     with one_thread():
         for k in STIFFNESS:
@@ -136,10 +136,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
                 }
             table.append(row)
     # The first run is the one the video shows: the stiffest cloth, at 1/60 s, implicit.
-    shown = f"{IMPLICIT[0]}_k{STIFFNESS[-1]:g}"
-    output.recordings[shown] = runs.pop(shown)
-    for name, recording in runs.items():
-        output.recordings[name] = recording
+    output.show_first(f"{IMPLICIT[0]}_k{STIFFNESS[-1]:g}")
     output.figures["stiffness_study"] = _figure(table, output.recordings)
     return {
         "dt": DT,

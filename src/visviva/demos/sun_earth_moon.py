@@ -8,6 +8,7 @@ to about 0.1%); the total energy and angular momentum are conserved.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -17,7 +18,7 @@ from ..io.job import JobOutput
 from ..mechanics import sun_earth_moon
 from ..simulation.solution import solve
 from . import Demo, register_demo
-from ._bodies import body_states, drawn_bodies
+from ._bodies import body_states, drawn_bodies, drawn_if_interrupted
 from .catalogue import BUILTIN_DEMOS
 
 DAY = 86_400.0  # [s]
@@ -53,12 +54,12 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     from matplotlib.figure import Figure
 
     bodies = sun_earth_moon()
-    solution = solve(
-        bodies.problem(name="Sun-Earth-Moon"), "velocity_verlet", dt=DT, until=duration
-    )
-    output.recordings["velocity_verlet"] = drawn_bodies(
-        solution.recording, color=COLORS, display_radius=DISPLAY_RADIUS
-    )
+    draw = functools.partial(drawn_bodies, color=COLORS, display_radius=DISPLAY_RADIUS)
+    with drawn_if_interrupted(draw):
+        solution = solve(
+            bodies.problem(name="Sun-Earth-Moon"), "velocity_verlet", dt=DT, until=duration
+        )
+    output.recordings["velocity_verlet"] = draw(solution.recording)
     x, v = body_states(solution.recording)
     earth = x[:, 1] - x[:, 0]
     moon = x[:, 2] - x[:, 1]

@@ -128,6 +128,12 @@ class JobOutput:
     def __exit__(self, *exc_info: object) -> None:
         self.discard()
 
+    def show_first(self, run: str) -> None:
+        """Make recording ``run`` the first: the one the video, viewer and exports show. A
+        job adds each run to :attr:`recordings` as it finishes (so that Ctrl-C keeps it), then
+        puts the one to show in front."""
+        self.recordings = {run: self.recordings[run]} | self.recordings
+
     def planned(self) -> list[str]:
         """File names this job will write."""
         names = ["recording.h5"] if self.recordings or "recording.h5" in self.staged else []

@@ -368,7 +368,12 @@ class Simulation:
         try:
             self.run(until, record_every=every, on_frame=keep, progress=progress)
         except (SimulationError, Interrupted) as stopped:
-            stopped.recording = recording()
+            cut = recording()
+            # As solve() marks a run that stopped early: complete, success, why.
+            cut.attrs |= {"complete": False, "success": False, "message": str(stopped)}
+            if isinstance(stopped, Interrupted):
+                cut.attrs["interrupted"] = stopped.signal
+            stopped.recording = cut
             raise
         return recording()
 
