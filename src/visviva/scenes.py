@@ -11,6 +11,7 @@ recording and summary (``success: false``) and then raises the divergence.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 import warnings
@@ -41,8 +42,32 @@ __all__ = [
     "final_values",
     "load_model",
     "run_scene",
+    "with_view",
     "write_run",
 ]
+
+
+def with_view(model: Model, camera: str | None, frame: str | None) -> Model:
+    """``model`` with the view of its videos and viewer replaced (``--camera``, ``--frame``;
+    ``None`` keeps the scene's), both checked before anything runs. A framing given alone
+    replaces the scene's camera."""
+    from .model.build import frame_problem
+    from .viz.framing import parse_camera
+
+    if camera is not None:
+        parse_camera(camera)  # a bad one is refused now, not after the run
+    if frame is not None:
+        problem = frame_problem(model, frame)
+        if problem is not None:
+            raise ModelError(f"--frame: {problem}")
+    if camera is None and frame is None:
+        return model
+    kept = model.output_camera if frame is None else None
+    return dataclasses.replace(
+        model,
+        output_camera=camera if camera is not None else kept,
+        output_frame=frame if frame is not None else model.output_frame,
+    )
 
 
 def load_model(path: str | os.PathLike[str]) -> Model:
@@ -83,7 +108,8 @@ class DryRun:
         steps: Steps of ``dt`` to the end.
         frames: Frames the recording would hold.
         max_stable_dt: The stability advisor's largest stable step for the method at the
-            initial state [s] (``inf``: no limit from the linearization).
+            initial state [s] (``inf``: no limit from the linearization; ``None``: rigid
+            bodies, which the advisor does not linearize).
         outputs: Files the run would write.
     """
 
@@ -91,7 +117,7 @@ class DryRun:
     systems: tuple[str, ...]
     steps: int
     frames: int
-    max_stable_dt: float
+    max_stable_dt: float | None
     outputs: tuple[str, ...]
 
 
@@ -105,7 +131,10 @@ def dry_run(model: Model, *, duration: float | None = None, formats: Iterable[st
     seconds = _duration(model, duration)
     settings = model.integration
     steps = math.ceil(seconds / settings.dt - 1e-9)
-    limit = largest_stable_step(model.system(), get(settings.method), model.initial_state())
+    try:
+        limit = largest_stable_step(model.system(), get(settings.method), model.initial_state())
+    except ModelError:  # not linearizable as q'' = F(q, v): rigid bodies' quaternions
+        limit = None
     return DryRun(
         particles=model.particle_count,
         systems=tuple(s.system for s in model.systems),
@@ -340,21 +369,26 @@ def recording_attrs(model: Model, seconds: float) -> dict[str, Any]:
     from .simulation import frames
 
     settings = model.integration
-    return {
-        "scene": model.source or dump_scene(model.scene),
-        "scene_name": model.name,
-        "visviva_version": __version__,
-        "method": settings.method,
-        "dt": settings.dt,
-        "substeps": settings.substeps,
-        "record_every": settings.record_every,
-        "t0": 0.0,
-        "until": seconds,
-        "playback_speed": model.output_speed,
-        "playback_trail": model.output_trail,
-        "playback_color_by": model.output_color_by,
-        "compiled": False,
-    } | frames.recording_attrs(model)
+    return (
+        {
+            "scene": model.source or dump_scene(model.scene),
+            "scene_name": model.name,
+            "visviva_version": __version__,
+            "method": settings.method,
+            "dt": settings.dt,
+            "substeps": settings.substeps,
+            "record_every": settings.record_every,
+            "t0": 0.0,
+            "until": seconds,
+            "playback_speed": model.output_speed,
+            "playback_trail": model.output_trail,
+            "playback_color_by": model.output_color_by,
+            "playback_frame": model.output_frame,
+            "compiled": False,
+        }
+        | ({} if model.output_camera is None else {"playback_camera": model.output_camera})
+        | (frames.recording_attrs(model))
+    )
 
 
 def final_attrs(

@@ -264,6 +264,12 @@ def state_jacobian(system: System, state: State) -> Any:
     if not system.second_order:
         return system.jacobian(state.t, state.parts[0])  # type: ignore[union-attr]
     q, v = state.parts
+    if q.shape != v.shape:
+        # Rigid bodies: orientations as quaternions (4 numbers) against 3 angular velocities.
+        raise ModelError(
+            "the stability advisor linearizes q'' = F(q, v) with as many coordinates as "
+            f"velocities; this system has {q.shape[-1]} and {v.shape[-1]} (rigid bodies)"
+        )
     stiffness, damping = system.force_jacobian(state.t, q, v)  # type: ignore[union-attr]
     mass = system.mass  # type: ignore[union-attr]
     n = q.shape[-1]

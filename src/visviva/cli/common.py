@@ -20,6 +20,22 @@ app = typer.Typer(
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON.")]
 ForceOption = Annotated[bool, typer.Option("--force", help="Replace existing output files.")]
+CameraOption = Annotated[
+    str | None,
+    typer.Option(
+        "--camera",
+        help='The view of the video and the viewer: "eye=X,Y,Z target=X,Y,Z [up=X,Y,Z] '
+        "[fov=DEGREES]\" [m]; default: the run's, else a framing (--frame).",
+    ),
+]
+FrameOption = Annotated[
+    str | None,
+    typer.Option(
+        "--frame",
+        help="Without --camera, what the view keeps in the picture for the whole run: all, "
+        "or the name of one rigid body; default: the run's, else all.",
+    ),
+]
 
 
 def print_json(data: Any) -> None:

@@ -21,7 +21,9 @@ if TYPE_CHECKING:
     from ..ode.system import System
 
 from .common import (
+    CameraOption,
     ForceOption,
+    FrameOption,
     JsonOption,
     app,
     check_figure_file,
@@ -343,6 +345,8 @@ def demo_command(
             "--full", help="The long version of a demo cut down to finish within a minute."
         ),
     ] = False,
+    camera: CameraOption = None,
+    frame: FrameOption = None,
     force: ForceOption = False,
 ) -> None:
     """Run a demonstration and write its recording, summary and figures (no NAME: list them)."""
@@ -356,7 +360,15 @@ def demo_command(
 
     directory = output if output is not None else Path("out") / name
     report = run_demo(
-        name, directory, duration=duration, formats=formats or (), fps=fps, force=force, full=full
+        name,
+        directory,
+        duration=duration,
+        formats=formats or (),
+        fps=fps,
+        force=force,
+        full=full,
+        camera=camera,
+        frame=frame,
     )
     print_report(report)
 

@@ -9,7 +9,9 @@ from typing import Annotated, Any
 import typer
 
 from .common import (
+    CameraOption,
     ForceOption,
+    FrameOption,
     app,
     check_figure_file,
     print_json,
@@ -72,23 +74,26 @@ def run_command(
             "(default: the scene's, 0.01)."
         ),
     ] = None,
+    camera: CameraOption = None,
+    frame: FrameOption = None,
     force: ForceOption = False,
 ) -> None:
     """Run a scene: recording.h5, summary.json and the requested outputs into a directory."""
     from ..scenes import dry_run as plan
-    from ..scenes import load_model, run_scene
+    from ..scenes import load_model, run_scene, with_view
 
-    model = load_model(scene)
+    model = with_view(load_model(scene), camera, frame)
     if dry_run:
         estimate = plan(model, duration=duration, formats=formats or ())
-        held = [f"{estimate.particles} particles"] if estimate.particles else []
-        what = ", ".join(held + [f"system {name}" for name in estimate.systems])
+        what = _held(model)
         limit, settings = estimate.max_stable_dt, model.integration
         # The integrator takes steps of h = dt / substeps: that is what must be stable.
         h = settings.dt / settings.substeps
         step = f"h = dt / {settings.substeps} = {h:.4g} s" if settings.substeps > 1 else "dt"
         advice = (
-            "no step limit from the linearization"
+            "no stable-step advice (the advisor does not linearize rigid bodies)"
+            if limit is None
+            else "no step limit from the linearization"
             if math.isinf(limit)
             else f"largest stable step for {settings.method} ≈ {limit:.4g} s"
             + (f" ({step} is above it!)" if h > limit else f" ({step} is within it)")
@@ -115,12 +120,17 @@ def validate_command(scene: SceneArgument) -> None:
     from ..scenes import load_model
 
     model = load_model(scene)
+    what = _held(model)
+    typer.echo(f"{scene}: valid ({what}, method {model.integration.method})")
+
+
+def _held(model: Any) -> str:
+    """What a scene holds: "400 particles, system pendulum, 3 rigid bodies"."""
     held = [f"{model.particle_count} particles"] if model.particle_count else []
     held += [f"system {s.system}" for s in model.systems]
     if model.body_count:
         held.append(f"{model.body_count} rigid bod{'y' if model.body_count == 1 else 'ies'}")
-    what = ", ".join(held)
-    typer.echo(f"{scene}: valid ({what}, method {model.integration.method})")
+    return ", ".join(held)
 
 
 @app.command("schema")
@@ -195,6 +205,8 @@ def view_command(
     trail: TrailOption = None,
     color_by: ColorByOption = None,
     run: RunOption = None,
+    camera: CameraOption = None,
+    frame: FrameOption = None,
     force: ForceOption = False,
 ) -> None:
     """Write the single-file web viewer of a recording (open it in any browser)."""
@@ -206,7 +218,7 @@ def view_command(
     target = output or recording.with_name("viewer.html")
     check_new_file(target, force=force)
     source = load_recording(recording, run)
-    chosen = playback(source, speed, trail, color_by)
+    chosen = playback(source, speed, trail, color_by, camera, frame)
     written = write_viewer(
         source,
         target,
@@ -214,6 +226,8 @@ def view_command(
         speed=chosen.speed,
         trail=chosen.trail,
         color_by=chosen.color_by,
+        camera=chosen.camera,
+        frame=chosen.frame,
     )
     typer.echo(f"wrote {written}; open it in a browser (file://{written.resolve()})")
 
@@ -234,6 +248,8 @@ def export_command(
         typer.Option("--size", help="Video size WIDTHxHEIGHT in pixels (mp4, gif), e.g. 1280x720."),
     ] = None,
     run: RunOption = None,
+    camera: CameraOption = None,
+    frame: FrameOption = None,
     force: ForceOption = False,
 ) -> None:
     """Export a recording for Blender/Houdini (USD, glTF, OBJ, PC2) or as a video."""
@@ -260,7 +276,7 @@ def export_command(
     else:
         check_new_file(target, force=force)
     source = load_recording(recording, run)
-    chosen = playback(source, speed, trail, color_by)
+    chosen = playback(source, speed, trail, color_by, camera, frame)
     if video:
         from ..viz.video import render_video
 
@@ -273,6 +289,8 @@ def export_command(
                 speed=chosen.speed,
                 trail=chosen.trail,
                 color_by=chosen.color_by,
+                camera=chosen.camera,
+                frame=chosen.frame,
             )
         ]
     else:

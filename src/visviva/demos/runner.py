@@ -12,6 +12,7 @@ from .._validation import real_number
 from ..errors import ModelError
 from ..io.job import JobOutput, JobReport, python_warnings, run_summary
 from ..simulation.interrupt import Interrupted, StopOnSignal
+from ..viz.framing import parse_camera
 from ..viz.outputs import output_names, write_output
 from . import Demo, demos, find_demo
 
@@ -31,6 +32,8 @@ def run_demo(
     fps: float = 30.0,
     force: bool = False,
     full: bool = False,
+    camera: str | None = None,
+    frame: str | None = None,
 ) -> JobReport:
     """Run demo ``name`` and write its outputs into ``directory``.
 
@@ -44,6 +47,10 @@ def run_demo(
         force: Replace outputs that already exist.
         full: Run the demo's long version (:attr:`Demo.full`), where its default is cut down
             to finish within a minute.
+        camera: The view of the video and the viewer,
+            ``"eye=x,y,z target=x,y,z [up=x,y,z] [fov=degrees]"``; default: a framing.
+        frame: Without ``camera``, what the framing keeps in view: ``"all"`` (default) or a
+            rigid body's name.
 
     Returns:
         The files written and the summary (also in ``summary.json``).
@@ -77,6 +84,9 @@ def run_demo(
             f"{', '.join(d.name for d in demos().values() if d.picture)}"
         )
     fps = real_number("fps", fps, positive=True, unit=" frames/s")
+    if camera is not None:
+        parse_camera(camera)  # a bad one is refused before the demo runs
+    view = {"playback_frame": frame or "all"} | ({"playback_camera": camera} if camera else {})
     with (
         warnings.catch_warnings(record=True) as caught,
         StopOnSignal() as stops,
@@ -87,6 +97,7 @@ def run_demo(
         started = time.perf_counter()
         interrupted: Interrupted | None = None
         extra: dict[str, Any] = {}
+        unwritten: list[str] = []
         try:
             with stops.polled():
                 extra = (demo.full if full and demo.full else demo.run)(output, seconds)
@@ -101,7 +112,7 @@ def run_demo(
                 "playback_speed": demo.speed,
                 "playback_trail": demo.trail,
                 "playback_color_by": demo.color_by,
-            }
+            } | view
         summary = _summary(demo, output, seconds, interrupted) | extra
         if full:
             summary["full"] = True
@@ -112,6 +123,8 @@ def run_demo(
                 try:
                     with output.writing(file_name) as path:
                         write_output(primary, path, fps, demo.speed, demo.trail, demo.color_by)
+                except ModelError as error:  # a bad --frame, say: the runs are kept all the same
+                    unwritten.append(f"{file_name} was not written: {error}")
                 except KeyboardInterrupt:
                     interrupted = Interrupted(stops.requested or "SIGINT", seconds)
                     summary["interrupted"] = interrupted.signal
@@ -119,10 +132,15 @@ def run_demo(
                     break
         summary["wall_time_s"] = time.perf_counter() - started
         summary["warnings"] = python_warnings(caught)
+        summary["warnings"] += [{"kind": "output", "message": line} for line in unwritten]
         report = output.write(summary)
     if interrupted is not None:
         interrupted.report = report
         raise interrupted
+    if unwritten:
+        failure = ModelError("; ".join(unwritten) + " (the recording and summary were kept)")
+        failure.report = report  # type: ignore[attr-defined]
+        raise failure
     return report
 
 

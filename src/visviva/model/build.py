@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from .._compiling import watch_compiles
+from .._registry import did_you_mean
 from .._validation import describe
 from ..entities import entity_kinds
 from ..entities.checks import entity_names
@@ -103,6 +104,8 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         output_speed=scene.output.speed,
         output_trail=scene.output.trail,
         output_color_by=scene.output.color_by,
+        output_camera=None if scene.output.camera is None else scene.output.camera.text(),
+        output_frame=scene.output.frame,
         source=source,
     )
     problems = _check_start(model)
@@ -276,6 +279,17 @@ def _hold(context: BuildContext) -> None:
     context.stages.append(stage)
 
 
+def frame_problem(model: Model, frame: str) -> str | None:
+    """What is wrong with framing ``frame`` (``"all"`` or a body's name) in ``model``'s
+    videos, or ``None``."""
+    bodies = () if model.bodies is None else model.bodies.names
+    if frame == "all" or frame in bodies:
+        return None
+    shown = ", ".join(repr(name) for name in bodies[:20]) or "this scene has none"
+    close = did_you_mean(frame, bodies)
+    return f"frame {frame!r} is neither 'all' nor a body's name.{close} Bodies: {shown}"
+
+
 def _check_start(model: Model) -> list[SceneProblem]:
     """Problems only the built model shows: a state that overflowed while being placed, or
     values that cannot give a finite start (``omega = 1e200`` squares to inf, a mass of 1e200
@@ -284,6 +298,9 @@ def _check_start(model: Model) -> list[SceneProblem]:
     The model's system is built and its initial acceleration and energy are evaluated once, so
     a scene that ``visviva validate`` accepts also starts in ``visviva run``.
     """
+    framing = frame_problem(model, model.output_frame)
+    if framing is not None:
+        return [SceneProblem("output.frame", framing)]
     for name in ("particle_position", "particle_velocity"):
         bad = ~np.isfinite(getattr(model, name))
         if bad.any():

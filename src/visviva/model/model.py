@@ -123,6 +123,10 @@ class Model:
         output_trail: Simulated seconds of each point's path drawn behind it [s].
         output_color_by: What colours the points of videos and the viewer: ``"scene"`` or
             ``"speed"``.
+        output_camera: The view of videos and the viewer as
+            :func:`~visviva.viz.framing.parse_camera` reads it, or ``None``: a framing.
+        output_frame: Without a camera, what the view keeps in the picture: ``"all"`` or a
+            body's name.
         source: The scene file's text, if it came from a file (kept in recordings).
     """
 
@@ -154,6 +158,8 @@ class Model:
     output_speed: float = 1.0
     output_trail: float = 0.0
     output_color_by: str = "scene"
+    output_camera: str | None = None
+    output_frame: str = "all"
     source: str | None = field(default=None, repr=False)
 
     @property

@@ -105,6 +105,29 @@ class Integration(Strict):
         return method
 
 
+class OutputCamera(Strict):
+    """``[output] camera``: the view of videos and the viewer's first view."""
+
+    eye: Vector = Field(description="camera position [m]")
+    target: Vector = Field(description="point at the centre of the picture [m]")
+    up: Vector = Field((0.0, 1.0, 0.0), description="direction shown upward (the viewer: +Y)")
+    fov: Annotated[float, Field(strict=False, gt=0, lt=180, allow_inf_nan=False)] = Field(
+        45.0, description="vertical field of view [degrees]"
+    )
+
+    def text(self) -> str:
+        """``"eye=x,y,z target=x,y,z up=x,y,z fov=deg"``: how recordings keep it and
+        ``--camera`` takes it (:func:`visviva.viz.framing.parse_camera`)."""
+
+        def numbers(vector: Any) -> str:
+            return ",".join(repr(float(v)) for v in vector)
+
+        return (
+            f"eye={numbers(self.eye)} target={numbers(self.target)} up={numbers(self.up)} "
+            f"fov={float(self.fov)!r}"
+        )
+
+
 class Output(Strict):
     """``[output]``: files ``visviva run`` writes besides the recording and the summary."""
 
@@ -126,6 +149,14 @@ class Output(Strict):
         "scene",
         description="what colours the points of videos and the viewer: scene (the entities' "
         "colours) or speed (purple at rest to yellow at the fastest)",
+    )
+    camera: OutputCamera | None = Field(
+        None, description="the view {eye, target, up, fov}; default: a framing (see frame)"
+    )
+    frame: Name = Field(
+        "all",
+        description="without camera, what the view keeps in the picture for the whole run: "
+        "all, or the name of one rigid body",
     )
 
 

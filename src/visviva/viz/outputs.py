@@ -8,11 +8,14 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from pathlib import Path
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 from .._registry import did_you_mean
 from ..errors import ModelError
 from ..simulation.recording import Recording
+
+if TYPE_CHECKING:
+    from .video import Camera
 
 __all__ = ["OUTPUT_FILES", "Playback", "output_names", "playback", "write_output"]
 
@@ -51,17 +54,21 @@ def write_output(
 ) -> None:
     """Write one output (video, viewer or export, chosen by the suffix of ``path``) at ``fps``
     frames per second, playing ``speed`` simulated seconds per second; the video and the viewer
-    draw ``trail`` simulated seconds of each point's path behind it and colour the points by
-    ``color_by`` (``"scene"`` or ``"speed"``)."""
+    draw ``trail`` simulated seconds of each point's path behind it, colour the points by
+    ``color_by`` (``"scene"`` or ``"speed"``) and take the view the recording keeps
+    (:func:`playback`)."""
     suffix = path.suffix.lower()
+    view = playback(recording, speed, trail, color_by)
     if suffix in (".mp4", ".gif"):
         from .video import render_video
 
-        render_video(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by)
+        render_video(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by,
+                     camera=view.camera, frame=view.frame)  # fmt: skip
     elif suffix == ".html":
         from .viewer import write_viewer
 
-        write_viewer(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by)
+        write_viewer(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by,
+                     camera=view.camera, frame=view.frame)  # fmt: skip
     else:
         from ..io.export import export_recording
 
@@ -71,11 +78,14 @@ def write_output(
 
 class Playback(NamedTuple):
     """How an output plays a recording: simulated seconds per second, the trail behind each
-    point [s], and what colours the points (``"scene"`` or ``"speed"``)."""
+    point [s], what colours the points (``"scene"`` or ``"speed"``), the camera (``None``: a
+    framing) and what the framing keeps in view (``"all"`` or a body's name)."""
 
     speed: float
     trail: float
     color_by: str
+    camera: Camera | None = None
+    frame: str = "all"
 
 
 def playback(
@@ -83,13 +93,17 @@ def playback(
     speed: float | None,
     trail: float | None,
     color_by: str | None = None,
+    camera: str | None = None,
+    frame: str | None = None,
 ) -> Playback:
     """The playback ``speed`` [simulated s per s], ``trail`` [s] and ``color_by`` of an output
     made later from ``recording``: the ones given, else those its run was made with
     (``visviva run`` and ``visviva demo`` store them as the attributes ``playback_speed``,
     ``playback_trail`` and ``playback_color_by``), else 1, 0 and ``"scene"``. So
     ``visviva export REC --to mp4`` plays a year of orbits at the week per second
-    ``visviva run -f mp4`` chose, not a year of video."""
+    ``visviva run -f mp4`` chose, not a year of video. The same for the view: ``camera`` (as
+    :func:`~visviva.viz.framing.parse_camera` reads it) and ``frame``, else the recording's
+    ``playback_camera`` and ``playback_frame``, else the framing of everything."""
     attrs = recording.attrs
     if speed is None:
         speed = float(attrs.get("playback_speed", 1.0))
@@ -97,4 +111,10 @@ def playback(
         trail = float(attrs.get("playback_trail", 0.0))
     if color_by is None:
         color_by = str(attrs.get("playback_color_by", "scene"))
-    return Playback(speed, trail, color_by)
+    if camera is None and frame is None:  # a framing given now replaces the kept camera
+        camera = attrs.get("playback_camera")
+    if frame is None:
+        frame = str(attrs.get("playback_frame", "all"))
+    from .framing import parse_camera
+
+    return Playback(speed, trail, color_by, None if camera is None else parse_camera(camera), frame)

@@ -48,7 +48,7 @@ from ..errors import ModelError
 from ..io.files import atomic_path
 from ..io.timeline import frames_at_rate
 from ..simulation.recording import Geometry, Recording
-from .frame import FramePainter, drawn_bounds
+from .frame import FramePainter
 from .speed_colors import check_color_mode, colored_by_speed
 
 __all__ = [
@@ -206,6 +206,7 @@ def render_video(
     speed: float = 1.0,
     trail: float = 0.0,
     color_by: str = "scene",
+    frame: str = "all",
 ) -> Path:
     """Render a recording's geometry to an mp4 or GIF file.
 
@@ -217,8 +218,8 @@ def render_video(
             Written atomically: a temporary file renamed when complete.
         fps: Output frames per second [1/s]; at most 50 for GIF.
         size: ``(width, height)`` [px]; both even for mp4 (yuv420p halves the colour planes).
-        camera: The view; default :meth:`Camera.framing` of the bounds of the live points and
-            the bodies of all frames, so that everything stays in view for the whole clip.
+        camera: The view; default :meth:`Camera.framing` of what ``frame`` names, over all
+            frames, so that it stays in view for the whole clip.
         progress: Show a progress bar on stderr for long renders; ``None`` (default): only
             when stderr is a terminal.
         speed: Simulated seconds per second of video (1: real time; 86400: a day per
@@ -228,6 +229,8 @@ def render_video(
             it (0: none); for at most :data:`MAX_TRAIL_POINTS` points.
         color_by: ``"scene"``: the recorded colours; ``"speed"``: each point's speed in each
             frame (:mod:`visviva.viz.speed_colors`), the scale in the corner label.
+        frame: Without ``camera``, what the view keeps in the picture: ``"all"`` (the live
+            points and the bodies) or the name of one rigid body (:mod:`visviva.viz.framing`).
 
     Returns:
         The path written.
@@ -290,8 +293,9 @@ def render_video(
         )
     shown = frames_at_rate(recording.time, fps, speed=speed)
 
-    if camera is None:
-        camera = Camera.framing(drawn_bounds(geometry), aspect=width / height)
+    from .framing import chosen_camera
+
+    camera = chosen_camera(geometry, camera, frame, width / height)
     painter = FramePainter(geometry, (width, height), camera, recording.time, trail, caption)
     times = recording.time[shown]
     from ..simulation.progress import Progress

@@ -22,6 +22,7 @@ import warnings
 from functools import cache
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -30,8 +31,9 @@ from ...errors import ModelError
 from ...io.files import atomic_path
 from ...io.timeline import check_playback, frames_at_rate
 from ...simulation.recording import Geometry, Recording
+from ..framing import ALL, chosen_camera
 from ..speed_colors import check_color_mode, colored_by_speed
-from ..video import MAX_TRAIL_POINTS
+from ..video import MAX_TRAIL_POINTS, Camera
 from ._payload import encode_payload, to_json
 
 __all__ = ["FALLBACK_FPS", "MAX_DEFAULT_FPS", "MAX_POSITION_BYTES", "default_fps", "write_viewer"]
@@ -209,6 +211,8 @@ def write_viewer(
     speed: float = 1.0,
     trail: float = 0.0,
     color_by: str = "scene",
+    camera: Camera | None = None,
+    frame: str = "all",
 ) -> Path:
     """Write ``recording``'s animation as one self-contained HTML file.
 
@@ -232,6 +236,10 @@ def write_viewer(
             (0: none); for at most :data:`~visviva.viz.video.MAX_TRAIL_POINTS` points.
         color_by: ``"scene"``: the recorded colours; ``"speed"``: each point's speed in each
             frame (:mod:`visviva.viz.speed_colors`), the scale in the legend.
+        camera: The page's first view (eye, target and field of view; the page keeps +Y up);
+            default: the framing of ``frame``.
+        frame: Without ``camera``, what the first view keeps in the picture over the whole
+            run: ``"all"`` or the name of one rigid body (:mod:`visviva.viz.framing`).
 
     Returns:
         The path written.
@@ -280,6 +288,8 @@ def write_viewer(
     )
     if scale is not None:
         payload["legend"].append(["colour", scale.caption()])
+    if camera is not None or frame != ALL:
+        payload["view"] = _home_view(chosen_camera(geometry, camera, frame, 16 / 9))
     parts = {
         "title": html.escape(page_title, quote=False),
         "three": _asset("three.min.js"),
@@ -290,3 +300,17 @@ def write_viewer(
     with atomic_path(target) as temporary:
         temporary.write_text(page, encoding="utf-8")
     return target
+
+
+def _home_view(camera: Camera) -> dict[str, Any]:
+    """``camera`` as the page's orbit view: its target, distance [m], polar angle from +Y and
+    azimuth from +Z towards +X [rad], and vertical field of view [degrees]."""
+    offset = np.subtract(camera.eye, camera.target)
+    distance = float(np.linalg.norm(offset))
+    return {
+        "target": list(camera.target),
+        "distance": distance,
+        "polar": float(np.arccos(np.clip(offset[1] / distance, -1.0, 1.0))),
+        "azimuth": float(np.arctan2(offset[0], offset[2])),
+        "fov": camera.field_of_view,
+    }

@@ -471,8 +471,15 @@
 
   /* Orbit camera: spherical coordinates (distance, polar angle from +Y, azimuth from +Z)
    * around a target point; drag orbits, right- or shift-drag pans, the wheel zooms. */
-  const camera = new THREE.PerspectiveCamera(FIELD_OF_VIEW, 1, 0.01, 100);
-  const home = {
+  // The scene's own first view, if it set a camera or framed one body; else the whole scene.
+  const given = data.view;
+  const camera = new THREE.PerspectiveCamera(given ? given.fov : FIELD_OF_VIEW, 1, 0.01, 100);
+  const home = given ? {
+    target: new THREE.Vector3().fromArray(given.target),
+    distance: given.distance,
+    polar: given.polar,
+    azimuth: given.azimuth,
+  } : {
     target: centre.clone(),
     distance: (FRAMING_MARGIN * 0.5 * size) / Math.sin((FIELD_OF_VIEW * Math.PI) / 360),
     polar: 1.15,
