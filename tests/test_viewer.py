@@ -509,3 +509,21 @@ def test_contacts_are_drawn_when_the_box_is_ticked(browser, tmp_path):
         assert page.page.is_hidden("#contacts")
     finally:
         page.page.close()
+
+
+def test_walls_and_a_scene_camera_reach_the_page(browser, tmp_path):
+    """The ball pit's four walls load as translucent meshes, and a scene's camera is the
+    page's first view (the camera's distance from its target)."""
+    scene = Path(__file__).parents[1] / "examples" / "scenes" / "ball_pit.toml"
+    recording = vv.Simulation(vv.load_model(scene)).record(until=0.05)
+    camera = vv.viz.video.Camera((0.0, 2.0, 3.0), (0.0, 0.5, 0.0), field_of_view=40.0)
+    opened = Opened(browser, write_viewer(recording, tmp_path / "pit.html", camera=camera))
+    try:
+        assert opened.errors == []
+        walls = opened.js("visviva.walls()")
+        assert len(walls) == 4 and all(0.0 < wall["opacity"] < 1.0 for wall in walls)
+        view = opened.js("visviva.view()")
+        assert view["target"] == pytest.approx([0.0, 0.5, 0.0])
+        assert view["distance"] == pytest.approx(np.hypot(1.5, 3.0))
+    finally:
+        opened.page.close()

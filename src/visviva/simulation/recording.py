@@ -70,7 +70,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .body_geometry import BodyGeometry, read_bodies
-from .scenery import Scenery, read_scenery
+from .scenery import Scenery, Walls, read_scenery, read_walls
 
 __all__ = ["Geometry", "Recording"]
 
@@ -104,6 +104,7 @@ class Geometry:
             of them, always). Outputs draw only the live points of each frame.
         bodies: The rigid bodies' surfaces and transforms, or ``None``.
         scenery: The static colliders' surfaces, or ``None``.
+        walls: The planes other than floors, or ``None``.
     """
 
     points: np.ndarray
@@ -115,6 +116,7 @@ class Geometry:
     alive: np.ndarray | None = None
     bodies: BodyGeometry | None = None
     scenery: Scenery | None = None
+    walls: Walls | None = None
 
     @property
     def to_scale(self) -> bool:
@@ -295,6 +297,7 @@ class Recording:
         scenery = read_scenery(self.static, self.attrs)
         return Geometry(
             points,
+            walls=read_walls(self.static),
             radius=radius,
             color=color,
             display_radius=display_radius,

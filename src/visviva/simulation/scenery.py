@@ -10,7 +10,13 @@ says why they are not static rigid bodies):
     static/scenery_color           float64 (C, 3): sRGB in [0, 1] (optional: grey)
     attrs["scenery_names"]         list of C strings (optional)
 
-Planes (half-spaces and walls without an edge) are not recorded: they have no finite surface.
+Planes have no finite surface. Floors are the outputs' own ground; any other plane (a wall, a
+ceiling, a slope) is recorded as a point and an outward normal, and the outputs draw the part
+of it within their picture (:class:`Walls`, :mod:`visviva.viz.walls`):
+
+    static/wall_point              float64 (W, 3) [m]
+    static/wall_normal             float64 (W, 3): unit, towards the side things stay on
+    static/wall_color              float64 (W, 3): sRGB in [0, 1]
 """
 
 from __future__ import annotations
@@ -26,7 +32,7 @@ from ..entities.collider.schema import DEFAULT_SCENERY_COLOR
 from ..errors import ModelError
 from .body_geometry import BodyGeometry, vertex_normals
 
-__all__ = ["SCENERY_STATIC", "Scenery", "read_scenery"]
+__all__ = ["SCENERY_STATIC", "Scenery", "Walls", "read_scenery", "read_walls"]
 
 #: The static arrays a recording with scenery has (``scenery_color`` is optional).
 SCENERY_STATIC = (
@@ -35,6 +41,10 @@ SCENERY_STATIC = (
     "scenery_vertex_start",
     "scenery_triangle_start",
 )
+
+
+#: The static arrays of a recording's walls.
+WALL_STATIC = ("wall_point", "wall_normal", "wall_color")
 
 
 @dataclass(frozen=True)
@@ -95,6 +105,33 @@ class Scenery:
             self.color,
             self.names,
         )
+
+
+@dataclass(frozen=True)
+class Walls:
+    """``W`` planes other than floors: a point [m], an outward unit normal and an sRGB colour
+    each, ``(W, 3)``."""
+
+    point: np.ndarray
+    normal: np.ndarray
+    color: np.ndarray
+
+
+def read_walls(static: Mapping[str, np.ndarray]) -> Walls | None:
+    """The walls of a recording's static arrays (``None`` without any).
+
+    Raises:
+        ModelError: If they are not three finite ``(W, 3)`` arrays of one ``W``.
+    """
+    if "wall_point" not in static:
+        return None
+    arrays = [np.asarray(static.get(name, np.empty(0))) for name in WALL_STATIC]
+    shape = arrays[0].shape
+    if len(shape) != 2 or shape[1] != 3 or any(a.shape != shape for a in arrays):
+        raise ModelError(f"`{'`, `'.join(WALL_STATIC)}` must all have one shape (W, 3)")
+    if not all(np.isfinite(a).all() for a in arrays):
+        raise ModelError("walls must be finite numbers")
+    return Walls(*arrays)
 
 
 def read_scenery(static: Mapping[str, np.ndarray], attrs: Mapping[str, Any]) -> Scenery | None:

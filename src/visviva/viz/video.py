@@ -294,8 +294,10 @@ def render_video(
     shown = frames_at_rate(recording.time, fps, speed=speed)
 
     from .framing import chosen_camera
+    from .walls import with_walls
 
     camera = chosen_camera(geometry, camera, frame, width / height)
+    geometry = with_walls(geometry, np.array(camera.eye))
     painter = FramePainter(geometry, (width, height), camera, recording.time, trail, caption)
     times = recording.time[shown]
     from ..simulation.progress import Progress

@@ -28,7 +28,7 @@ from ...errors import SceneProblem
 from ..checks import check_names
 from ..context import BuildContext, Located
 from ..kind import KindBuild, Replica
-from .outputs import scenery_attrs, scenery_fields
+from .outputs import scenery_attrs, scenery_fields, wall_fields
 from .schema import Collider
 from .shapes import collider_shape
 
@@ -73,7 +73,7 @@ def _finish(entries: Sequence[tuple[str, Collider]], context: BuildContext) -> N
             )
             context.forces.append(force)
             context.contact_sources.append(force)
-    context.static |= scenery_fields(entries)
+    context.static |= scenery_fields(entries) | wall_fields(entries)
     context.attrs |= scenery_attrs(entries)
 
 

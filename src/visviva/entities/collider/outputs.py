@@ -15,8 +15,9 @@ records them):
 Drawn: boxes (their six faces, four vertices each, so the faces are flat with sharp edges:
 the 12 triangles over the box's 8 corners), spheres (the rigid bodies' tessellation,
 :func:`visviva.rigid.surfaces.unit_sphere`: 32 segments around, 16 from pole to pole) and
-meshes (their own vertices and triangles). Planes are not drawn: a half-space or a slab
-without an edge has no finite surface, and the video already draws a ground.
+meshes (their own vertices and triangles). Planes have no finite surface: a floor is the
+outputs' own ground, and any other plane (a wall) is kept as a point and a normal
+(:func:`wall_fields`), drawn as much of it as the picture needs.
 
 Why fields of their own rather than static rigid bodies with a constant transform: every
 consumer of ``body_*`` counts the bodies, names them, plots their momenta or animates their
@@ -35,7 +36,10 @@ from ...geometry.packing import packed_surfaces
 from .schema import DEFAULT_SCENERY_COLOR, Collider
 from .shapes import collider_shape, collider_surface
 
-__all__ = ["scenery_attrs", "scenery_fields"]
+__all__ = ["scenery_attrs", "scenery_fields", "wall_fields"]
+
+#: A plane whose outward normal is this close to +Y is a floor: the outputs' ground shows it.
+FLOOR = 0.999
 
 
 def _drawn(
@@ -69,6 +73,29 @@ def scenery_fields(entries: Sequence[tuple[str, Collider]]) -> dict[str, np.ndar
         "scenery_color": np.array(
             [e.color or DEFAULT_SCENERY_COLOR for _, e, _ in drawn], dtype=np.float64
         ),
+    }
+
+
+def wall_fields(entries: Sequence[tuple[str, Collider]]) -> dict[str, np.ndarray]:
+    """The planes that are not floors (a box's walls, a ceiling, a slope) as a point, an
+    outward unit normal and a colour each: ``wall_point``, ``wall_normal``, ``wall_color``
+    ``(W, 3)``. Unbounded, they are drawn as the part of them within what a video or viewer
+    shows (:mod:`visviva.viz.walls`); empty without any."""
+    walls = [
+        e
+        for _, e in entries
+        if e.shape == "plane"
+        and e.point is not None
+        and e.normal is not None
+        and np.asarray(e.normal, float)[1] / np.linalg.norm(e.normal) < FLOOR
+    ]
+    if not walls:
+        return {}
+    normal = np.array([e.normal for e in walls], dtype=np.float64)
+    return {
+        "wall_point": np.array([e.point for e in walls], dtype=np.float64),
+        "wall_normal": normal / np.linalg.norm(normal, axis=1, keepdims=True),
+        "wall_color": np.array([e.color or DEFAULT_SCENERY_COLOR for e in walls], np.float64),
     }
 
 

@@ -58,6 +58,7 @@ from ...simulation.recording import Geometry
 from ...simulation.scenery import Scenery
 from ..frame import drawn_bounds
 from ..timescale import time_unit
+from ..walls import wall_scenery
 
 __all__ = [
     "PAYLOAD_FORMAT",
@@ -316,6 +317,9 @@ def encode_payload(
         layers["bodies"] = _bodies_layer(geometry.bodies, shown)
     if geometry.scenery is not None:
         layers["scenery"] = _scenery_layer(geometry.scenery)
+    walls = None if geometry.walls is None else wall_scenery(geometry.walls, low, high)
+    if walls is not None:  # translucent, every one: the page's camera goes all round them
+        layers["walls"] = _scenery_layer(walls)
     if contacts:
         layers["contacts"] = contacts_layer(contacts, shown, float(np.linalg.norm(high - low)))
     return {

@@ -423,8 +423,13 @@
         contactView.shown = n;
       };
     },
+    /* Walls (planes other than floors), cut to the scene's box: translucent, both sides. */
+    walls(layer) {
+      return LAYERS.scenery(layer, new THREE.MeshLambertMaterial({ transparent: true,
+        opacity: 0.25, side: THREE.DoubleSide, depthWrite: false }));
+    },
     /* Static colliders: one mesh per collider, in the world frame, drawn as placed. */
-    scenery(layer) {
+    scenery(layer, look = null) {
       const vertices = decode(layer.vertices, Float32Array);
       const triangles = decode(layer.triangles, Uint32Array);
       const vertexStart = decode(layer.vertex_start, Uint32Array);
@@ -440,11 +445,12 @@
         geometry.setIndex(new THREE.BufferAttribute(
           triangles.slice(3 * triangleStart[c], 3 * triangleStart[c + 1]), 1));
         geometry.computeVertexNormals();
-        const material = new THREE.MeshLambertMaterial({ color: srgb(rgb, c) });
+        const material = look ? look.clone() : new THREE.MeshLambertMaterial();
+        material.color.copy(srgb(rgb, c));
         const mesh = new THREE.Mesh(geometry, material);
         mesh.name = layer.names[c];
         scene.add(mesh);
-        sceneryMeshes.push(mesh);
+        (look ? wallMeshes : sceneryMeshes).push(mesh);
       }
       return function update() {};
     },
@@ -455,6 +461,7 @@
   let pointMesh = null; // the points layer's instanced mesh, read back by visviva.drawn()
   const bodyMeshes = []; // the bodies layer's meshes, read back by visviva.bodies()
   const sceneryMeshes = []; // the scenery layer's meshes, read back by visviva.scenery()
+  const wallMeshes = []; // the walls layer's meshes, read back by visviva.walls()
   const updates = [];
   for (const [name, layer] of Object.entries(data.layers)) {
     if (!(name in LAYERS)) throw new Error("this viewer cannot draw layer " + name);
@@ -683,6 +690,10 @@
       visible: contactView.layer !== null && contactToggle.checked,
       shown: contactView.shown,
     }),
+    /* The walls as drawn: each mesh's name and opacity. */
+    walls: () => wallMeshes.map((mesh) => ({ name: mesh.name, opacity: mesh.material.opacity })),
+    /* The orbit camera: its target [m] and distance [m] from it. */
+    view: () => ({ target: view.target.toArray(), distance: view.distance }),
     /* The static colliders as drawn: each mesh's name and number of triangles. */
     scenery: () => sceneryMeshes.map((mesh) => ({
       name: mesh.name,
