@@ -527,3 +527,18 @@ def test_walls_and_a_scene_camera_reach_the_page(browser, tmp_path):
         assert view["distance"] == pytest.approx(np.hypot(1.5, 3.0))
     finally:
         opened.page.close()
+
+
+def test_many_points_without_a_size_are_a_star_field(browser, tmp_path):
+    """1500 gravitating bodies (points without a radius): spots of light added together on a
+    night sky, not 1500 opaque spheres."""
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(4, 1500, 3))
+    recording = vv.Recording(np.arange(4.0), {"system_points": points})
+    opened = Opened(browser, write_viewer(recording, tmp_path / "stars.html"))
+    try:
+        assert opened.errors == []
+        assert opened.js("visviva.stars()") == {"count": 1500, "additive": True}
+        assert opened.js("visviva.drawn().count") == 0  # no spheres
+    finally:
+        opened.page.close()

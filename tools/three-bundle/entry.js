@@ -1,6 +1,7 @@
 // The parts of three.js the visviva web viewer (src/visviva/viz/viewer/viewer.js) uses.
 // esbuild bundles only what is re-exported here; add a name when the viewer needs it.
 export {
+  AdditiveBlending,
   AmbientLight,
   BufferAttribute,
   BufferGeometry,
@@ -16,6 +17,8 @@ export {
   Mesh,
   MeshLambertMaterial,
   PerspectiveCamera,
+  Points,
+  PointsMaterial,
   REVISION,
   Scene,
   SphereGeometry,

@@ -73,6 +73,17 @@ MIN_SPHERE_PIXELS = 0.75
 LINE_DEPTH_BIAS = 2e-3
 #: Near plane, as a fraction of the camera's distance to its target.
 NEAR_FRACTION = 1e-3
+#: A recording of at least this many points, all without a size (gravitating bodies: a
+#: galaxy, a star cluster) and nothing else, is drawn as a star field: each point a small
+#: spot of light added to a dark sky, so that a disk of stars shows its density and its arms
+#: instead of a pancake of opaque spheres hiding each other.
+STAR_FIELD_POINTS = 1000
+#: A star's colour when the recording gives none.
+STAR_COLOUR = (1.0, 0.9, 0.78)
+#: A star's brightness: a few overlapping stars saturate, a lone one is clearly seen.
+STAR_GAIN = 0.8
+#: The star field's night sky, top and bottom of the picture.
+NIGHT = ((0.02, 0.03, 0.07), (0.0, 0.0, 0.01))
 
 
 def drawn_bounds(geometry: Geometry) -> tuple[np.ndarray, np.ndarray]:
@@ -368,6 +379,35 @@ class _Faces:
         )
 
 
+def is_star_field(geometry: Geometry) -> bool:
+    """Whether ``geometry`` is drawn as a star field (see :data:`STAR_FIELD_POINTS`)."""
+    return (
+        geometry.points.shape[1] >= STAR_FIELD_POINTS
+        and geometry.radius is None
+        and geometry.display_radius is None
+        and geometry.bodies is None
+        and geometry.scenery is None
+        and geometry.walls is None
+        and not (geometry.faces is not None and len(geometry.faces))
+    )
+
+
+class _StarField:
+    """Every live point as a spot of light (:func:`~visviva.viz.raster.splat_points`)."""
+
+    def __init__(self, height: int, width: int) -> None:
+        self.light = np.zeros((height, width, 3), dtype=np.float32)
+
+    def cast_shadows(self, stage: _Stage, frame: _Frame, shadows: _ShadowMap) -> None:
+        pass  # light in the dark casts none
+
+    def draw(self, stage: _Stage, frame: _Frame, color: np.ndarray, depth: np.ndarray) -> None:
+        self.light.fill(0.0)
+        order = np.arange(frame.positions.shape[0]) if frame.live is None else frame.live
+        raster.splat_points(self.light, frame.screen, order, frame.colour, STAR_GAIN)
+        raster.expose(self.light, color.copy(), color)
+
+
 class FramePainter:
     """Paints frames of one geometry, seen by one camera, at one size.
 
@@ -391,8 +431,10 @@ class FramePainter:
         self.width, self.height = size
         look = Appearance.of(geometry)
         self.look = look
+        self.stars = is_star_field(geometry)
         self.default_colour = np.tile(
-            np.array(SPHERE_COLOUR, dtype=np.float32), (geometry.points.shape[1], 1)
+            np.array(STAR_COLOUR if self.stars else SPHERE_COLOUR, dtype=np.float32),
+            (geometry.points.shape[1], 1),
         )
         low, high = drawn_bounds(geometry)
         scene = max(float(np.linalg.norm(high - low)), 1e-9)
@@ -410,14 +452,24 @@ class FramePainter:
         if trail > 0.0:
             self.layers.append(_Trails(geometry.points, times, trail, look, self.height))
         spheres = geometry.off_faces()
-        if spheres.size:
+        if self.stars:
+            self.layers.append(_StarField(self.height, self.width))
+        elif spheres.size:
             whole = spheres.size == geometry.points.shape[1]
             self.layers.append(_Spheres(None if whole else spheres))
         self.span = float(times[-1] - times[0]) if times.size else 0.0
         shape = (self.height, self.width)
         self.background = np.empty((*shape, 3), dtype=np.float32)
-        self.background_depth = np.empty(shape, dtype=np.float32)
+        self.background_depth = np.full(shape, np.inf, dtype=np.float32)
         self.ground_x, self.ground_z = np.empty(shape), np.empty(shape)
+        self.color = np.empty_like(self.background)
+        self.depth = np.empty_like(self.background_depth)
+        self._label = _Label(self.height)
+        if self.stars:  # a night sky, no ground and no shadows
+            top, bottom = np.array(NIGHT, dtype=np.float32)
+            rows = np.linspace(0.0, 1.0, self.height, dtype=np.float32)[:, None, None]
+            self.background[:] = top + rows * (bottom - top)
+            return
         ground.paint_background(
             self.background,
             self.background_depth,
@@ -433,9 +485,6 @@ class FramePainter:
             BACKGROUND_SAMPLES,
         )
         self.shadows = _ShadowMap(stage, low, high, _live_radii(look))
-        self.color = np.empty_like(self.background)
-        self.depth = np.empty_like(self.background_depth)
-        self._label = _Label(self.height)
 
     def label(self, time: float) -> str:
         """The text in the corner: the time in the unit that reads best for the recording's
@@ -461,6 +510,20 @@ class FramePainter:
             look.radius_at(index),
             self.default_colour if colour is None else colour,
         )
+        if self.stars:
+            self.color[:] = self.background
+            self.depth[:] = self.background_depth
+        else:
+            self._ground(frame)
+        for layer in self.layers:
+            layer.draw(self.stage, frame, self.color, self.depth)
+        self._label.stamp(self.color, self.label(time))
+        image = np.empty((self.height, self.width, 3), dtype=np.uint8)
+        raster.to_bytes(self.color, image)
+        return image
+
+    def _ground(self, frame: _Frame) -> None:
+        """Start the frame from the background: the ground darkened by this frame's shadows."""
         shadows = self.shadows
         shadows.occlusion.fill(0.0)
         for layer in self.layers:
@@ -478,12 +541,6 @@ class FramePainter:
             shadows.cell,
             SHADOW_DARKNESS,
         )
-        for layer in self.layers:
-            layer.draw(self.stage, frame, self.color, self.depth)
-        self._label.stamp(self.color, self.label(time))
-        image = np.empty((self.height, self.width, 3), dtype=np.uint8)
-        raster.to_bytes(self.color, image)
-        return image
 
 
 def _checker_cell(scene: float) -> float:

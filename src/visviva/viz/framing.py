@@ -4,9 +4,9 @@ Either a camera given outright — eye, target, up and vertical field of view, a
 ``[output] camera = {eye = [4, 2, 6], target = [0, 0.5, 0], fov = 40}`` or on the command line
 as ``--camera "eye=4,2,6 target=0,0.5,0 fov=40"`` — or a framing: the raised three-quarter
 view (:meth:`~visviva.viz.video.Camera.framing`) that keeps a box in the picture for the whole
-run, the box holding everything drawn (``--frame all``, the default) or one named rigid body
-over every frame (``--frame NAME``), so that a brick falling far away no longer shrinks the
-bodies the scene is about to specks.
+run, the box holding everything drawn (``--frame all``, the default; for a star field, where
+98 % of the stars are) or one named rigid body over every frame (``--frame NAME``), so that a
+brick falling far away no longer shrinks the bodies the scene is about to specks.
 
 Both are stored with a recording (attributes ``playback_camera`` and ``playback_frame``) so that
 a later ``visviva export`` or ``visviva view`` shows what the run showed.
@@ -20,7 +20,7 @@ from .._registry import did_you_mean
 from ..errors import ModelError
 from ..geometry.quaternions import quaternion_matrix
 from ..simulation.recording import Geometry
-from .frame import drawn_bounds
+from .frame import drawn_bounds, is_star_field
 from .video import FIELD_OF_VIEW, Camera
 
 __all__ = ["ALL", "chosen_camera", "framed_bounds", "parse_camera"]
@@ -29,6 +29,9 @@ __all__ = ["ALL", "chosen_camera", "framed_bounds", "parse_camera"]
 ALL = "all"
 
 _KEYS = {"eye": 3, "target": 3, "up": 3, "fov": 1}
+
+#: The percentiles of a star field's points, per axis, that its framing keeps in view.
+STAR_SHARE = (1.0, 99.0)
 
 
 def parse_camera(text: str) -> Camera:
@@ -76,6 +79,14 @@ def framed_bounds(geometry: Geometry, frame: str = ALL) -> tuple[np.ndarray, np.
     Raises:
         ModelError: For a name that is not a body's, listing the bodies' names.
     """
+    if frame == ALL and is_star_field(geometry):
+        # A few stars flung far out would shrink the galaxies to a dot: frame where nearly
+        # all of them are, over the whole run, and let the stragglers leave the picture.
+        points = geometry.points.reshape(-1, 3)
+        if geometry.alive is not None:
+            points = points[geometry.alive.reshape(-1)]
+        low, high = np.percentile(points, [STAR_SHARE[0], STAR_SHARE[1]], axis=0)
+        return low, high
     if frame == ALL:
         return drawn_bounds(geometry)
     names = () if geometry.bodies is None else geometry.bodies.names

@@ -13,6 +13,9 @@ has its centre at ``(j + 0.5, i + 0.5)``.
   of the sphere's visible hemisphere, ``n = (u, v, sqrt(1 − u² − v²))`` in view space, lit by
   hemispheric ambient + Lambert + a Blinn-Phong highlight (Blinn 1977), depth
   ``z_c − r·n_z``, with an anti-aliased rim (coverage from the distance to the silhouette).
+* :func:`splat_points` — many small points added up as light (a star field): each a Gaussian
+  spot whose brightness adds to what is there, no depth test; :func:`expose` maps the sum of
+  light to colour as film does, ``1 − exp(−E)``, so dense regions glow instead of clipping.
 * :func:`to_bytes` — the finished frame as 8-bit RGB.
 
 The sky, the ground and the shadows are in :mod:`visviva.viz.ground`. All kernels are plain
@@ -26,7 +29,10 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["draw_lines", "draw_spheres", "draw_triangles", "to_bytes"]
+#: Variance [px²] of a star field's Gaussian spot: 0.8 px standard deviation.
+SPOT = 0.64
+
+__all__ = ["draw_lines", "draw_spheres", "draw_triangles", "expose", "splat_points", "to_bytes"]
 
 
 @njit(cache=True)
@@ -304,6 +310,48 @@ def draw_spheres(
                 pixel[2] += coverage * (blue * lit + gloss - pixel[2])
                 if coverage > 0.5:
                     depth[i, j] = z
+
+
+@njit(cache=True)
+def splat_points(
+    light: np.ndarray, screen: np.ndarray, order: np.ndarray, colour: np.ndarray, gain: float
+) -> None:
+    """Add each point ``order[k]`` at ``screen[order[k], :2]`` [px] to ``light`` (float32
+    ``(H, W, 3)``) as a Gaussian spot of variance :data:`SPOT` [px²] (4 × 4 pixels), of total
+    brightness ``gain`` times its colour ``colour[order[k]]``; points off screen or behind the
+    camera (NaN) add nothing."""
+    height, width = light.shape[0], light.shape[1]
+    for k in range(order.shape[0]):
+        p = order[k]
+        x, y = screen[p, 0], screen[p, 1]
+        if not (x == x and y == y) or x < -2.0 or y < -2.0 or x > width + 2.0 or y > height + 2.0:
+            continue
+        j0, i0 = math.floor(x - 0.5), math.floor(y - 0.5)
+        for i in range(i0 - 1, i0 + 3):
+            if i < 0 or i >= height:
+                continue
+            dy = i + 0.5 - y
+            for j in range(j0 - 1, j0 + 3):
+                if j < 0 or j >= width:
+                    continue
+                dx = j + 0.5 - x
+                weight = (
+                    gain * math.exp(-(dx * dx + dy * dy) / (2.0 * 0.64)) / (2.0 * math.pi * 0.64)
+                )
+                for channel in range(3):
+                    light[i, j, channel] += weight * colour[p, channel]
+
+
+@njit(cache=True)
+def expose(light: np.ndarray, background: np.ndarray, color: np.ndarray) -> None:
+    """``color = background + (1 − background)·(1 − exp(−light))``: light added to a dark
+    background as film takes it, saturating smoothly where many points overlap."""
+    height, width = light.shape[0], light.shape[1]
+    for i in range(height):
+        for j in range(width):
+            for channel in range(3):
+                base = background[i, j, channel]
+                color[i, j, channel] = base + (1.0 - base) * (1.0 - math.exp(-light[i, j, channel]))
 
 
 @njit(cache=True)

@@ -56,7 +56,7 @@ from ...simulation.body_geometry import BodyGeometry
 from ...simulation.lifetimes import Appearance, held_frames, held_points, life_starts
 from ...simulation.recording import Geometry
 from ...simulation.scenery import Scenery
-from ..frame import drawn_bounds
+from ..frame import drawn_bounds, is_star_field
 from ..timescale import time_unit
 from ..walls import wall_scenery
 
@@ -110,6 +110,8 @@ def _points_layer(geometry: Geometry, shown: np.ndarray, trail_frames: int) -> d
         layer["frame_colors"] = _differences_u8(_held_values(look.color, shown, held))
     elif look.color is not None:
         layer["colors"] = _base64(np.round(255 * look.color), "u1")
+    if is_star_field(geometry):  # drawn as spots of light on a night sky, as the video does
+        layer["stars"] = True
     spheres = geometry.off_faces()
     if spheres.size < count:  # the points on faces are drawn by the faces
         layer["spheres"] = _base64(spheres, "<u4")

@@ -27,6 +27,8 @@
 
   const BACKGROUND = 0xeef1f5;
   const POINT_COLOUR = 0x2f6fb3;
+  const NIGHT = 0x03050c; // a star field's sky
+  const STAR_COLOUR = 0xffe6c7; // a star's colour when the recording gives none
   const EDGE_COLOUR = 0x1d2733;
   const FACE_COLOUR = 0xd9822b;
   const FIELD_OF_VIEW = 45; // degrees, vertical
@@ -248,6 +250,7 @@
      * each with its radius and colour in that frame. With faces, only the points on no face
      * (layer.spheres) are spheres: the others are the surface's vertices. */
     points(layer) {
+      if (layer.stars) return LAYERS.stars(layer);
       const radius = layer.radius ? decode(layer.radius, Float32Array) : null;
       const onFaces = layer.spheres !== undefined; // "" when every point is on a face
       const sphere = new Uint8Array(pointCount).fill(onFaces ? 0 : 1);
@@ -304,6 +307,38 @@
         mesh.instanceMatrix.needsUpdate = true;
         if (rgb && mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
         if (trail) trail(frame);
+      };
+    },
+    /* Many points without a size (a galaxy, a star cluster): spots of light added together
+     * on a night sky, without a ground, so that density and structure show. */
+    stars(layer) {
+      starField = true;
+      scene.background = new THREE.Color(NIGHT);
+      const geometry = new THREE.BufferGeometry();
+      geometry.setAttribute("position", current);
+      const staticRgb = layer.colors ? decode(layer.colors, Uint8Array) : null;
+      const colours = new THREE.BufferAttribute(new Float32Array(3 * pointCount), 3);
+      const colour = new THREE.Color(STAR_COLOUR);
+      for (let i = 0; i < pointCount; i++) {
+        if (staticRgb) srgb(staticRgb, i, colour);
+        colours.setXYZ(i, colour.r, colour.g, colour.b);
+      }
+      geometry.setAttribute("color", colours);
+      const material = new THREE.PointsMaterial({ size: 2, sizeAttenuation: false,
+        vertexColors: true, blending: THREE.AdditiveBlending, transparent: true,
+        depthWrite: false, opacity: 0.8 });
+      const cloud = new THREE.Points(geometry, material);
+      cloud.frustumCulled = false; // the points move
+      scene.add(cloud);
+      starCloud = cloud;
+      return function update() {
+        const rgb = frameColours ? coloursAt(frame, staticRgb) : null;
+        if (!rgb) return;
+        for (let i = 0; i < pointCount; i++) {
+          srgb(rgb, i, colour);
+          colours.setXYZ(i, colour.r, colour.g, colour.b);
+        }
+        colours.needsUpdate = true;
       };
     },
     /* Lines between pairs of points (ropes, springs). */
@@ -459,6 +494,8 @@
   const contactToggle = document.getElementById("contacts");
   const contactView = { layer: null, shown: 0 }; // read back by visviva.contacts()
   let pointMesh = null; // the points layer's instanced mesh, read back by visviva.drawn()
+  let starField = false; // the points are drawn as a star field: no ground grid
+  let starCloud = null; // its points, read back by visviva.stars()
   const bodyMeshes = []; // the bodies layer's meshes, read back by visviva.bodies()
   const sceneryMeshes = []; // the scenery layer's meshes, read back by visviva.scenery()
   const wallMeshes = []; // the walls layer's meshes, read back by visviva.walls()
@@ -474,7 +511,7 @@
   const grid = new THREE.GridHelper(cells * cell, cells, 0x8794a3, 0xc3cad3);
   grid.position.set(Math.round(centre.x / cell) * cell, Math.min(0, low.y),
     Math.round(centre.z / cell) * cell);
-  scene.add(grid);
+  if (!starField) scene.add(grid);
 
   /* Orbit camera: spherical coordinates (distance, polar angle from +Y, azimuth from +Z)
    * around a target point; drag orbits, right- or shift-drag pans, the wheel zooms. */
@@ -690,6 +727,9 @@
       visible: contactView.layer !== null && contactToggle.checked,
       shown: contactView.shown,
     }),
+    /* The star field as drawn, or null: its number of points and whether light adds up. */
+    stars: () => starCloud && ({ count: starCloud.geometry.attributes.position.count,
+      additive: starCloud.material.blending === THREE.AdditiveBlending }),
     /* The walls as drawn: each mesh's name and opacity. */
     walls: () => wallMeshes.map((mesh) => ({ name: mesh.name, opacity: mesh.material.opacity })),
     /* The orbit camera: its target [m] and distance [m] from it. */
