@@ -144,3 +144,23 @@ def test_every_body_and_particle_of_an_example_scene_stays_in_the_picture(tmp_pa
     points = drawn_points(recording)
     inside = in_picture(camera, points, 960 / 540)
     assert inside.all(), f"{(~inside).sum()} of {inside.size} points leave the picture"
+
+
+def test_labels_name_each_body_above_it():
+    from visviva.viz.frame import FramePainter
+
+    builder = vv.SceneBuilder(name="named")
+    builder.set_world(gravity=(0.0, 0.0, 0.0))
+    builder.add_body("box", size=(0.3, 0.3, 0.3), density=500.0, name="left", position=(-1, 0, 0))
+    builder.add_body("box", size=(0.3, 0.3, 0.3), density=500.0, name="right", position=(1, 0, 0))
+    recording = vv.Simulation(builder.build()).record(until=0.01)
+    geometry = recording.geometry()
+    camera = chosen_camera(geometry, None, "all", 16 / 9)
+    plain, named = (
+        FramePainter(geometry, (320, 180), camera, recording.time, labels=labels).paint(0, 0.0)
+        for labels in (False, True)
+    )
+    changed = np.abs(named.astype(int) - plain.astype(int)).sum(axis=2) > 30
+    _rows, columns = np.nonzero(changed[40:])  # below the time label in the corner
+    # Two labels, one over each box: changed pixels left and right of the middle.
+    assert (columns < 160).any() and (columns >= 160).any()

@@ -41,6 +41,8 @@ class Demo:
             viewer (0: none).
         color_by: What colours the points of the video and the viewer: ``"scene"`` (the
             recorded colours) or ``"speed"``.
+        labels: The video writes each rigid body's name above it (where the lesson depends
+            on telling them apart).
         full: The long version's ``run`` (``visviva demo NAME --full``), for a demo whose
             default is cut down to finish within a minute; ``None`` if there is none.
     """
@@ -53,6 +55,7 @@ class Demo:
     speed: float = 1.0
     trail: float = 0.0
     color_by: str = "scene"
+    labels: bool = False
     full: Callable[[JobOutput, float], dict[str, Any]] | None = None
 
 

@@ -30,6 +30,8 @@ NUDGE = 0.01  # of the spin, about the other two axes
 DT = 1.0 / 480.0  # [s]
 SAMPLES_PER_SECOND = 60
 AXES = ("smallest moment (x)", "intermediate moment (y)", "largest moment (z)")
+#: The handles' names, written above them in the video.
+NAMES = ("about x: smallest I, steady", "about y: middle I, flips", "about z: largest I, steady")
 
 
 def build_scene(duration: float) -> SceneBuilder:
@@ -44,7 +46,7 @@ def build_scene(duration: float) -> SceneBuilder:
         spin[k] = SPIN
         builder.add_body(
             "mesh", vertices=vertices, triangles=triangles, density=DENSITY,
-            position=(x, 0.0, 0.0), angular_velocity=spin, name=f"handle {'xyz'[k]}",
+            position=(x, 0.0, 0.0), angular_velocity=spin, name=NAMES[k],
             color=((0.9, 0.6, 0.2), (0.85, 0.25, 0.2), (0.3, 0.55, 0.85))[k],
         )  # fmt: skip
     return builder
@@ -109,5 +111,6 @@ register_demo(
         20.0,
         run,
         picture=True,
+        labels=True,
     )
 )

@@ -112,6 +112,7 @@ def run_demo(
                 "playback_speed": demo.speed,
                 "playback_trail": demo.trail,
                 "playback_color_by": demo.color_by,
+                "playback_labels": demo.labels,
             } | view
         summary = _summary(demo, output, seconds, interrupted) | extra
         if full:

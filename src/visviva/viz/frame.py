@@ -425,8 +425,10 @@ class FramePainter:
         times: np.ndarray,
         trail: float = 0.0,
         caption: str = "",
+        labels: bool = False,
     ) -> None:
         self.geometry = geometry
+        self.labels = labels
         self.caption = caption
         self.width, self.height = size
         look = Appearance.of(geometry)
@@ -517,10 +519,27 @@ class FramePainter:
             self._ground(frame)
         for layer in self.layers:
             layer.draw(self.stage, frame, self.color, self.depth)
+        if self.labels and self.geometry.bodies is not None:
+            self._name_bodies(index)
         self._label.stamp(self.color, self.label(time))
         image = np.empty((self.height, self.width, 3), dtype=np.uint8)
         raster.to_bytes(self.color, image)
         return image
+
+    def _name_bodies(self, index: int) -> None:
+        """Each rigid body's name just above the top of its surface in recorded frame
+        ``index`` (a body behind the camera goes unnamed)."""
+        bodies = self.geometry.bodies
+        assert bodies is not None
+        surface = bodies.world_vertices(index)
+        for b, name in enumerate(bodies.names):
+            own = surface[bodies.vertex_start[b] : bodies.vertex_start[b + 1]]
+            if not own.shape[0]:
+                continue
+            top = np.array([own[:, 0].mean(), own[:, 1].max(), own[:, 2].mean()])
+            x, y, _depth = self.stage.to_screen(self.stage.to_view(top))
+            if np.isfinite(x) and np.isfinite(y):
+                self._label.stamp(self.color, name, above=(float(x), float(y)))
 
     def _ground(self, frame: _Frame) -> None:
         """Start the frame from the background: the ground darkened by this frame's shadows."""
@@ -562,7 +581,9 @@ class _Label:
         self.margin = max(2, round(height / 60))
         self.font: Any = ImageFont.load_default(size=self.pixels)
 
-    def stamp(self, color: np.ndarray, text: str) -> None:
+    def stamp(self, color: np.ndarray, text: str, above: tuple[float, float] | None = None) -> None:
+        """Write ``text`` in the top-left corner, or centred just above the pixel ``above``
+        (x, y), kept inside the picture."""
         from PIL import Image, ImageDraw
 
         _left, top, right, bottom = self.font.getbbox(text)
@@ -571,6 +592,10 @@ class _Label:
         ImageDraw.Draw(mask).text((pad, pad - top), text, fill=255, font=self.font)
         alpha = np.asarray(mask, dtype=np.float32)[..., None] / 255.0
         x, y = self.margin, self.margin
+        if above is not None:
+            high, wide = color.shape[0] - alpha.shape[0], color.shape[1] - alpha.shape[1]
+            x = int(min(max(above[0] - alpha.shape[1] / 2, 0), max(wide, 0)))
+            y = int(min(max(above[1] - alpha.shape[0] - self.margin, 0), max(high, 0)))
         region = color[y : y + alpha.shape[0], x : x + alpha.shape[1]]
         alpha = alpha[: region.shape[0], : region.shape[1]]
         region *= 0.45

@@ -63,7 +63,8 @@ def write_output(
         from .video import render_video
 
         render_video(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by,
-                     camera=view.camera, frame=view.frame)  # fmt: skip
+                     camera=view.camera, frame=view.frame,
+                     labels=bool(recording.attrs.get("playback_labels", False)))  # fmt: skip
     elif suffix == ".html":
         from .viewer import write_viewer
 

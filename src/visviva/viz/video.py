@@ -207,6 +207,7 @@ def render_video(
     trail: float = 0.0,
     color_by: str = "scene",
     frame: str = "all",
+    labels: bool = False,
 ) -> Path:
     """Render a recording's geometry to an mp4 or GIF file.
 
@@ -231,6 +232,8 @@ def render_video(
             frame (:mod:`visviva.viz.speed_colors`), the scale in the corner label.
         frame: Without ``camera``, what the view keeps in the picture: ``"all"`` (the live
             points and the bodies) or the name of one rigid body (:mod:`visviva.viz.framing`).
+        labels: Write each rigid body's name above it, where the lesson depends on telling
+            them apart (the ``dzhanibekov`` demo's three handles).
 
     Returns:
         The path written.
@@ -298,7 +301,9 @@ def render_video(
 
     camera = chosen_camera(geometry, camera, frame, width / height)
     geometry = with_walls(geometry, np.array(camera.eye))
-    painter = FramePainter(geometry, (width, height), camera, recording.time, trail, caption)
+    painter = FramePainter(
+        geometry, (width, height), camera, recording.time, trail, caption, labels=labels
+    )
     times = recording.time[shown]
     from ..simulation.progress import Progress
 
