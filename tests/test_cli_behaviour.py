@@ -217,3 +217,10 @@ def test_full_is_refused_by_a_demo_without_a_long_version(monkeypatch, capsys, t
     status, _, err = run_main(monkeypatch, capsys, "demo", "pendulum", "--full", "-o", tmp_path)
     assert status == 2 and "demo 'pendulum' has no long version" in err
     assert not any(tmp_path.iterdir())
+
+
+def test_fps_zero_is_refused_by_demo_as_by_export_and_view(monkeypatch, capsys, tmp_path):
+    status, _, err = run_main(
+        monkeypatch, capsys, "demo", "kepler", "-f", "mp4", "--fps", "0", "-o", tmp_path / "k"
+    )
+    assert status == 2 and "`fps` must be" in err and not (tmp_path / "k").exists()
