@@ -83,7 +83,7 @@ class BandTicks(Locator):
         if high > low and bins >= 2:
             inside = MaxNLocator(nbins=bins, steps=[1, 2, 2.5, 5, 10]).tick_values(low, high)
             ticks |= {float(t) for t in inside if low <= t <= high}
-        return _merged(sorted(ticks), 1e-9 * self.linthresh)
+        return _merged(sorted(ticks), 1e-9 * (vmax - vmin))
 
     def _band_share(self, vmin: float, vmax: float, low: float, high: float) -> float:
         """The share of the axis' length the band's part of the view takes."""
@@ -94,8 +94,8 @@ class BandTicks(Locator):
 
 
 def _merged(ticks: list[float], tolerance: float) -> list[float]:
-    """``ticks`` (sorted) without near-duplicates: the band's edge comes from both locators,
-    once as 0.01 and once as 0.010000000000000002."""
+    """``ticks`` (sorted) without near-duplicates (closer than ``tolerance``): the band's edge
+    comes from both locators, once as 0.01 and once as 0.010000000000000002."""
     kept: list[float] = []
     for tick in ticks:
         if not kept or tick - kept[-1] > tolerance:

@@ -36,7 +36,9 @@ class PercentTicks(Formatter):
         percents = 100.0 * np.asarray(locs, dtype=float)
         percents = np.unique(percents[np.isfinite(percents)])
         gaps = np.diff(percents)
-        scale = gaps.min() if gaps.size else float(np.abs(percents).max(initial=1.0))
+        # A lone tick is written to a thousandth of itself (or of 1 % if it is 0).
+        lone = float(np.abs(percents).max(initial=0.0)) or 1.0
+        scale = gaps.min() if gaps.size else lone
         self._tolerance = _FAITHFUL * scale
         self._scientific = any(_decimals(p, self._tolerance) is None for p in percents)
 
