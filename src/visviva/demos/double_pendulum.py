@@ -74,7 +74,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     figure = Figure(figsize=(13, 4.5), layout="constrained")
     spread, running, energy = figure.subplots(1, 3)
     # The two runs by the colours the video gives them: blue starts at Q0, orange δ0 away.
-    spread.semilogy(pair.t, separation, label="|Δ(θ, θ̇)|: orange run − blue run")
+    spread.semilogy(pair.t, separation, label="|Δ(θ, θ̇)| between the two runs")
     spread.semilogy(
         pair.t,
         DELTA * np.exp(estimate.exponent * pair.t),
@@ -83,22 +83,22 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     )
     spread.set_xlabel("t [s]")
     spread.set_ylabel("separation")
-    spread.set_title(f"Two starts {DELTA:g} rad apart in θ₂ (video: blue, orange)")
+    spread.set_title(f"Two starts {DELTA:g} rad apart in θ₂ (the video's blue and orange)")
     legend_below(spread)
     running.plot(estimate.times, estimate.running)
     running.set_xlabel("t [s]")
     running.set_ylabel("λ estimate [1/s]")
     running.set_title("Finite-time Lyapunov exponent (Benettin)")
     e0 = pair.energy[0, 0]
-    energy.plot(pair.t, pair.energy[:, 0] / e0 - 1, label=f"blue run: RK4 (θ, θ̇), h = {DT} s")
+    energy.plot(pair.t, pair.energy[:, 0] / e0 - 1, label=f"RK4 (θ, θ̇), h = {DT} s")
     energy.plot(
         canonical.t,
         canonical.energy / e0 - 1,
-        label=f"blue start: implicit midpoint (θ, p), h = {10 * DT} s",
+        label=f"implicit midpoint (θ, p), h = {10 * DT} s",
     )
     energy.set_xlabel("t [s]")
     energy.set_ylabel("E(t)/E(0) − 1")
-    energy.set_title("Energy")
+    energy.set_title("Energy of the first start (the video's blue pendulum)")
     legend_below(energy)
     output.figures["double_pendulum"] = figure
     visible = np.flatnonzero(separation > 0.1)

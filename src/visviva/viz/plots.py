@@ -102,10 +102,12 @@ def plot_energy(
 ) -> Figure:
     """The relative change of the energy, ``(E(t) − E(0)) / |E(0)|``, of several runs: in
     percent, signed (top: growth and decay, linear within ±1 % and logarithmic beyond, so a
-    method that multiplies the energy by 1000 and one that loses half of it both read plainly)
-    and its magnitude on a log axis (bottom: separates the methods that keep the energy to
-    round-off from those with a bounded oscillation or a slow drift). Runs without an energy
-    are skipped; for a batch, system 0 is shown.
+    method that multiplies the energy by 1000 and one that loses half of it both read plainly;
+    the linear band is shaded, so a curve's bend at ±1 % reads as the axis', and the ticks
+    carry the decimals a small change needs) and its magnitude on a log axis (bottom:
+    separates the methods that keep the energy to round-off from those with a bounded
+    oscillation or a slow drift). Runs without an energy are skipped; for a batch, system 0 is
+    shown.
     """
     from matplotlib.figure import Figure
 
