@@ -44,6 +44,8 @@ import numpy as np
 from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
+from ..viz.colors import shades
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -310,19 +312,28 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     elevation.set_xlabel("x [m]")
     elevation.set_ylabel("y [m]")
     elevation.set_title(f"{BLOCKS} voussoirs on the catenary, joints square to it", fontsize=10)
-    elevation.legend(fontsize=8, loc="lower center")
+    legend_below(elevation)
+    # Green: it stands, red: it falls; within each, a shade of its own for each μ.
+    colors = {}
+    for stands, family in ((True, "Greens"), (False, "Reds")):
+        chosen = sorted(f for f in arches if arches[f]["stands"] == stands)
+        colors |= dict(zip(chosen, shades(len(chosen), family), strict=True))
     for friction in sorted(arches, reverse=True):
         drop = arches[friction]["_drop"]
-        drops.semilogy(times[friction], np.maximum(drop, 1e-6), label=f"μ = {friction:g}",
-                       color="tab:green" if arches[friction]["stands"] else "tab:red",
-                       alpha=0.5 + 0.5 * (friction in FRICTIONS))  # fmt: skip
+        drops.semilogy(
+            times[friction],
+            np.maximum(drop, 1e-6),
+            label=f"μ = {friction:g}",
+            color=colors[friction],
+            lw=1.8 if friction in FRICTIONS else 1.0,  # the recording's arches: bold
+        )
     drops.axhline(STOOD, color="grey", lw=0.6, ls="--")
     drops.set_xlabel("t [s]")
     drops.set_ylabel("keystone's drop [m]")
     drops.set_title(f"Stands from μ = {min(stood, default=float('nan')):g}, falls up to "
                     f"μ = {max(fell, default=float('nan')):g} (limit analysis: "
                     f"{limits['critical_friction']:.3f})", fontsize=10)  # fmt: skip
-    drops.legend(fontsize=8, ncols=2)
+    legend_below(drops)
     output.figures["arch"] = figure
     for found in arches.values():
         del found["_drop"]

@@ -31,6 +31,7 @@ from ..collision import ParticleContacts
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -172,7 +173,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     energy.set_xlabel("t [s]")
     energy.set_ylabel("kinetic energy [J]")
     energy.set_title(f"{mass.shape[0]} balls settling")
-    energy.legend(fontsize=8)
+    legend_below(energy)
     # The cut through the middle of the box (the plane z = 0): each ball it crosses is a disc
     # of radius √(r² − z²); two discs overlap only where their balls do.
     from matplotlib.collections import EllipseCollection

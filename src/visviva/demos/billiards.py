@@ -44,6 +44,7 @@ import numpy as np
 from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -202,7 +203,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     grow.set_xlabel("t [s]")
     grow.set_ylabel("object balls' mean distance to the nearest other [m]")
     grow.set_title("How far the rack spreads")
-    grow.legend(fontsize=8)
+    legend_below(grow)
     for ax, impacts in ((simultaneous, "simultaneous"), (sequential, "sequential")):
         recording = output.recordings[impacts]
         path = recording["body_origin"]

@@ -23,6 +23,7 @@ from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..particles.boids import polarisation
 from ..simulation.simulation import Simulation
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -116,7 +117,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     left.set_xlabel("t [s]")
     left.set_ylabel("Φ")
     left.set_title(f"{BIRDS:,} birds line up")
-    left.legend(fontsize=8, loc="lower right")
+    legend_below(left)
     for k, shade in ((0, "0.75"), (len(t) // 2, "C1"), (len(t) - 1, "C0")):
         right.scatter(x[k, :, 0], x[k, :, 2], s=0.2, color=shade, label=f"t = {t[k]:.0f} s")
     circle = np.linspace(0.0, 2.0 * np.pi, 200)
@@ -131,7 +132,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     right.set_xlabel("x [m]")
     right.set_ylabel("z [m]")
     right.set_title("Seen from above")
-    legend = right.legend(fontsize=8, loc="upper left")
+    legend = legend_below(right)
     for handle in legend.legend_handles[:3]:  # the three frames' dots, enlarged
         handle.set_sizes([12.0])
     output.figures["boids"] = figure

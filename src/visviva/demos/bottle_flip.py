@@ -21,6 +21,8 @@ from ..geometry.quaternions import quaternion_matrix
 from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -104,14 +106,14 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 
     figure = Figure(figsize=(12, 4.5), layout="constrained")
     turn, rise = figure.subplots(1, 2)
-    for k, name in enumerate(names):
-        turn.plot(t, turned[:, k], label=f"{name}: {landing[name]:.0f}° at landing")
-        rise.plot(t, heights[:, k], label=name)
+    for k, (name, color) in enumerate(zip(names, distinct_colors(len(names)), strict=True)):
+        turn.plot(t, turned[:, k], color=color, label=f"{name}: {landing[name]:.0f}° at landing")
+        rise.plot(t, heights[:, k], color=color, label=name)
     turn.axhline(360.0, color="grey", lw=0.6)
     turn.set_xlabel("t [s]")
     turn.set_ylabel("turned [°]")
     turn.set_title("Same flick, different I: ω = L / I")
-    turn.legend(fontsize=8)
+    legend_below(turn)
     rise.axhline(0.0, color="grey", lw=0.6)
     rise.set_xlabel("t [s]")
     rise.set_ylabel("centre of mass above its start [m]")

@@ -28,6 +28,8 @@ from ..geometry.quaternions import quaternion_matrix
 from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._meshes import bunny
 from .catalogue import BUILTIN_DEMOS
@@ -98,15 +100,15 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 
     figure = Figure(figsize=(12, 4.5), layout="constrained")
     fall, rest = figure.subplots(1, 2)
-    for k, name in enumerate(names):
-        fall.plot(t, heights[:, k], label=name)
-        rest.semilogy(t, np.maximum(energy[:, k], 1e-12), label=name)
+    for k, (name, color) in enumerate(zip(names, distinct_colors(len(names)), strict=True)):
+        fall.plot(t, heights[:, k], color=color, label=name)
+        rest.semilogy(t, np.maximum(energy[:, k], 1e-12), color=color, label=name)
     fall.axhline(0.0, color="grey", lw=0.6)
     fall.axhline(2 * STEP["center"][1], color="grey", lw=0.6, ls=":")
     fall.set_xlabel("t [s]")
     fall.set_ylabel("lowest surface point [m]")
     fall.set_title(f"Bunnies cut into {len(pieces)} convex pieces land on their surfaces")
-    fall.legend(fontsize=8)
+    legend_below(fall)
     rest.set_xlabel("t [s]")
     rest.set_ylabel("kinetic energy [J]")
     rest.set_title("Restitution 0.3, friction 0.6: they come to rest")

@@ -20,6 +20,7 @@ from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..rigid import mesh_mass_properties, sampled_mass_properties
 from ..simulation import Simulation
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._meshes import bunny
 from .catalogue import BUILTIN_DEMOS
@@ -73,14 +74,14 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     path.set_aspect("equal")
     path.set_xlabel("x [m]")
     path.set_ylabel("y [m]")
-    path.legend(fontsize=8)
+    legend_below(path)
     path.set_title("The centre of mass flies a parabola")
     for axis in range(3):
         tumble.plot(t, spin[:, axis], label=f"ω_{'xyz'[axis]}")
     tumble.set_xlabel("t [s]")
     tumble.set_ylabel("ω, world frame [rad/s]")
     tumble.set_title(f"ω wanders; L is constant (|ΔL| = {l_change:.1e} kg m²/s)")
-    tumble.legend(fontsize=8)
+    legend_below(tumble)
     moments = np.arange(3)
     check.bar(moments - 0.2, np.diag(exact.inertia), width=0.4, label="Mirtich (exact)")
     check.bar(
@@ -90,7 +91,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     check.set_xticks(moments, ["I_xx", "I_yy", "I_zz"])
     check.set_ylabel("kg m²")
     check.set_title("Inertia about the centre of mass")
-    check.legend(fontsize=8)
+    legend_below(check)
     output.figures["bunny_throw"] = figure
     z_scores = (np.diag(sampled.inertia) - np.diag(exact.inertia)) / np.diag(sampled.inertia_error)
     return {

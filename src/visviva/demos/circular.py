@@ -18,6 +18,8 @@ import numpy as np
 from ..io.job import JobOutput
 from ..ode.problems import SecondOrderProblem
 from ..simulation.solution import solve
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -54,21 +56,22 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     plane.plot(
         RADIUS * np.sin(angle), RADIUS * np.cos(angle), color="0.6", linewidth=3, label="exact"
     )
-    for name, recording in output.recordings.items():
+    runs = output.recordings.items()
+    for (name, recording), color in zip(runs, distinct_colors(len(runs)), strict=True):
         x, y = recording["q"][:, 0], recording["v"][:, 0]
-        plane.plot(x, y, linewidth=1.1, label=name)
-        radius.plot(recording.time, np.hypot(x, y), linewidth=1.3, label=name)
+        plane.plot(x, y, linewidth=1.1, color=color, label=name)
+        radius.plot(recording.time, np.hypot(x, y), linewidth=1.3, color=color, label=name)
     plane.set_aspect("equal")
     plane.set_xlabel("x [m]")
     plane.set_ylabel("y [m]")
     plane.set_title(f"Circular motion, h = {DT} s")
-    plane.legend(fontsize=8)
+    legend_below(plane)
     radius.axhline(RADIUS, color="0.6", linewidth=3, label="exact")
     radius.set_yscale("log")
     radius.set_xlabel("t [s]")
     radius.set_ylabel("radius |q| [m]")
     radius.set_title("Explicit Euler spirals out, backward Euler in")
-    radius.legend(fontsize=8)
+    legend_below(radius)
     output.figures["circular"] = figure
     return {
         "dt_s": DT,

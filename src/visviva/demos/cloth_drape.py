@@ -39,6 +39,7 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._deformables import (
     GRAVITY,
@@ -184,7 +185,7 @@ def _figure(
     total.set_xlabel("t [s]")
     total.set_ylabel("energy [J]")
     total.set_title("The energy never rises (contact and friction in the solve)")
-    total.legend(fontsize=8)
+    legend_below(total)
     side.add_patch(Circle(BALL_CENTER[:2], BALL_RADIUS, color="0.85", zorder=0))
     grid = recording["particle_position"][-1].reshape(POINTS, POINTS, 3)
     for row in grid:
@@ -201,7 +202,7 @@ def _figure(
     cone.set_xlabel("angle of the contact from the ball's top [°]")
     cone.set_ylabel("reaction along the surface / pressing")
     cone.set_title("Static friction: inside Coulomb's cone")
-    cone.legend(fontsize=8)
+    legend_below(cone)
     return figure
 
 

@@ -37,6 +37,7 @@ import numpy as np
 
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._deformables import (
     GRAVITY,
@@ -148,7 +149,7 @@ def _figure(recording: Recording, kinetic: np.ndarray, grid: np.ndarray) -> Figu
     total.set_xlabel("t [s]")
     total.set_ylabel("energy [J]")
     total.set_title("Backward Euler: the energy never rises")
-    total.legend(fontsize=8)
+    legend_below(total)
     moving.semilogy(t[1:], np.maximum(kinetic[1:], 1e-16), color="C1")
     moving.set_xlabel("t [s]")
     moving.set_ylabel("kinetic energy [J]")
@@ -167,7 +168,7 @@ def _figure(recording: Recording, kinetic: np.ndarray, grid: np.ndarray) -> Figu
     front.set_xlabel("x [m]")
     front.set_ylabel("height y [m]")
     front.set_title("At rest, seen from the front")
-    front.legend(fontsize=8)
+    legend_below(front)
     return figure
 
 

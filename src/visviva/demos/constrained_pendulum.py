@@ -17,6 +17,7 @@ from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.recording import Recording
 from ..simulation.solution import solve
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._bodies import drawn_if_interrupted
 from .catalogue import BUILTIN_DEMOS
@@ -81,15 +82,15 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     angle.set_xlabel("t [s]")
     angle.set_ylabel("θ [rad]")
     angle.set_title("The same swing, two descriptions")
-    angle.legend(fontsize=8)
+    legend_below(angle)
     drift.set_xlabel("t [s]")
     drift.set_ylabel("| |r − c| − L | [m]")
     drift.set_title(f"Rod length error, RK4, h = {DT} s")
-    drift.legend(fontsize=8)
+    legend_below(drift)
     tension.set_xlabel("t [s]")
     tension.set_ylabel("|f^c| [N]")
     tension.set_title("Constraint force along the rod")
-    tension.legend(fontsize=8)
+    legend_below(tension)
     output.figures["constrained_pendulum"] = figure
     return {"dt_s": DT, "max_rod_length_error_m": drifts}
 

@@ -41,6 +41,8 @@ from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
 from ..simulation.recording import Recording
+from ..viz.colors import distinct_colors
+from ..viz.legends import shared_legend_below
 from . import Demo, register_demo
 from ._bodies import drawn_if_interrupted
 from .catalogue import BUILTIN_DEMOS
@@ -186,9 +188,9 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
         x = recording["body_origin"][:, :, 0]
         y = recording["body_origin"][:, :, 1]
         v = np.gradient(x, t, axis=0)
-        for k in range(COUNT):
-            row[0].plot(t, v[:, k], lw=1.0, label=f"ball {k + 1}")
-            row[1].plot(t, 1e3 * (y[:, k] - y[0, 1]), lw=1.0, label=f"ball {k + 1}")
+        for k, color in enumerate(distinct_colors(COUNT)):
+            row[0].plot(t, v[:, k], lw=1.0, color=color, label=f"ball {k + 1}")
+            row[1].plot(t, 1e3 * (y[:, k] - y[0, 1]), lw=1.0, color=color, label=f"ball {k + 1}")
         peaks = found[impacts].get("peak_height_over_release_height")
         shares = "" if peaks is None else ", ".join(f"{p:.2f}" for p in peaks)
         row[0].set_title(f"{impacts} impacts: horizontal velocity")
@@ -198,8 +200,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
         row[1].set_ylabel("height [mm]")
     for ax in axes[1]:
         ax.set_xlabel("t [s]")
-    figure.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside lower center",
-                  ncols=COUNT, fontsize=8)  # fmt: skip
+    shared_legend_below(figure, axes[0, 0], ncols=COUNT)
     output.figures["cradle"] = figure
     return {
         "ball_mass_kg": MASS,

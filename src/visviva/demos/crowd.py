@@ -26,6 +26,8 @@ from ..analysis.crowds import exit_flow, exited, mean_flow
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -172,7 +174,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     rate.set_xlabel("t [s]")
     rate.set_ylabel("flow through the door [agents/s]")
     rate.set_title(f"Flow rate ({WINDOW:g} s windows)")
-    rate.legend(fontsize=8)
+    legend_below(rate)
     image = heat.pcolormesh(x_edges, z_edges, density.T, cmap="magma", shading="flat")
     heat.plot([ROOM, ROOM], [-3.5, -0.5 * DOOR], color="w", linewidth=3)
     heat.plot([ROOM, ROOM], [0.5 * DOOR, 3.5], color="w", linewidth=3)
@@ -186,13 +188,13 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     study: dict[str, Any] = {}
     widths = Figure(figsize=(10, 4.2), layout="constrained")
     curves, trend = widths.subplots(1, 2)
-    for door in WIDTHS:
+    for door, color in zip(WIDTHS, distinct_colors(len(WIDTHS)), strict=True):
         builder = build_scene(duration, agents=STUDY_AGENTS, side=STUDY_ROOM, door=door, seed=1)
         run_ = Simulation(builder.build())
         evacuate(run_, duration)
         left = run_.raw_state["crowd_exit_time"]
         grid = np.linspace(0.0, run_.time, 200)
-        curves.plot(grid, exited(left, grid), label=f"{door} m")
+        curves.plot(grid, exited(left, grid), color=color, label=f"{door} m")
         study[f"{door}"] = {
             "mean_flow_agents_per_s": mean_flow(left),
             "all_out_s": float(np.nanmax(left)) if np.isfinite(left).all() else None,
@@ -200,7 +202,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     curves.set_xlabel("t [s]")
     curves.set_ylabel("agents out")
     curves.set_title(f"{STUDY_AGENTS} agents, {STUDY_ROOM} m room")
-    curves.legend(title="door width", fontsize=8)
+    legend_below(curves, title="door width")
     flows = [study[f"{w}"]["mean_flow_agents_per_s"] for w in WIDTHS]
     trend.plot(WIDTHS, flows, "o-")
     trend.set_xlabel("door width [m]")

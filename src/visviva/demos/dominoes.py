@@ -33,6 +33,7 @@ from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
 from ..simulation.recording import Recording
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -152,7 +153,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     front.set_ylabel("position in the row / h")
     front.set_title("Where and when each fell: the larger row runs on the same line",
                     fontsize=10)  # fmt: skip
-    front.legend(fontsize=8)
+    legend_below(front)
     output.figures["dominoes"] = figure
     return {
         "domino_size_m": [HEIGHT, WIDTH, THICKNESS],

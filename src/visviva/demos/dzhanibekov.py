@@ -20,6 +20,7 @@ from ..geometry.quaternions import quaternion_matrix
 from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._meshes import t_handle
 from .catalogue import BUILTIN_DEMOS
@@ -32,6 +33,9 @@ SAMPLES_PER_SECOND = 60
 AXES = ("smallest moment (x)", "intermediate moment (y)", "largest moment (z)")
 #: The handles' names, written above them in the video.
 NAMES = ("about x: smallest I, steady", "about y: middle I, flips", "about z: largest I, steady")
+#: Each handle as the video shows it (left to right, its colour) and its spin axis' name.
+HANDLES = ("left, orange", "middle, red", "right, blue")
+ROLES = ("minor", "intermediate", "major")
 
 
 def build_scene(duration: float) -> SceneBuilder:
@@ -85,16 +89,22 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     panels = figure.subplots(2, 2).ravel()
     for k in range(3):
         for axis, style in zip(range(3), ("C0", "C1", "C2"), strict=True):
-            panels[k].plot(t, spins[:, k, axis], style, lw=0.8, label=f"ω_{'xyz'[axis]}")
-        panels[k].set_title(f"spun about its {AXES[k]}: {flips[k]} sign changes")
+            spun = axis == k  # the spin axis' ω, whose sign changes are counted: bolder
+            label = f"ω_{'xyz'[axis]}: {ROLES[axis]} axis" + (", spun" if spun else "")
+            panels[k].plot(t, spins[:, k, axis], style, lw=1.4 if spun else 0.8, label=label)
+        panels[k].set_title(
+            f"Handle {HANDLES[k]}: spun about its {ROLES[k]} axis, of the {AXES[k]}\n"
+            f"{flips[k]} sign changes",
+            fontsize=10,
+        )
         panels[k].set_xlabel("t [s]")
         panels[k].set_ylabel("ω in the body's axes [rad/s]")
-        panels[k].legend(fontsize=8, loc="upper right")
+        legend_below(panels[k])
     panels[3].plot(t, energy, label="kinetic energy / start − 1")
     panels[3].plot(t, drift_l, label="max |L − L₀| [kg m²/s]")
     panels[3].set_xlabel("t [s]")
     panels[3].set_title(f"Conserved: L exactly, energy within O(h²) (h = {DT:.4g} s)")
-    panels[3].legend(fontsize=8)
+    legend_below(panels[3])
     output.figures["dzhanibekov"] = figure
     return {
         "principal_moments_kg_m2": model.bodies.moments[0].tolist(),

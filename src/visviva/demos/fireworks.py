@@ -27,6 +27,7 @@ import numpy as np
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -214,7 +215,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     count.set_xlabel("t [s]")
     count.set_ylabel("live sparks")
     count.set_title("Sparks alive per shell (dotted: uniform lifetimes)")
-    count.legend(fontsize=8, loc="upper left")
+    legend_below(count)
     k = int(np.searchsorted(t, SHELLS[-1].burst_time + 0.4))
     k = min(k, t.shape[0] - 1)
     shown = alive[k]

@@ -40,6 +40,7 @@ import numpy as np
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..model.model import Model
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._deformables import GRAVITY, kinetic_energy, load_on_pins, record_alone
 from .catalogue import BUILTIN_DEMOS
@@ -162,7 +163,7 @@ def _figure(
     history.set_xlabel("t [s]")
     history.set_ylabel("angle from the vertical [°]")
     history.set_title("Blown out, it swings and settles")
-    history.legend(fontsize=8, loc="lower right")
+    legend_below(history)
     grid = points.reshape(ROWS, COLUMNS, 3)
     for column in range(COLUMNS):
         side.plot(grid[:, column, 2], grid[:, column, 1], color="C0", lw=0.8)

@@ -24,6 +24,7 @@ import numpy as np
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -126,7 +127,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     count.set_xlabel("t [s]")
     count.set_ylabel("drops alive")
     count.set_title("Filling up to the steady state")
-    count.legend(fontsize=8, loc="lower right")
+    legend_below(count)
     last = alive[-1]
     end = recording["particle_position"][-1][last]
     side.scatter(end[:, 0], end[:, 1], s=1.0, c=recording["particle_color"][-1][last])
@@ -139,7 +140,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     side.set_xlabel("x [m]")
     side.set_ylabel("height y [m]")
     side.set_title(f"Side view at t = {t[-1]:.2f} s")
-    side.legend(fontsize=8, loc="upper left", framealpha=0.9)
+    legend_below(side)
     output.figures["fountain"] = figure
 
     state = simulation.state

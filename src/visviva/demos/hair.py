@@ -52,6 +52,8 @@ from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..model.model import Model
 from ..simulation.simulation import Simulation
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._deformables import GRAVITY, one_thread, spring_pairs, strain
 from .catalogue import BUILTIN_DEMOS
@@ -289,14 +291,16 @@ def _figure(model: Model, t: np.ndarray, points: np.ndarray, strands: list[dict]
     figure = Figure(figsize=(12, 4.6), layout="constrained")
     swing, periods = figure.subplots(1, 2)
     swing.axvspan(TURN_START, TURN_STOP, color="0.9", label="the head turns")
-    for group, strand in zip(model.particle_groups, strands, strict=True):
+    colors = distinct_colors(len(strands))
+    for group, strand, color in zip(model.particle_groups, strands, colors, strict=True):
         offsets = sideways(points[:, group.start : group.start + strand["points"]])
-        swing.plot(t, 100 * offsets[:, -1], lw=1.0, label=f"{100 * strand['length_m']:.0f} cm")
+        swing.plot(t, 100 * offsets[:, -1], lw=1.0, color=color,
+                   label=f"{100 * strand['length_m']:.0f} cm")  # fmt: skip
     swing.set_xlabel("t [s]")
     swing.set_ylabel("tip's offset from the root along the hairline [cm]")
     swing.set_title("The head turns, stops, and the strands swing")
     swing.margins(y=0.3)
-    swing.legend(fontsize=8, ncols=3, loc="upper right")
+    legend_below(swing)
     length = np.array([s["length_m"] for s in strands])
     span = np.linspace(0.9 * length.min(), 1.05 * length.max(), 50)
     periods.plot(span, 2 * np.pi * np.sqrt(2 * span / (3 * GRAVITY)), "k:",
@@ -309,7 +313,7 @@ def _figure(model: Model, t: np.ndarray, points: np.ndarray, strands: list[dict]
     periods.set_xlabel("strand length L [m]")
     periods.set_ylabel("period [s]")
     periods.set_title("Small swings: a chain, a little slower than a rod")
-    periods.legend(fontsize=8)
+    legend_below(periods)
     return figure
 
 

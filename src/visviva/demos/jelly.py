@@ -32,6 +32,7 @@ import numpy as np
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..model.model import Model
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._deformables import (
     GRAVITY,
@@ -201,19 +202,19 @@ def _figure(
     fall.set_xlabel("t [s]")
     fall.set_ylabel("height above the floor [m]")
     fall.set_title("It falls, lands and bounces a little")
-    fall.legend(fontsize=8)
+    legend_below(fall)
     squash.plot(t, 100 * height, color="C2")
     squash.axhline(100 * SIZE, color="0.5", linestyle=":", label="undeformed")
     squash.set_xlabel("t [s]")
     squash.set_ylabel("top face above the bottom face [cm]")
     squash.set_title("Squash on impact, wobble, rest")
-    squash.legend(fontsize=8)
+    legend_below(squash)
     spent.plot(t, energy, label="total")
     spent.plot(t, kinetic, label="kinetic")
     spent.set_xlabel("t [s]")
     spent.set_ylabel("energy [J]")
     spent.set_title("The drop's energy goes to impacts and dampers")
-    spent.legend(fontsize=8)
+    legend_below(spent)
     return figure
 
 

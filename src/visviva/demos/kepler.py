@@ -18,6 +18,8 @@ from ..analysis.invariants import angular_momentum
 from ..io.job import JobOutput
 from ..mechanics import kepler_orbit
 from ..simulation.solution import solve
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._bodies import body_states, drawn_bodies, drawn_if_interrupted
 from .catalogue import BUILTIN_DEMOS
@@ -51,7 +53,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
         label="Kepler ellipse",
     )
     figures = {}
-    for name in METHODS:
+    for name, color in zip(METHODS, distinct_colors(len(METHODS)), strict=True):
         draw = functools.partial(drawn_bodies, color=COLORS)
         with drawn_if_interrupted(draw):
             solution = solve(problem, name, dt=dt, until=duration, record_every=10)
@@ -66,26 +68,23 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
             "max_angular_momentum_error": float(np.abs(relative_spin).max()),
             "final_position_error_m": float(error[-1]),
         }
-        path.plot(x[:, 1, 0], x[:, 1, 2], linewidth=0.8, label=name)
-        energy.semilogy(
-            solution.t / orbit.period, np.maximum(np.abs(relative_energy), 1e-17), label=name
-        )
-        momentum.semilogy(
-            solution.t / orbit.period, np.maximum(np.abs(relative_spin), 1e-17), label=name
-        )
+        path.plot(x[:, 1, 0], x[:, 1, 2], linewidth=0.8, color=color, label=name)
+        orbits = solution.t / orbit.period
+        energy.semilogy(orbits, np.maximum(np.abs(relative_energy), 1e-17), color=color, label=name)
+        momentum.semilogy(orbits, np.maximum(np.abs(relative_spin), 1e-17), color=color, label=name)
     path.set_aspect("equal")
     path.set_xlabel("x [m]")
     path.set_ylabel("z [m]")
     path.set_title(f"Lighter body, e = {ECCENTRICITY}, {STEPS_PER_ORBIT} steps per orbit")
-    path.legend(fontsize=8)
+    legend_below(path)
     energy.set_xlabel("orbits")
     energy.set_ylabel("|E/E_Kepler − 1|")
     energy.set_title("Energy")
-    energy.legend(fontsize=8)
+    legend_below(energy)
     momentum.set_xlabel("orbits")
     momentum.set_ylabel("|L/L0 − 1|")
     momentum.set_title("Angular momentum")
-    momentum.legend(fontsize=8)
+    legend_below(momentum)
     output.figures["kepler"] = figure
     return {"period_s": orbit.period, "dt_s": dt, "methods": figures}
 

@@ -18,6 +18,7 @@ import numpy as np
 from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.solution import solve
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._bodies import drawn_if_interrupted, drawn_system
 from .catalogue import BUILTIN_DEMOS
@@ -48,7 +49,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     motion.set_xlabel("t [s]")
     motion.set_ylabel("θ [rad]")
     motion.set_title("Large swings are slower than the harmonic approximation")
-    motion.legend(fontsize=8)
+    legend_below(motion)
     small = 2 * math.pi * math.sqrt(LENGTH / classic.STANDARD_GRAVITY)
     curve = np.linspace(0.01, 3.0, 300)
     periods.plot(
@@ -70,7 +71,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     periods.set_xlabel("amplitude θ0 [rad]")
     periods.set_ylabel("period T [s]")
     periods.set_title("Period against amplitude")
-    periods.legend(fontsize=8)
+    legend_below(periods)
     output.figures["pendulum"] = figure
     return {
         "equations": system.text(),

@@ -27,6 +27,7 @@ from ..geometry.quaternions import quaternion_rotate
 from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -153,13 +154,13 @@ def run(output: JobOutput, duration: float, columns: int = COLUMNS) -> dict[str,
     left.semilogy(t, np.maximum(kinetic, 1e-9), label="kinetic energy [J]")
     left.semilogy(t[1:], np.maximum(fastest, 1e-9), label="fastest centre of mass [m/s]")
     left.set_xlabel("t [s]")
-    left.legend(fontsize=8)
+    legend_below(left)
     left.set_title(f"{len(kinds):,} bodies fall into a bin and come to rest", fontsize=10)
     right.plot(t, centre[:, :, 1].max(axis=1), label="highest centre of mass")
     right.plot(t, centre[:, :, 1].mean(axis=1), label="mean height")
     right.set_xlabel("t [s]")
     right.set_ylabel("[m]")
-    right.legend(fontsize=8)
+    legend_below(right)
     right.set_title("The pile forms", fontsize=10)
     output.figures["pile"] = figure
     return {

@@ -41,6 +41,8 @@ import numpy as np
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._deformables import GRAVITY, one_thread
 from .catalogue import BUILTIN_DEMOS
@@ -213,15 +215,18 @@ def _figure(
 
     figure = Figure(figsize=(16, 4.4), layout="constrained")
     top, bottom, trend, sets = figure.subplots(1, 4)
+    resolutions = sorted(corners.keys() | curtain.keys())  # one colour per resolution
+    color = dict(zip(resolutions, distinct_colors(len(resolutions)), strict=True))
     for n, grid in corners.items():
-        top.plot(grid[0, :, 0], 1e3 * (grid[0, :, 1] - HEIGHT), "o-", ms=3, label=f"{n} × {n}")
+        top.plot(grid[0, :, 0], 1e3 * (grid[0, :, 1] - HEIGHT), "o-", ms=3, color=color[n],
+                 label=f"{n} × {n}")  # fmt: skip
     top.set_xlabel("x [m]")
     top.set_ylabel("height of the top edge [mm]")
     top.set_title("Held at two corners: the top edge")
-    top.legend(fontsize=8)
+    legend_below(top)
     for n, grid in curtain.items():
         bottom.plot(grid[-1, :, 0], 1e3 * (grid[-1, :, 1] - HEIGHT + SIZE), "o-", ms=3,
-                    label=f"{n} × {n}")  # fmt: skip
+                    color=color[n], label=f"{n} × {n}")  # fmt: skip
     moduli = membrane_moduli()
     for key, style in (("E", ":"), ("C11", "--")):
         level = AREAL_DENSITY * GRAVITY * SIZE**2 / (2 * moduli[key])
@@ -230,7 +235,7 @@ def _figure(
     bottom.set_xlabel("x [m]")
     bottom.set_ylabel("drop of the bottom edge [mm]")
     bottom.set_title("A curtain (top edge pinned): converges")
-    bottom.legend(fontsize=8)
+    legend_below(bottom)
     resolution = np.array(list(sag))
     trend.semilogx(resolution, 1e3 * np.array(list(sag.values())), "o-", base=2)
     trend.set_xlabel("points per side")
@@ -247,7 +252,7 @@ def _figure(
     sets.set_yticks(place, labels)
     sets.set_xlabel("droop [m]")
     sets.set_title("Which springs resist what (seed 001)")
-    sets.legend(fontsize=8, loc="center right")
+    legend_below(sets)
     return figure
 
 

@@ -16,6 +16,8 @@ import numpy as np
 from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.solution import solve
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._bodies import drawn_if_interrupted, drawn_system
 from .catalogue import BUILTIN_DEMOS
@@ -34,27 +36,27 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     figure = Figure(figsize=(12, 5), layout="constrained")
     path, error = figure.subplots(1, 2)
     errors = {}
-    for name in METHODS:
+    for name, color in zip(METHODS, distinct_colors(len(METHODS)), strict=True):
         with drawn_if_interrupted(functools.partial(drawn_system, system)):
             solution = solve(problem, name, dt=DT, until=duration)
         output.recordings[name] = drawn_system(system, solution.recording)
         exact = classic.rock_trajectory(solution.t, Q0, V0)
         height_error = solution.q[:, 1] - exact[:, 1]
         errors[name] = float(np.abs(solution.q - exact).max())
-        path.plot(solution.q[:, 0], solution.q[:, 1], "o-", markersize=3, label=name)
-        error.plot(solution.t, height_error, label=name)
+        path.plot(solution.q[:, 0], solution.q[:, 1], "o-", markersize=3, color=color, label=name)
+        error.plot(solution.t, height_error, color=color, label=name)
     t = np.linspace(0.0, duration, 200)
     exact = classic.rock_trajectory(t, Q0, V0)
     path.plot(exact[:, 0], exact[:, 1], color="0.3", linewidth=3, alpha=0.4, label="exact")
     path.set_xlabel("x [m]")
     path.set_ylabel("height y [m]")
     path.set_title(f"Thrown rock, h = {DT} s")
-    path.legend(fontsize=8)
+    legend_below(path)
     error.plot(t, 0.5 * classic.STANDARD_GRAVITY * DT * t, "k:", label="½ g h t (Euler, predicted)")
     error.set_xlabel("t [s]")
     error.set_ylabel("height error [m]")
     error.set_title("Constant force: Verlet and RK4 exact, Euler off by ½ g h t")
-    error.legend(fontsize=8)
+    legend_below(error)
     output.figures["rock"] = figure
     return {
         "dt_s": DT,

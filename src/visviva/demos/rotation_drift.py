@@ -18,6 +18,8 @@ import numpy as np
 from ..analysis.rotation_drift import drift_study
 from ..io.job import JobOutput
 from ..rigid.motion import BodyMotion
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -39,17 +41,21 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     study = drift_study(MOMENTS, OMEGA, DT, round(duration / DT), {"splitting": splitting})
     figure = Figure(figsize=(13, 4.5), layout="constrained")
     shape, energy, error = figure.subplots(1, 3)
-    for name in study.error:
-        shape.semilogy(study.t[1:], np.maximum(study.not_a_rotation[name][1:], 1e-17), label=name)
-        energy.plot(study.t, study.energy_error[name], label=name)
-        error.semilogy(study.t[1:], np.maximum(study.error[name][1:], 1e-17), label=name)
+    for name, color in zip(study.error, distinct_colors(len(study.error)), strict=True):
+        shape.semilogy(
+            study.t[1:], np.maximum(study.not_a_rotation[name][1:], 1e-17), color=color, label=name
+        )
+        energy.plot(study.t, study.energy_error[name], color=color, label=name)
+        error.semilogy(
+            study.t[1:], np.maximum(study.error[name][1:], 1e-17), color=color, label=name
+        )
     shape.set_title("How far from a rotation: ‖RᵀR − E‖")
     energy.set_title("Kinetic energy / start − 1")
     energy.set_ylim(-0.3, 1.0)
     error.set_title("Distance from the reference: ‖R − R_ref‖")
     for axes in (shape, energy, error):
         axes.set_xlabel("t [s]")
-    shape.legend(fontsize=7)
+    legend_below(shape)
     output.figures["rotation_drift"] = figure
     return {
         "dt_s": DT,

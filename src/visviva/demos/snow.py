@@ -29,6 +29,7 @@ from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..model.model import Model
 from ..simulation.simulation import Simulation
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -229,7 +230,7 @@ def _figure(
     settling.set_ylabel("fraction of the flakes born so far")
     settling.set_ylim(0.0, 1.02)
     settling.set_title("Settling")
-    settling.legend(fontsize=8, loc="upper left")
+    legend_below(settling)
     side.add_patch(Circle(BALL_CENTER[:2], BALL_RADIUS, color="0.85", zorder=0))
     side.axhline(0.0, color="0.4")
     for chosen, color, label in (
@@ -253,7 +254,7 @@ def _figure(
     side.set_xlabel("x [m] (wind towards +x)")
     side.set_ylabel("height y [m]")
     side.set_title(f"Side view at t = {t[-1]:.1f} s (dotted: tan α = μ, still air)")
-    side.legend(fontsize=8, loc="upper left", markerscale=5)
+    legend_below(side, markerscale=5)
     return figure
 
 

@@ -16,6 +16,7 @@ import numpy as np
 from ..io.job import JobOutput
 from ..mechanics import classic
 from ..simulation.solution import solve
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._bodies import drawn_if_interrupted, drawn_system
 from .catalogue import BUILTIN_DEMOS
@@ -62,7 +63,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     exchange.set_xlabel("t [s]")
     exchange.set_ylabel("energy [J]")
     exchange.set_title("ω_spring = 2 ω_swing: the modes trade energy")
-    exchange.legend(fontsize=8)
+    legend_below(exchange)
     e = spring + gravity + radial + swing
     total.plot(solution.t, e / e[0] - 1)
     total.set_xlabel("t [s]")

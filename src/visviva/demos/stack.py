@@ -34,6 +34,8 @@ import numpy as np
 from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -106,14 +108,14 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
 
     figure = Figure(figsize=(12, 4.5), layout="constrained")
     left, right = figure.subplots(1, 2)
-    for b in range(COUNT):
-        left.plot(t, 1e3 * moved[:, b], lw=1.0, label=f"box {b + 1}")
+    for b, color in enumerate(distinct_colors(COUNT)):
+        left.plot(t, 1e3 * moved[:, b], lw=1.0, color=color, label=f"box {b + 1}")
     left.axhline(1.0, color="grey", lw=0.8, ls="--", label="issue 27's 1 mm")
     left.set_xlabel("t [s]")
     left.set_ylabel("distance from its start [mm]")
     left.set_title(f"Ten stacked 1 m cubes: at most {1e3 * moved.max():.2f} mm, at rest to "
                    f"{max(speed.max(), spin.max()):.0e} m/s", fontsize=10)  # fmt: skip
-    left.legend(fontsize=7, ncols=2)
+    legend_below(left)
     for sweeps, style in zip(SWEEPS, ("--", "-"), strict=True):
         for fraction, color in zip(LEANS, ("tab:green", "tab:red"), strict=True):
             right.semilogy(tower.time, np.maximum(tops[sweeps][fraction], 1e-6), style,
@@ -122,7 +124,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     right.set_ylabel("top box's distance from its start [m]")
     right.set_title("Leaning towers (harmonic shifts × f): stand at f < 1, topple at f > 1",
                     fontsize=10)  # fmt: skip
-    right.legend(fontsize=8)
+    legend_below(right)
     output.figures["stack"] = figure
     return {
         "max_displacement_m": float(moved.max()),

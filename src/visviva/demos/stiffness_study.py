@@ -46,6 +46,8 @@ from ..errors import SimulationError
 from ..io.job import JobOutput
 from ..model.builder import SceneBuilder
 from ..simulation.simulation import Simulation
+from ..viz.colors import distinct_colors
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._deformables import GRAVITY, largest_rise, one_thread, strain, stretch_pairs
 from .catalogue import BUILTIN_DEMOS
@@ -166,7 +168,7 @@ def _figure(table: list[dict[str, Any]], recordings: dict[str, Recording]) -> Fi
     limit.set_xlabel("spring stiffness k [N/m]")
     limit.set_ylabel("step [ms]")
     limit.set_title("Stable where h < h_max ∝ 1/√k")
-    limit.legend(fontsize=8)
+    legend_below(limit)
     for row_index, method in enumerate(methods):
         for column, entry in enumerate(table):
             result = entry[method]
@@ -179,17 +181,17 @@ def _figure(table: list[dict[str, Any]], recordings: dict[str, Recording]) -> Fi
     board.set_title("At h = 1/60 s: o survived, x blew up")
     for method in methods:
         panel = panels[method]
-        for index, entry in enumerate(table):
+        for entry, color in zip(table, distinct_colors(len(table)), strict=True):
             recording = recordings[f"{method}_k{entry['k_N_per_m']:g}"]
             energy = recording["energy"]
             change = np.abs(energy - energy[0]) / abs(energy[0])
-            panel.semilogy(recording.time[1:], np.maximum(change[1:], 1e-12), color=f"C{index}",
+            panel.semilogy(recording.time[1:], np.maximum(change[1:], 1e-12), color=color,
                            label=f"k = {entry['k_N_per_m']:g}")  # fmt: skip
         panel.set_xlabel("t [s]")
         panel.set_ylabel("|E − E₀| / E₀")
         panel.set_ylim(1e-6, 1e6)
         panel.set_title(method)
-    panels[methods[-1]].legend(fontsize=8)
+    legend_below(panels[methods[-1]])
     return figure
 
 

@@ -17,6 +17,7 @@ from ..analysis.invariants import angular_momentum
 from ..io.job import JobOutput
 from ..mechanics import sun_earth_moon
 from ..simulation.solution import solve
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from ._bodies import body_states, drawn_bodies, drawn_if_interrupted
 from .catalogue import BUILTIN_DEMOS
@@ -87,7 +88,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     invariants.set_xlabel("t [days]")
     invariants.set_ylabel("relative change")
     invariants.set_title(f"Velocity Verlet, h = {DT / 3600:g} h")
-    invariants.legend(fontsize=8)
+    legend_below(invariants)
     output.figures["sun_earth_moon"] = figure
     return {
         "sidereal_year_days": _period(solution.t, earth) / DAY,

@@ -30,6 +30,7 @@ from ..geometry.quaternions import quaternion_matrix, quaternion_multiply, quate
 from ..io.job import JobOutput
 from ..model import SceneBuilder
 from ..simulation import Simulation
+from ..viz.legends import legend_below
 from . import Demo, register_demo
 from .catalogue import BUILTIN_DEMOS
 
@@ -107,7 +108,7 @@ def run(output: JobOutput, duration: float) -> dict[str, Any]:
     turn.set_xlabel("t [s]")
     turn.set_ylabel("azimuth [rad]")
     turn.set_title(f"Precession: {rate:.3f} rad/s (steady {steady:.3f}, fast {theory:.3f})")
-    turn.legend(fontsize=8)
+    legend_below(turn)
     output.figures["top"] = figure
     return {
         "precession_rate_rad_per_s": rate,

@@ -14,6 +14,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..analysis.invariants import relative_change
+from .colors import distinct_styles
+from .legends import legend_below, legend_beside, shared_legend_below
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -31,6 +33,8 @@ __all__ = [
     "plot_stability_regions",
 ]
 
+#: The signed energy change's axis label (its second line says where the axis is linear).
+ENERGY_CHANGE = "(E(t) − E(0)) / |E(0)|"
 STABLE_COLOR = "#9ecae1"
 BOUNDARY_COLOR = "#08519c"
 
@@ -91,19 +95,6 @@ def plot_stability_regions(
     return figure
 
 
-def _styles(count: int) -> list[dict[str, Any]]:
-    """Distinct colour/line-style pairs for up to 40 curves on one axis."""
-    from matplotlib import colormaps
-
-    palette = colormaps["tab20"]
-    colors = [palette(i) for i in range(20)]
-    dashes = ("-", "--")
-    return [
-        {"color": colors[(2 * i) % 20 + (i // 10) % 2], "linestyle": dashes[(i // 20) % 2]}
-        for i in range(count)
-    ]
-
-
 def plot_energy(
     recordings: Mapping[str, Recording],
     *,
@@ -111,18 +102,22 @@ def plot_energy(
 ) -> Figure:
     """The relative change of the energy, ``(E(t) − E(0)) / |E(0)|``, of several runs: in
     percent, signed (top: growth and decay, linear within ±1 % and logarithmic beyond, so a
-    method that multiplies the energy by 1000 and one that loses half of it both read plainly)
-    and its magnitude on a log axis (bottom: separates the methods that keep the energy to
-    round-off from those with a bounded oscillation or a slow drift). Runs without an energy
-    are skipped; for a batch, system 0 is shown.
+    method that multiplies the energy by 1000 and one that loses half of it both read plainly;
+    the linear band is shaded, so a curve's bend at ±1 % reads as the axis', and the ticks
+    carry the decimals a small change needs) and its magnitude on a log axis (bottom:
+    separates the methods that keep the energy to round-off from those with a bounded
+    oscillation or a slow drift). Runs without an energy are skipped; for a batch, system 0 is
+    shown.
     """
     from matplotlib.figure import Figure
-    from matplotlib.ticker import PercentFormatter
+
+    from .symlog import symlog_axis
+    from .ticks import PercentTicks
 
     figure = Figure(figsize=(9.0, 8.0), layout="constrained")
     change_ax, error_ax = figure.subplots(2, 1, sharex=True)
     runs = [(n, r) for n, r in recordings.items() if "energy" in r and r.frames > 0]
-    for (name, recording), style in zip(runs, _styles(len(runs)), strict=True):
+    for (name, recording), style in zip(runs, distinct_styles(len(runs)), strict=True):
         energy = recording["energy"]
         energy = energy if energy.ndim == 1 else energy[:, 0]
         change = relative_change(energy)
@@ -134,11 +129,10 @@ def plot_energy(
             linewidth=1.1,
             **style,
         )
-    change_ax.set_yscale("symlog", linthresh=0.01, linscale=0.5)
-    change_ax.yaxis.set_major_formatter(PercentFormatter(xmax=1.0, decimals=0))
-    change_ax.set_ylabel("(E(t) − E(0)) / |E(0)|")
+    symlog_axis(change_ax, linthresh=0.01, linscale=0.5, label=ENERGY_CHANGE, threshold_text="1 %")
+    change_ax.yaxis.set_major_formatter(PercentTicks())
     change_ax.axhline(0.0, color="0.5", linewidth=0.8)
-    change_ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    legend_beside(change_ax)  # up to 17 methods: a tall list
     change_ax.set_title(title)
     error_ax.set_yscale("log")
     error_ax.set_ylabel("|E(t) − E(0)| / |E(0)|")
@@ -185,8 +179,8 @@ def plot_phase(
         ax.set_xlabel(labels[0])
         ax.set_ylabel(labels[1])
         ax.set_aspect("equal", adjustable="datalim")
-    if recordings:
-        figure.axes[0].legend(fontsize=8, loc="upper right")
+    if recordings:  # every panel draws the same three things: one legend for all
+        shared_legend_below(figure, figure.axes[0])
     figure.suptitle(title)
     return figure
 
@@ -195,7 +189,7 @@ def plot_convergence(studies: Sequence[ConvergenceStudy]) -> Figure:
     """Error against step size, log–log, with the fitted order of each method."""
     figure = _figure(1, width=7.5, height=5.5)
     ax = figure.axes[0]
-    for study, style in zip(studies, _styles(len(studies)), strict=True):
+    for study, style in zip(studies, distinct_styles(len(studies)), strict=True):
         finite = np.isfinite(study.error) & (study.error > 0)
         ax.loglog(
             study.dt[finite],
@@ -216,7 +210,7 @@ def plot_convergence(studies: Sequence[ConvergenceStudy]) -> Figure:
     ax.set_xlabel("dt [s]")
     ax.set_ylabel("error at `until` (max norm)")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    legend_below(ax)
     ax.set_title("Convergence: circled points are in the fitted asymptotic range")
     return figure
 
@@ -269,6 +263,6 @@ def plot_momentum(recording: Recording, *, title: str = "Momenta") -> Figure:
             ax.plot(recording.time, values[:, axis], label=f"{label.split()[-2]}{name}")
         ax.set_xlabel("t [s]")
         ax.set_ylabel(label)
-        ax.legend(fontsize="small")
+        legend_below(ax)
     figure.suptitle(title)
     return figure

@@ -10,7 +10,8 @@ import textwrap
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from .plots import _styles
+from .colors import distinct_styles
+from .legends import legend_beside
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -58,7 +59,7 @@ def plot_against_parameter(
     figure = Figure(figsize=FIGURE_SIZE, dpi=DPI, layout="constrained")
     ax = figure.subplots()
     drawn = [line for line in lines if len(line[1])]
-    for (label, x, y), style in zip(drawn, _styles(len(drawn)), strict=True):
+    for (label, x, y), style in zip(drawn, distinct_styles(len(drawn)), strict=True):
         ax.plot(
             x,
             y,
@@ -88,7 +89,8 @@ def plot_against_parameter(
     ax.set_title(title)
     ax.grid(True, which="both", alpha=0.3)
     if any(label for label, _, _ in drawn):
-        ax.legend(title=legend_title, fontsize=8, title_fontsize=8)
+        # Beside, not below: slanted x tick labels reach an unknown depth under the axes.
+        legend_beside(ax, title=legend_title, title_fontsize=8)
     if note:
         # A figure-level label: constrained layout makes room for it under the axis label.
         figure.supxlabel(
