@@ -2,6 +2,7 @@
 light that add up on a night sky, framed where nearly all of them are."""
 
 import numpy as np
+import pytest
 
 import visviva as vv
 from visviva.viz import raster
@@ -45,3 +46,16 @@ def test_a_star_field_is_dark_with_bright_stars_and_framed_on_the_disk():
     brightness = image.mean(axis=2)
     assert np.median(brightness) < 20  # a night sky
     assert brightness.max() > 200  # the dense middle of the disk glows
+
+
+def test_a_style_chooses_night_or_day_whatever_the_points_are():
+    recording = _disk(3000)
+    for style, stars in (("day", False), ("night", True), ("auto", True)):
+        recording.attrs["playback_style"] = style
+        assert is_star_field(recording.geometry()) is stars
+    small = _disk(50)
+    small.attrs["playback_style"] = "night"  # fireworks: few sparks, with radii, at night
+    assert is_star_field(small.geometry())
+    small.attrs["playback_style"] = "dusk"
+    with pytest.raises(vv.ModelError, match="not one of auto, day, night"):
+        small.geometry()

@@ -384,6 +384,7 @@ def recording_attrs(model: Model, seconds: float) -> dict[str, Any]:
             "playback_trail": model.output_trail,
             "playback_color_by": model.output_color_by,
             "playback_frame": model.output_frame,
+            "playback_style": model.output_style,
             "compiled": False,
         }
         | ({} if model.output_camera is None else {"playback_camera": model.output_camera})

@@ -43,6 +43,8 @@ class Demo:
             recorded colours) or ``"speed"``.
         labels: The video writes each rigid body's name above it (where the lesson depends
             on telling them apart).
+        style: How the video and the viewer draw the points: ``"auto"``, ``"day"`` or
+            ``"night"`` (spots of light on a night sky: fireworks).
         full: The long version's ``run`` (``visviva demo NAME --full``), for a demo whose
             default is cut down to finish within a minute; ``None`` if there is none.
     """
@@ -56,6 +58,7 @@ class Demo:
     trail: float = 0.0
     color_by: str = "scene"
     labels: bool = False
+    style: str = "auto"
     full: Callable[[JobOutput, float], dict[str, Any]] | None = None
 
 

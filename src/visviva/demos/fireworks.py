@@ -248,5 +248,6 @@ register_demo(
         DURATION,
         run,
         picture=True,
+        style="night",  # sparks are light: spots that add up on a night sky
     )
 )

@@ -113,6 +113,7 @@ def run_demo(
                 "playback_trail": demo.trail,
                 "playback_color_by": demo.color_by,
                 "playback_labels": demo.labels,
+                "playback_style": demo.style,
             } | view
         summary = _summary(demo, output, seconds, interrupted) | extra
         if full:

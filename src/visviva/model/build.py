@@ -106,6 +106,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         output_color_by=scene.output.color_by,
         output_camera=None if scene.output.camera is None else scene.output.camera.text(),
         output_frame=scene.output.frame,
+        output_style=scene.output.style,
         source=source,
     )
     problems = _check_start(model)

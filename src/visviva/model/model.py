@@ -127,6 +127,8 @@ class Model:
             :func:`~visviva.viz.framing.parse_camera` reads it, or ``None``: a framing.
         output_frame: Without a camera, what the view keeps in the picture: ``"all"`` or a
             body's name.
+        output_style: How videos and the viewer draw the points: ``"auto"``, ``"day"`` or
+            ``"night"``.
         source: The scene file's text, if it came from a file (kept in recordings).
     """
 
@@ -160,6 +162,7 @@ class Model:
     output_color_by: str = "scene"
     output_camera: str | None = None
     output_frame: str = "all"
+    output_style: str = "auto"
     source: str | None = field(default=None, repr=False)
 
     @property

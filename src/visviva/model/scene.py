@@ -153,6 +153,11 @@ class Output(Strict):
     camera: OutputCamera | None = Field(
         None, description="the view {eye, target, up, fov}; default: a framing (see frame)"
     )
+    style: Literal["auto", "day", "night"] = Field(
+        "auto",
+        description="how videos and the viewer draw the points: auto, day (shaded spheres on "
+        "a ground) or night (spots of light on a night sky: fireworks, galaxies)",
+    )
     frame: Name = Field(
         "all",
         description="without camera, what the view keeps in the picture for the whole run: "

@@ -105,6 +105,9 @@ class Geometry:
         bodies: The rigid bodies' surfaces and transforms, or ``None``.
         scenery: The static colliders' surfaces, or ``None``.
         walls: The planes other than floors, or ``None``.
+        style: How outputs draw the points: ``"auto"`` (by what they are), ``"day"`` (shaded
+            spheres on a ground) or ``"night"`` (spots of light on a night sky: fireworks, a
+            galaxy); a recording's attribute ``playback_style``.
     """
 
     points: np.ndarray
@@ -117,6 +120,7 @@ class Geometry:
     bodies: BodyGeometry | None = None
     scenery: Scenery | None = None
     walls: Walls | None = None
+    style: str = "auto"
 
     @property
     def to_scale(self) -> bool:
@@ -298,6 +302,7 @@ class Recording:
         return Geometry(
             points,
             walls=read_walls(self.static),
+            style=_style(self.attrs),
             radius=radius,
             color=color,
             display_radius=display_radius,
@@ -358,3 +363,16 @@ class Recording:
     def __repr__(self) -> str:
         shapes = ", ".join(f"{k}{tuple(v.shape)}" for k, v in self.fields.items())
         return f"Recording({self.frames} frames: {shapes})"
+
+
+#: How outputs may draw a recording's points (:attr:`Geometry.style`).
+STYLES = ("auto", "day", "night")
+
+
+def _style(attrs: Mapping[str, Any]) -> str:
+    style = str(attrs.get("playback_style", "auto"))
+    if style not in STYLES:
+        raise ModelError(
+            f"the recording's playback_style {style!r} is not one of {', '.join(STYLES)}"
+        )
+    return style

@@ -380,7 +380,11 @@ class _Faces:
 
 
 def is_star_field(geometry: Geometry) -> bool:
-    """Whether ``geometry`` is drawn as a star field (see :data:`STAR_FIELD_POINTS`)."""
+    """Whether ``geometry`` is drawn as a star field: its style says so (``"night"``,
+    ``"day"``), or by default it is many points without a size and nothing else (see
+    :data:`STAR_FIELD_POINTS`)."""
+    if geometry.style != "auto":
+        return geometry.style == "night" and geometry.points.shape[1] > 0
     return (
         geometry.points.shape[1] >= STAR_FIELD_POINTS
         and geometry.radius is None
@@ -404,7 +408,9 @@ class _StarField:
     def draw(self, stage: _Stage, frame: _Frame, color: np.ndarray, depth: np.ndarray) -> None:
         self.light.fill(0.0)
         order = np.arange(frame.positions.shape[0]) if frame.live is None else frame.live
-        raster.splat_points(self.light, frame.screen, order, frame.colour, STAR_GAIN)
+        # Fewer points shine brighter (a fireworks shell of a few hundred sparks), up to 4×.
+        gain = STAR_GAIN * float(np.clip(np.sqrt(2000 / max(order.size, 1)), 1.0, 4.0))
+        raster.splat_points(self.light, frame.screen, order, frame.colour, gain)
         raster.expose(self.light, color.copy(), color)
 
 
