@@ -3,30 +3,18 @@ keep every body and particle of the example scenes in the picture for the whole 
 
 import json
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import visviva as vv
-from visviva.cli.main import main
+from test_cli import run_main
 from visviva.errors import ModelError
 from visviva.viz.framing import chosen_camera, framed_bounds, parse_camera
 from visviva.viz.outputs import playback
 
 EXAMPLES = Path(__file__).parents[1] / "examples" / "scenes"
-
-
-def run_main(monkeypatch, capsys, *args) -> tuple[int, str, str]:
-    monkeypatch.setattr(sys, "argv", ["visviva", *map(str, args)])
-    try:
-        main()
-        status = 0
-    except SystemExit as exit_:
-        status = 0 if exit_.code is None else exit_.code
-    captured = capsys.readouterr()
-    return status, captured.out, captured.err
 
 
 def in_picture(camera: vv.viz.video.Camera, points: np.ndarray, aspect: float) -> np.ndarray:

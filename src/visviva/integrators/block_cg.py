@@ -78,32 +78,7 @@ def _new_direction(beta, z, p):  # pragma: no cover - compiled
 @njit(cache=True)
 def _precondition(cycle, normals, r, z):  # pragma: no cover - compiled
     """``z ← B r`` (filtered across ``normals`` if any); returns ``r · z``."""
-    (
-        levels,
-        indptr,
-        indices,
-        blocks,
-        inverses,
-        aggregates,
-        factor,
-        residuals,
-        corrections,
-        scratch,
-    ) = cycle
-    vcycle(
-        levels,
-        indptr,
-        indices,
-        blocks,
-        inverses,
-        aggregates,
-        factor,
-        residuals,
-        corrections,
-        scratch,
-        r,
-        z,
-    )
+    vcycle(*cycle, r, z)
     if normals.shape[0] > 0:
         _filter(normals, z)
     return _dot(r, z)
