@@ -15,8 +15,9 @@ What runs:
   runs a page's commands again.
 - The scratch directory holds a copy of ``examples/`` (what the pages name by relative path);
   ``out/...`` lands in it. ``visviva`` on its ``PATH`` is ``python -m visviva`` of the package
-  under test. Numba runs one thread: the suite's other worker holds the other core, and two
-  threads on a busy core ran projected Newton's solver ten times slower.
+  under test. Numba and OpenBLAS run one thread each (results do not depend on it): the
+  suite's other worker holds the other core, and a thread that waits for a busy core made
+  the deformables page's projected Newton cloth several times slower.
 - Install commands are not run: the snippets run in the environment the suite runs in (CI
   installs the project with its ``test`` extra). In a bash block, a line's leading commands
   joined by ``&&`` that make or enter a virtual environment (``python3 -m venv DIR``,
@@ -310,6 +311,7 @@ def _environment(tools: Path) -> dict[str, str]:
         "PYTHONPATH": os.pathsep.join(p for p in python_path if p),
         "MPLBACKEND": "Agg",
         "NUMBA_NUM_THREADS": "1",
+        "OPENBLAS_NUM_THREADS": "1",
     }
 
 
