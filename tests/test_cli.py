@@ -376,7 +376,7 @@ def test_dry_run_advises_against_the_step_the_integrator_takes(
     scene = tmp_path / "spring.toml"
     scene.write_text(
         '[scene]\nname = "spring"\n[integration]\nmethod = "symplectic_euler"\ndt = 0.5\n'
-        f"substeps = {substeps}\nduration = 5.0\n[[entities]]\ntype = \"system\"\n"
+        f'substeps = {substeps}\nduration = 5.0\n[[entities]]\ntype = "system"\n'
         'system = "oscillator"\nparameters = { omega = 10.0 }\n'
     )
     status, out, err = run_main(monkeypatch, capsys, "run", scene, "--dry-run")

@@ -71,6 +71,16 @@ def test_plot_refuses_a_recording_without_energy_or_momenta(monkeypatch, capsys,
     assert sorted(p.name for p in tmp_path.iterdir()) == ["recording.h5"]
 
 
+def test_plot_momentum_of_a_recording_with_energy_alone_offers_its_energy(
+    monkeypatch, capsys, tmp_path
+):
+    """A named system's recording (examples/scenes/kepler.toml) has energy but no momenta:
+    --momentum used to say it had neither."""
+    path = _recording(tmp_path, energy=np.ones(5), system_points=np.zeros((5, 2, 3)))
+    line = refused(monkeypatch, capsys, "plot", path, "--momentum")
+    assert "has no momenta to plot" in line and "without --momentum, its energy" in line
+
+
 def test_plot_draws_what_the_recording_has(monkeypatch, capsys, tmp_path):
     recording = vv.Recording(
         np.linspace(0.0, 1.0, 5),

@@ -177,9 +177,12 @@ def plot_command(
             )
         (chosen,) = runs.values()
         if not has_momenta(chosen):
+            # --momentum on a recording with energy (a named system's): it has energy to plot.
+            has = "no momenta" if with_energy else "neither energy nor momenta"
+            instead = "; without --momentum, its energy" if with_energy else ""
             raise ModelError(
-                f"{recording} has neither energy nor momenta to plot (fields: {_fields(runs)}); "
-                "momenta need the positions, velocities and masses of a particle recording"
+                f"{recording} has {has} to plot (fields: {_fields(runs)}); momenta need the "
+                f"positions, velocities and masses of a particle recording{instead}"
             )
     target = output or recording.with_name(f"{kind}.png")
     check_figure_file(target, force)
