@@ -51,8 +51,8 @@ from pathlib import Path
 
 import visviva
 
-#: Fence tags whose blocks run, and as what.
-RUNNABLE = {"python": "python", "bash": "bash"}
+#: Fence tags whose blocks run.
+RUNNABLE = ("python", "bash")
 #: Folders of the repository that the pages name by relative paths, copied into the scratch
 #: directory (a copy, so that nothing a page does can write into the repository).
 COPIED = ("examples",)
@@ -145,9 +145,8 @@ def _block(
     page: str, line: int, tag: str, code: list[str], markers: list[tuple[int, str, str]]
 ) -> Block | None:
     """The block of a fence, or None for one this runner does not run (and must not mark)."""
-    kind = RUNNABLE.get(tag)
-    doctest = kind == "python" and next((c for c in code if c.strip()), "").startswith(">>>")
-    if kind is None or doctest:
+    doctest = tag == "python" and next((c for c in code if c.strip()), "").startswith(">>>")
+    if tag not in RUNNABLE or doctest:
         if markers:
             what = "a doctest" if doctest else f"a {tag or 'plain'} block, which is not run"
             raise SnippetError(f"{page}:{markers[0][0]}: a snippet marker above {what}")
@@ -162,7 +161,7 @@ def _block(
             skip = argument
         else:
             fragment = True
-    return Block(page, line, kind, "\n".join(code), skip, fragment)
+    return Block(page, line, tag, "\n".join(code), skip, fragment)
 
 
 def _check_order(blocks: list[Block]) -> None:
@@ -170,7 +169,7 @@ def _check_order(blocks: list[Block]) -> None:
     for k, block in enumerate(blocks):
         if block.kind == "setup":
             after = blocks[k + 1] if k + 1 < len(blocks) else None
-            if after is None or after.kind == "setup" or not after.fragment or after.skip:
+            if after is None or not after.fragment or after.skip:
                 raise SnippetError(
                     f"{block.page}:{block.line}: a setup must be followed by the block it "
                     "completes, marked `<!-- snippet: fragment -->`"
