@@ -12,7 +12,7 @@ SOURCE = Path(visviva.__file__).parent
 
 #: The layers, lowest first (docs/architecture.md, "Layers").
 LAYERS = [
-    {"errors", "_validation", "_registry", "_memo", "_lazy", "_version"},
+    {"errors", "_validation", "_registry", "_memo", "_lazy", "_version", "_blas", "_compiling"},
     {"ode", "geometry"},
     {"integrators", "mechanics"},
     {"analysis"},
