@@ -152,3 +152,36 @@ def test_labels_name_each_body_above_it():
     _rows, columns = np.nonzero(changed[40:])  # below the time label in the corner
     # Two labels, one over each box: changed pixels left and right of the middle.
     assert (columns < 160).any() and (columns >= 160).any()
+
+
+def test_a_followed_body_stays_at_the_centre_of_a_moving_view(tmp_path, monkeypatch, capsys):
+    from visviva.viz.framing import following
+
+    builder = vv.SceneBuilder(name="thrown")
+    builder.set_integration(method="symplectic_euler", dt=0.01, duration=1.0)
+    builder.add_body("box", size=(0.2, 0.2, 0.2), density=500.0, name="ball",
+                     velocity=(3.0, 4.0, 0.0))  # fmt: skip
+    builder.add_body("box", size=(0.2, 0.2, 0.2), density=500.0, name="still",
+                     position=(-1.0, 0.0, 0.0))  # fmt: skip
+    recording = vv.Simulation(builder.build()).record(until=1.0)
+    geometry = recording.geometry()
+    camera_at = following(geometry, "ball", 16 / 9)
+    first, last = camera_at(0), camera_at(recording.frames - 1)
+    # The target is the box's centre in each frame (x = 3 t, y = 4 t − g t²/2), the eye keeps
+    # its offset from it.
+    t = recording.time[-1]
+    np.testing.assert_allclose(last.target, (3.0 * t, 4.0 * t - 0.5 * 9.81 * t * t, 0.0), atol=0.05)
+    np.testing.assert_allclose(
+        np.subtract(last.eye, last.target), np.subtract(first.eye, first.target)
+    )
+    path = tmp_path / "thrown.h5"
+    vv.io.write_recordings(path, {"thrown": recording})
+    status, _, err = run_main(monkeypatch, capsys, "export", path, "--to", "gif", "--follow",
+                              "ball", "--fps", "10", "-o", tmp_path / "f.gif")  # fmt: skip
+    assert status == 0 and (tmp_path / "f.gif").stat().st_size > 1000, err
+    status, _, err = run_main(monkeypatch, capsys, "view", path, "--follow", "bal")
+    assert status == 2 and "Did you mean 'ball'" in err
+    status, _, err = run_main(monkeypatch, capsys, "view", path, "--follow", "ball")
+    assert status == 0, err
+    page = (tmp_path / "viewer.html").read_text()
+    assert '"follow":{"body":0' in page

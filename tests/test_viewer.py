@@ -542,3 +542,21 @@ def test_many_points_without_a_size_are_a_star_field(browser, tmp_path):
         assert opened.js("visviva.drawn().count") == 0  # no spheres
     finally:
         opened.page.close()
+
+
+def test_the_page_camera_follows_a_body(browser, tmp_path):
+    builder = vv.SceneBuilder(name="thrown")
+    builder.set_integration(method="symplectic_euler", dt=0.01, duration=1.0)
+    builder.add_body("box", size=(0.2, 0.2, 0.2), density=500.0, name="box", velocity=(3, 4, 0))
+    recording = vv.Simulation(builder.build()).record(until=1.0)
+    opened = Opened(browser, write_viewer(recording, tmp_path / "follow.html", follow="box"))
+    try:
+        assert opened.errors == []
+        frames = opened.js("visviva.frames")
+        opened.js(f"visviva.pause(), visviva.setFrame({frames - 1})")
+        target = opened.js("visviva.view().target")
+        # The box's centre at t = 1 s: x = 3 m, y = 4 − g/2 m (to the recording's frame).
+        assert target == pytest.approx([3.0, 4.0 - 0.5 * 9.81, 0.0], abs=0.1)
+        assert opened.errors == []
+    finally:
+        opened.page.close()

@@ -47,26 +47,28 @@ __all__ = [
 ]
 
 
-def with_view(model: Model, camera: str | None, frame: str | None) -> Model:
-    """``model`` with the view of its videos and viewer replaced (``--camera``, ``--frame``;
-    ``None`` keeps the scene's), both checked before anything runs. A framing given alone
-    replaces the scene's camera."""
+def with_view(
+    model: Model, camera: str | None, frame: str | None, follow: str | None = None
+) -> Model:
+    """``model`` with the view of its videos and viewer replaced (``--camera``, ``--frame``,
+    ``--follow``; ``None`` keeps the scene's), checked before anything runs. A view given
+    replaces the scene's camera and the body it follows."""
     from .model.build import frame_problem
     from .viz.framing import parse_camera
 
     if camera is not None:
         parse_camera(camera)  # a bad one is refused now, not after the run
-    if frame is not None:
-        problem = frame_problem(model, frame)
+    for option, name in (("--frame", frame), ("--follow", follow)):
+        problem = None if name is None else frame_problem(model, name)
         if problem is not None:
-            raise ModelError(f"--frame: {problem}")
-    if camera is None and frame is None:
+            raise ModelError(f"{option}: {problem}")
+    if camera is None and frame is None and follow is None:
         return model
-    kept = model.output_camera if frame is None else None
     return dataclasses.replace(
         model,
-        output_camera=camera if camera is not None else kept,
+        output_camera=camera,
         output_frame=frame if frame is not None else model.output_frame,
+        output_follow=follow,
     )
 
 
@@ -385,6 +387,7 @@ def recording_attrs(model: Model, seconds: float) -> dict[str, Any]:
             "playback_color_by": model.output_color_by,
             "playback_frame": model.output_frame,
             "playback_style": model.output_style,
+            "playback_follow": model.output_follow or "",
             "compiled": False,
         }
         | ({} if model.output_camera is None else {"playback_camera": model.output_camera})

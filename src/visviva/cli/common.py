@@ -28,6 +28,14 @@ CameraOption = Annotated[
         "[fov=DEGREES]\" [m]; default: the run's, else a framing (--frame).",
     ),
 ]
+FollowOption = Annotated[
+    str | None,
+    typer.Option(
+        "--follow",
+        help="A rigid body the camera of the video and the viewer follows (it moves with it); "
+        "default: the run's, else a still camera.",
+    ),
+]
 FrameOption = Annotated[
     str | None,
     typer.Option(

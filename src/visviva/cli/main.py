@@ -22,6 +22,7 @@ if TYPE_CHECKING:
 
 from .common import (
     CameraOption,
+    FollowOption,
     ForceOption,
     FrameOption,
     JsonOption,
@@ -347,6 +348,7 @@ def demo_command(
     ] = False,
     camera: CameraOption = None,
     frame: FrameOption = None,
+    follow: FollowOption = None,
     force: ForceOption = False,
 ) -> None:
     """Run a demonstration and write its recording, summary and figures (no NAME: list them)."""
@@ -369,6 +371,7 @@ def demo_command(
         full=full,
         camera=camera,
         frame=frame,
+        follow=follow,
     )
     print_report(report)
 

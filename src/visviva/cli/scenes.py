@@ -10,6 +10,7 @@ import typer
 
 from .common import (
     CameraOption,
+    FollowOption,
     ForceOption,
     FrameOption,
     app,
@@ -76,13 +77,14 @@ def run_command(
     ] = None,
     camera: CameraOption = None,
     frame: FrameOption = None,
+    follow: FollowOption = None,
     force: ForceOption = False,
 ) -> None:
     """Run a scene: recording.h5, summary.json and the requested outputs into a directory."""
     from ..scenes import dry_run as plan
     from ..scenes import load_model, run_scene, with_view
 
-    model = with_view(load_model(scene), camera, frame)
+    model = with_view(load_model(scene), camera, frame, follow)
     if dry_run:
         estimate = plan(model, duration=duration, formats=formats or ())
         what = _held(model)
@@ -210,6 +212,7 @@ def view_command(
     run: RunOption = None,
     camera: CameraOption = None,
     frame: FrameOption = None,
+    follow: FollowOption = None,
     force: ForceOption = False,
 ) -> None:
     """Write the single-file web viewer of a recording (open it in any browser)."""
@@ -221,7 +224,7 @@ def view_command(
     target = output or recording.with_name("viewer.html")
     check_new_file(target, force=force)
     source = load_recording(recording, run)
-    chosen = playback(source, speed, trail, color_by, camera, frame)
+    chosen = playback(source, speed, trail, color_by, camera, frame, follow)
     written = write_viewer(
         source,
         target,
@@ -231,6 +234,7 @@ def view_command(
         color_by=chosen.color_by,
         camera=chosen.camera,
         frame=chosen.frame,
+        follow=chosen.follow,
     )
     typer.echo(f"wrote {written}; open it in a browser (file://{written.resolve()})")
 
@@ -253,6 +257,7 @@ def export_command(
     run: RunOption = None,
     camera: CameraOption = None,
     frame: FrameOption = None,
+    follow: FollowOption = None,
     force: ForceOption = False,
 ) -> None:
     """Export a recording for Blender/Houdini (USD, glTF, OBJ, PC2) or as a video."""
@@ -279,7 +284,7 @@ def export_command(
     else:
         check_new_file(target, force=force)
     source = load_recording(recording, run)
-    chosen = playback(source, speed, trail, color_by, camera, frame)
+    chosen = playback(source, speed, trail, color_by, camera, frame, follow)
     if video:
         from ..viz.video import render_video
 
@@ -294,6 +299,7 @@ def export_command(
                 color_by=chosen.color_by,
                 camera=chosen.camera,
                 frame=chosen.frame,
+                follow=chosen.follow,
             )
         ]
     else:

@@ -34,6 +34,7 @@ def run_demo(
     full: bool = False,
     camera: str | None = None,
     frame: str | None = None,
+    follow: str | None = None,
 ) -> JobReport:
     """Run demo ``name`` and write its outputs into ``directory``.
 
@@ -51,6 +52,7 @@ def run_demo(
             ``"eye=x,y,z target=x,y,z [up=x,y,z] [fov=degrees]"``; default: a framing.
         frame: Without ``camera``, what the framing keeps in view: ``"all"`` (default) or a
             rigid body's name.
+        follow: A rigid body the camera follows (instead of ``camera``).
 
     Returns:
         The files written and the summary (also in ``summary.json``).
@@ -86,7 +88,9 @@ def run_demo(
     fps = real_number("fps", fps, positive=True, unit=" frames/s")
     if camera is not None:
         parse_camera(camera)  # a bad one is refused before the demo runs
-    view = {"playback_frame": frame or "all"} | ({"playback_camera": camera} if camera else {})
+    view = {"playback_frame": frame or "all", "playback_follow": follow or ""} | (
+        {"playback_camera": camera} if camera else {}
+    )
     with (
         warnings.catch_warnings(record=True) as caught,
         StopOnSignal() as stops,

@@ -107,6 +107,7 @@ def build_model(scene: Scene, source: str | None = None) -> Model:
         output_camera=None if scene.output.camera is None else scene.output.camera.text(),
         output_frame=scene.output.frame,
         output_style=scene.output.style,
+        output_follow=scene.output.follow,
         source=source,
     )
     problems = _check_start(model)
@@ -302,6 +303,9 @@ def _check_start(model: Model) -> list[SceneProblem]:
     framing = frame_problem(model, model.output_frame)
     if framing is not None:
         return [SceneProblem("output.frame", framing)]
+    followed = None if model.output_follow is None else frame_problem(model, model.output_follow)
+    if followed is not None:
+        return [SceneProblem("output.follow", "follow: " + followed.removeprefix("frame "))]
     for name in ("particle_position", "particle_velocity"):
         bad = ~np.isfinite(getattr(model, name))
         if bad.any():

@@ -129,6 +129,7 @@ class Model:
             body's name.
         output_style: How videos and the viewer draw the points: ``"auto"``, ``"day"`` or
             ``"night"``.
+        output_follow: A rigid body the camera follows, or ``None``.
         source: The scene file's text, if it came from a file (kept in recordings).
     """
 
@@ -163,6 +164,7 @@ class Model:
     output_camera: str | None = None
     output_frame: str = "all"
     output_style: str = "auto"
+    output_follow: str | None = None
     source: str | None = field(default=None, repr=False)
 
     @property

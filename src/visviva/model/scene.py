@@ -158,6 +158,9 @@ class Output(Strict):
         description="how videos and the viewer draw the points: auto, day (shaded spheres on "
         "a ground) or night (spots of light on a night sky: fireworks, galaxies)",
     )
+    follow: Name | None = Field(
+        None, description="a rigid body the camera follows, moving with it (instead of camera)"
+    )
     frame: Name = Field(
         "all",
         description="without camera, what the view keeps in the picture for the whole run: "

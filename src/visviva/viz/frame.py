@@ -26,6 +26,7 @@ are drawn between their points in every frame (emitters' particles have none).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -432,9 +433,11 @@ class FramePainter:
         trail: float = 0.0,
         caption: str = "",
         labels: bool = False,
+        follow: Callable[[int], Camera] | None = None,
     ) -> None:
         self.geometry = geometry
         self.labels = labels
+        self.follow = follow  # the camera of each recorded frame, for a camera that moves
         self.caption = caption
         self.width, self.height = size
         look = Appearance.of(geometry)
@@ -446,7 +449,8 @@ class FramePainter:
         )
         low, high = drawn_bounds(geometry)
         scene = max(float(np.linalg.norm(high - low)), 1e-9)
-        stage = _Stage(camera, self.width, self.height, min(0.0, float(low[1])), scene)
+        self.scene, self.ground_y = scene, min(0.0, float(low[1]))
+        stage = _Stage(camera, self.width, self.height, self.ground_y, scene)
         self.stage = stage
         self.layers: list[_Layer] = []
         if geometry.bodies is not None:
@@ -478,6 +482,12 @@ class FramePainter:
             rows = np.linspace(0.0, 1.0, self.height, dtype=np.float32)[:, None, None]
             self.background[:] = top + rows * (bottom - top)
             return
+        self._paint_background()
+        self.shadows = _ShadowMap(stage, low, high, _live_radii(look))
+
+    def _paint_background(self) -> None:
+        """Sky and ground as the stage's camera sees them (once, or every frame it moves)."""
+        stage = self.stage
         ground.paint_background(
             self.background,
             self.background_depth,
@@ -487,12 +497,11 @@ class FramePainter:
             stage.basis,
             stage.focal,
             stage.ground_y,
-            _checker_cell(scene),
-            HAZE_DISTANCE * (stage.distance + scene),
+            _checker_cell(self.scene),
+            HAZE_DISTANCE * (stage.distance + self.scene),
             np.array(ENVIRONMENT),
             BACKGROUND_SAMPLES,
         )
-        self.shadows = _ShadowMap(stage, low, high, _live_radii(look))
 
     def label(self, time: float) -> str:
         """The text in the corner: the time in the unit that reads best for the recording's
@@ -504,6 +513,11 @@ class FramePainter:
 
     def paint(self, index: int, time: float) -> np.ndarray:
         """Image of recorded frame ``index`` labelled with ``time`` [s]: uint8, ``(H, W, 3)``."""
+        if self.follow is not None:
+            camera = self.follow(index)
+            self.stage = _Stage(camera, self.width, self.height, self.ground_y, self.scene)
+            if not self.stars:
+                self._paint_background()
         positions = np.asarray(self.geometry.points[index], dtype=np.float64)
         view = self.stage.to_view(positions)
         look = self.look

@@ -14,6 +14,8 @@ a later ``visviva export`` or ``visviva view`` shows what the run showed.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from .._registry import did_you_mean
@@ -23,7 +25,10 @@ from ..simulation.recording import Geometry
 from .frame import drawn_bounds, is_star_field
 from .video import FIELD_OF_VIEW, Camera
 
-__all__ = ["ALL", "chosen_camera", "framed_bounds", "parse_camera"]
+__all__ = ["ALL", "FOLLOW_ROOM", "chosen_camera", "following", "framed_bounds", "parse_camera"]
+
+#: A followed body's view shows a box this many times the body's size around it.
+FOLLOW_ROOM = 4.0
 
 #: The framing that keeps everything drawn in view.
 ALL = "all"
@@ -103,6 +108,33 @@ def framed_bounds(geometry: Geometry, frame: str = ALL) -> tuple[np.ndarray, np.
     rotation = quaternion_matrix(bodies.orientation[:, b])  # (frames, 3, 3)
     surface = bodies.position[:, b, None] + np.einsum("fij,vj->fvi", rotation, own)
     return surface.min(axis=(0, 1)), surface.max(axis=(0, 1))
+
+
+def following(geometry: Geometry, name: str, aspect: float) -> Callable[[int], Camera]:
+    """The camera of each recorded frame that follows rigid body ``name``: it looks at the
+    body's centre from a fixed offset, the raised three-quarter view of a box
+    :data:`FOLLOW_ROOM` times the body's size (so the body and what is around it show).
+
+    Raises:
+        ModelError: For a name that is not a body's, listing the bodies' names.
+    """
+    framed_bounds(geometry, name)  # refuses a name that is not a body's
+    bodies = geometry.bodies
+    assert bodies is not None
+    b = bodies.names.index(name)
+    own = bodies.vertices[bodies.vertex_start[b] : bodies.vertex_start[b + 1]]
+    rotation = quaternion_matrix(bodies.orientation[:, b])
+    centres = (bodies.position[:, b, None] + np.einsum("fij,vj->fvi", rotation, own)).mean(axis=1)
+    size = max(float(np.max(own.max(axis=0) - own.min(axis=0))), 1e-3)
+    half = np.full(3, 0.5 * FOLLOW_ROOM * size)
+    home = Camera.framing((-half, half), aspect=aspect)
+    offset = np.subtract(home.eye, home.target)
+
+    def camera(index: int) -> Camera:
+        centre = centres[index]
+        return Camera(tuple(centre + offset), tuple(centre), home.up, home.field_of_view)
+
+    return camera
 
 
 def chosen_camera(geometry: Geometry, camera: Camera | None, frame: str, aspect: float) -> Camera:

@@ -63,13 +63,13 @@ def write_output(
         from .video import render_video
 
         render_video(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by,
-                     camera=view.camera, frame=view.frame,
+                     camera=view.camera, frame=view.frame, follow=view.follow,
                      labels=bool(recording.attrs.get("playback_labels", False)))  # fmt: skip
     elif suffix == ".html":
         from .viewer import write_viewer
 
         write_viewer(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by,
-                     camera=view.camera, frame=view.frame)  # fmt: skip
+                     camera=view.camera, frame=view.frame, follow=view.follow)  # fmt: skip
     else:
         from ..io.export import export_recording
 
@@ -87,6 +87,7 @@ class Playback(NamedTuple):
     color_by: str
     camera: Camera | None = None
     frame: str = "all"
+    follow: str | None = None
 
 
 def playback(
@@ -96,6 +97,7 @@ def playback(
     color_by: str | None = None,
     camera: str | None = None,
     frame: str | None = None,
+    follow: str | None = None,
 ) -> Playback:
     """The playback ``speed`` [simulated s per s], ``trail`` [s] and ``color_by`` of an output
     made later from ``recording``: the ones given, else those its run was made with
@@ -104,7 +106,8 @@ def playback(
     ``visviva export REC --to mp4`` plays a year of orbits at the week per second
     ``visviva run -f mp4`` chose, not a year of video. The same for the view: ``camera`` (as
     :func:`~visviva.viz.framing.parse_camera` reads it) and ``frame``, else the recording's
-    ``playback_camera`` and ``playback_frame``, else the framing of everything."""
+    ``playback_camera`` and ``playback_frame``, else the framing of everything; ``follow``
+    (a rigid body's name: a camera that moves with it), else ``playback_follow``."""
     attrs = recording.attrs
     if speed is None:
         speed = float(attrs.get("playback_speed", 1.0))
@@ -112,10 +115,12 @@ def playback(
         trail = float(attrs.get("playback_trail", 0.0))
     if color_by is None:
         color_by = str(attrs.get("playback_color_by", "scene"))
-    if camera is None and frame is None:  # a framing given now replaces the kept camera
+    if camera is None and frame is None and follow is None:  # a view given now replaces it
         camera = attrs.get("playback_camera")
+        follow = attrs.get("playback_follow") or None
     if frame is None:
         frame = str(attrs.get("playback_frame", "all"))
     from .framing import parse_camera
 
-    return Playback(speed, trail, color_by, None if camera is None else parse_camera(camera), frame)
+    chosen = None if camera is None else parse_camera(camera)
+    return Playback(speed, trail, color_by, chosen, frame, follow)

@@ -208,6 +208,7 @@ def render_video(
     color_by: str = "scene",
     frame: str = "all",
     labels: bool = False,
+    follow: str | None = None,
 ) -> Path:
     """Render a recording's geometry to an mp4 or GIF file.
 
@@ -234,6 +235,8 @@ def render_video(
             points and the bodies) or the name of one rigid body (:mod:`visviva.viz.framing`).
         labels: Write each rigid body's name above it, where the lesson depends on telling
             them apart (the ``dzhanibekov`` demo's three handles).
+        follow: The name of a rigid body the camera follows (it moves with the body's centre;
+            :func:`~visviva.viz.framing.following`), instead of ``camera`` and ``frame``.
 
     Returns:
         The path written.
@@ -274,6 +277,8 @@ def render_video(
     width, height = _checked_size(size, even=suffix == ".mp4")
     trail = real_number("trail", trail, nonnegative=True, unit=" s")
     color_by = check_color_mode(color_by)
+    if follow is not None and camera is not None:
+        raise ModelError("`follow` moves the camera with a body; give it or `camera`, not both")
     if camera is not None and not isinstance(camera, Camera):
         raise ModelError(f"`camera` must be a visviva Camera or None (got {describe(camera)})")
     if not isinstance(recording, Recording):
@@ -296,14 +301,16 @@ def render_video(
         )
     shown = frames_at_rate(recording.time, fps, speed=speed)
 
-    from .framing import chosen_camera
+    from .framing import chosen_camera, following
     from .walls import with_walls
 
-    camera = chosen_camera(geometry, camera, frame, width / height)
+    moving = None if follow is None else following(geometry, follow, width / height)
+    camera = chosen_camera(geometry, camera, frame, width / height) if moving is None else moving(0)
     geometry = with_walls(geometry, np.array(camera.eye))
     painter = FramePainter(
-        geometry, (width, height), camera, recording.time, trail, caption, labels=labels
-    )
+        geometry, (width, height), camera, recording.time, trail, caption, labels=labels,
+        follow=moving,
+    )  # fmt: skip
     times = recording.time[shown]
     from ..simulation.progress import Progress
 

@@ -31,7 +31,7 @@ from ...errors import ModelError
 from ...io.files import atomic_path
 from ...io.timeline import check_playback, frames_at_rate
 from ...simulation.recording import Geometry, Recording
-from ..framing import ALL, chosen_camera
+from ..framing import ALL, chosen_camera, following
 from ..speed_colors import check_color_mode, colored_by_speed
 from ..video import MAX_TRAIL_POINTS, Camera
 from ._payload import encode_payload, to_json
@@ -213,6 +213,7 @@ def write_viewer(
     color_by: str = "scene",
     camera: Camera | None = None,
     frame: str = "all",
+    follow: str | None = None,
 ) -> Path:
     """Write ``recording``'s animation as one self-contained HTML file.
 
@@ -240,6 +241,8 @@ def write_viewer(
             default: the framing of ``frame``.
         frame: Without ``camera``, what the first view keeps in the picture over the whole
             run: ``"all"`` or the name of one rigid body (:mod:`visviva.viz.framing`).
+        follow: The name of a rigid body the page's camera follows as it plays (its target
+            moves with the body's centre; orbiting and zooming still work).
 
     Returns:
         The path written.
@@ -288,7 +291,16 @@ def write_viewer(
     )
     if scale is not None:
         payload["legend"].append(["colour", scale.caption()])
-    if camera is not None or frame != ALL:
+    if follow is not None:
+        start = following(geometry, follow, 16 / 9)  # refuses a name that is not a body's
+        payload["view"] = _home_view(start(0))
+        bodies = geometry.bodies
+        assert bodies is not None
+        b = bodies.names.index(follow)
+        own = bodies.vertices[bodies.vertex_start[b] : bodies.vertex_start[b + 1]]
+        # The page moves its target with the body: its index and centre in its own axes.
+        payload["follow"] = {"body": b, "centre": own.mean(axis=0).tolist()}
+    elif camera is not None or frame != ALL:
         payload["view"] = _home_view(chosen_camera(geometry, camera, frame, 16 / 9))
     parts = {
         "title": html.escape(page_title, quote=False),

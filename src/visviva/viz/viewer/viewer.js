@@ -612,6 +612,12 @@
     frame = k;
     loadFrame(k);
     for (const update of updates) update();
+    if (data.follow) { // the camera's target moves with the followed body's centre
+      const body = bodyMeshes[data.follow.body];
+      view.target.fromArray(data.follow.centre).applyQuaternion(body.quaternion)
+        .add(body.position);
+      placeCamera();
+    }
     slider.value = String(k);
     const [unit, seconds, decimals] = data.time_unit;
     timeText.textContent = "t = " + (times[k] / seconds).toFixed(decimals) + " " + unit +
