@@ -560,3 +560,18 @@ def test_the_page_camera_follows_a_body(browser, tmp_path):
         assert opened.errors == []
     finally:
         opened.page.close()
+
+
+def test_a_demo_that_names_its_bodies_names_them_on_the_page(browser, tmp_path):
+    builder = vv.SceneBuilder(name="named")
+    builder.set_world(gravity=(0.0, 0.0, 0.0))
+    for name, x in (("left", -1.0), ("right", 1.0)):
+        builder.add_body("box", size=(0.3, 0.3, 0.3), density=500.0, name=name, position=(x, 0, 0))
+    recording = vv.Simulation(builder.build()).record(until=0.05)
+    recording.attrs["playback_labels"] = True
+    opened = Opened(browser, write_viewer(recording, tmp_path / "named.html"))
+    try:
+        assert opened.errors == []
+        assert opened.js("visviva.nameTags()") == ["left", "right"]
+    finally:
+        opened.page.close()

@@ -335,6 +335,7 @@ def encode_payload(
         "to_scale": geometry.to_scale,
         "bounds": [[float(v) for v in low], [float(v) for v in high]],
         "legend": _legend(attrs, geometry, fps),
+        "labels": bool(attrs.get("playback_labels", False)) and geometry.bodies is not None,
         "layers": layers,
     }
 

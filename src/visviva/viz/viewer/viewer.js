@@ -625,8 +625,32 @@
     needsDraw = true;
   }
 
+  /* The bodies' names over them (data.labels), placed where each body's centre is drawn. */
+  const nameTags = data.labels ? bodyMeshes.map((mesh) => {
+    const tag = document.createElement("div");
+    tag.className = "name-tag";
+    tag.textContent = mesh.name;
+    tag.style.cssText = "position:fixed;pointer-events:none;transform:translate(-50%,-150%);" +
+      "font:13px sans-serif;color:#fff;background:rgba(25,30,38,0.6);padding:1px 5px;" +
+      "border-radius:3px;white-space:nowrap";
+    document.body.appendChild(tag);
+    return tag;
+  }) : [];
+
+  function placeNameTags() {
+    const rect = canvas.getBoundingClientRect();
+    const where = new THREE.Vector3();
+    nameTags.forEach((tag, b) => {
+      where.copy(bodyMeshes[b].position).project(camera);
+      tag.hidden = where.z > 1;
+      tag.style.left = rect.left + (0.5 + 0.5 * where.x) * rect.width + "px";
+      tag.style.top = rect.top + (0.5 - 0.5 * where.y) * rect.height + "px";
+    });
+  }
+
   function draw() {
     renderer.render(scene, camera);
+    placeNameTags();
     needsDraw = false;
   }
 
@@ -736,6 +760,8 @@
     /* The star field as drawn, or null: its number of points and whether light adds up. */
     stars: () => starCloud && ({ count: starCloud.geometry.attributes.position.count,
       additive: starCloud.material.blending === THREE.AdditiveBlending }),
+    /* The bodies' name tags as shown: their texts. */
+    nameTags: () => nameTags.map((tag) => tag.textContent),
     /* The walls as drawn: each mesh's name and opacity. */
     walls: () => wallMeshes.map((mesh) => ({ name: mesh.name, opacity: mesh.material.opacity })),
     /* The orbit camera: its target [m] and distance [m] from it. */
