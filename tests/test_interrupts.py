@@ -290,3 +290,36 @@ def test_a_recording_cut_at_any_frame_exports_to_video_and_gltf(
     path = tmp_path / "cut.h5"
     vv.io.write_recordings(path, {"cut": cut})
     _exports(monkeypatch, capsys, path, "cut", tmp_path)
+
+
+def test_ctrl_c_during_an_implicit_solve_stops_between_newton_iterations(monkeypatch):
+    """A projected-Newton step asked to stop in its third Newton iteration is dropped: the
+    run ends at the last whole step, recorded as its last frame, and can go on from there."""
+    from visviva.integrators import newton
+
+    builder = vv.SceneBuilder(name="sheet")
+    builder.set_integration(method="projected_newton", dt=0.02, duration=1.0)
+    builder.add_cloth((6, 6), origin=(0.0, 1.0, 0.0), along=(0.5, 0.0, 0.0),
+                      across=(0.0, 0.0, 0.5), stiffness=500.0, pinned=[0, 5])  # fmt: skip
+    simulation = vv.Simulation(builder.build())
+
+    class AskedAfter:
+        polls = 0
+
+        def requested(self):
+            self.polls += 1
+            return "SIGINT" if self.polls > 13 else None
+
+    asked = AskedAfter()
+    monkeypatch.setattr(newton, "_stop", asked)
+    with pytest.raises(Interrupted) as caught:
+        simulation.record(until=1.0)
+    iterations = simulation.system.counters.newton_iterations
+    stopped = caught.value
+    steps = round(stopped.t / 0.02)
+    assert steps * 0.02 == pytest.approx(stopped.t)  # a whole step, not a part of one
+    assert iterations == asked.polls - 1 and iterations > 3 * steps  # it stopped mid-solve
+    assert stopped.recording.time[-1] == pytest.approx(stopped.t) == simulation.time
+    monkeypatch.setattr(newton, "_stop", type("Quiet", (), {"requested": lambda self: None})())
+    simulation.run(until=stopped.t + 0.1)  # and goes on from the last whole step
+    assert simulation.time == pytest.approx(stopped.t + 0.1)

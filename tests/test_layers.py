@@ -12,7 +12,17 @@ SOURCE = Path(visviva.__file__).parent
 
 #: The layers, lowest first (docs/architecture.md, "Layers").
 LAYERS = [
-    {"errors", "_validation", "_registry", "_memo", "_lazy", "_version", "_blas", "_compiling"},
+    {
+        "errors",
+        "_validation",
+        "_registry",
+        "_memo",
+        "_lazy",
+        "_version",
+        "_blas",
+        "_compiling",
+        "_stop",
+    },
     {"ode", "geometry"},
     {"integrators", "mechanics"},
     {"analysis"},

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 __all__ = [
+    "Interrupted",
     "ModelError",
     "NewtonConvergenceError",
     "SceneError",
@@ -175,3 +176,19 @@ class NewtonConvergenceError(SimulationError):
         super().__init__(message, t=t, step=step)
         self.iterations = iterations
         self.update_norm = update_norm
+
+
+class Interrupted(VisvivaError):
+    """A run stopped early because the process received SIGINT or SIGTERM (inside a job:
+    :class:`~visviva.simulation.interrupt.StopOnSignal`).
+
+    Attributes:
+        signal: The signal's name, ``"SIGINT"`` or ``"SIGTERM"``.
+        t: Simulation time reached [s] (the last recorded frame).
+        recording: The frames recorded up to ``t`` (set by the loop that stopped).
+    """
+
+    def __init__(self, signal_name: str, t: float) -> None:
+        super().__init__(f"interrupted by {signal_name} at t = {t:.6g} s")
+        self.signal = signal_name
+        self.t = t

@@ -37,8 +37,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .. import _stop
 from .._validation import real_number, whole_number
-from ..errors import NewtonConvergenceError
+from ..errors import Interrupted, NewtonConvergenceError
 
 if TYPE_CHECKING:
     from ..ode.mass import Mass
@@ -91,6 +92,15 @@ class NewtonOptions:
             real_number("atol", self.atol, positive=True)
 
 
+def stop_if_asked(t: float) -> None:
+    """Between Newton iterations: raise :class:`~visviva.errors.Interrupted` if the job was
+    asked to stop (Ctrl-C), so that a long solve answers within an iteration; the simulation
+    loop drops the half-done step and keeps the last whole one."""
+    name = _stop.requested()
+    if name is not None:
+        raise Interrupted(name, t)
+
+
 def solve_stage(
     system: System,
     t_star: float,
@@ -123,6 +133,7 @@ def _solve_first_order(
     matrix_free = _matrix_free(system, y)
     iteration, norm = 0, np.inf
     while iteration < options.max_iterations:
+        stop_if_asked(t)
         iteration += 1
         rate = system.rhs(t, y)
         residual = y - y_base - theta_h * rate
@@ -158,6 +169,7 @@ def _solve_second_order(
     last: tuple[np.ndarray, np.ndarray, float] | None = None
     iteration, norm = 0, np.inf
     while iteration < options.max_iterations:
+        stop_if_asked(t)
         iteration += 1
         q, force, residual = _stage_residual(system, t, q_base, v_base, v, theta_h)
         if last is not None and v.ndim == 1:

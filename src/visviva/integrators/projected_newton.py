@@ -65,7 +65,7 @@ from .bsr import block_product
 from .contact_set import hold_contacts
 from .friction import LaggedFriction
 from .implicit import BackwardEuler, Trapezoidal
-from .newton import NewtonOptions
+from .newton import NewtonOptions, stop_if_asked
 from .newton_solve import BlockNewtonSolve, same_blocks
 
 if TYPE_CHECKING:
@@ -229,6 +229,7 @@ class ProjectedNewton(BlockNewtonSolve, BackwardEuler):
         held = None  # the dampers' matrix D, held from the first iterate when there is Φ
         rest = np.zeros_like(v)
         while iteration < newton.max_iterations:
+            stop_if_asked(t)
             iteration += 1
             counters.newton_iterations += 1
             q = q_base + h * v

@@ -21,37 +21,23 @@ from collections.abc import Iterator
 from types import FrameType, TracebackType
 from typing import Any
 
-from ..errors import VisvivaError
+from .. import _stop
+from ..errors import Interrupted
 
 __all__ = ["Interrupted", "StopOnSignal", "exit_status", "stop_requested"]
 
 #: The signals that ask a run to stop.
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
-# The signal that asked the current run to stop, or None; set only inside a StopOnSignal.
-_requested: int | None = None
+# The signal that asked the current run to stop lives in visviva._stop (set only inside a
+# StopOnSignal), where the implicit solves poll it too.
 # True while a loop polls stop_requested(): a first signal then waits for it.
 _polled = False
 
 
-class Interrupted(VisvivaError):
-    """A run stopped early because the process received SIGINT or SIGTERM.
-
-    Attributes:
-        signal: The signal's name, ``"SIGINT"`` or ``"SIGTERM"``.
-        t: Simulation time reached [s] (the last recorded frame).
-        recording: The frames recorded up to ``t`` (set by the loop that stopped).
-    """
-
-    def __init__(self, signal_name: str, t: float) -> None:
-        super().__init__(f"interrupted by {signal_name} at t = {t:.6g} s")
-        self.signal = signal_name
-        self.t = t
-
-
 def stop_requested() -> str | None:
     """Name of the signal that asked the run to stop (``"SIGINT"``), or ``None``."""
-    return None if _requested is None else signal.Signals(_requested).name
+    return _stop.requested()
 
 
 def exit_status(signal_name: str) -> int:
@@ -77,8 +63,7 @@ class StopOnSignal:
         self._previous: dict[int, Any] = {}
 
     def __enter__(self) -> StopOnSignal:
-        global _requested
-        _requested = None
+        _stop.record(None)
         if threading.current_thread() is threading.main_thread():
             for number in STOP_SIGNALS:
                 self._previous[number] = signal.signal(number, self._handle)
@@ -100,9 +85,8 @@ class StopOnSignal:
         return stop_requested()
 
     def _handle(self, number: int, frame: FrameType | None) -> None:
-        global _requested
-        first = _requested is None
-        _requested = number
+        first = _stop.requested() is None
+        _stop.record(number)
         if not (first and _polled):
             raise KeyboardInterrupt
 
@@ -112,8 +96,7 @@ class StopOnSignal:
         error: BaseException | None,
         trace: TracebackType | None,
     ) -> None:
-        global _requested
         for number, handler in self._previous.items():
             signal.signal(number, handler)
         self._previous.clear()
-        _requested = None
+        _stop.record(None)

@@ -304,6 +304,13 @@ def advance(
         except SimulationError as failure:
             failure.state, failure.steps_done = stepper.earlier(done, sub + 1), step
             raise
+        except Interrupted as asked:  # by a solve between its iterations: drop the half step
+            settled = stepper.settled(done)
+            if recorder is not None and recorder.last().t != settled.t:
+                recorder.append(settled)  # the last whole step is the last frame
+            cut = Interrupted(asked.signal, settled.t)
+            cut.state, cut.steps_done = settled, step
+            raise cut from None
         done = current
         last = step + 1 == schedule.steps
         stop = stop_requested()
