@@ -239,9 +239,23 @@ def test_cli_validate_schema_dry_run_and_plot(tmp_path):
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
 def test_example_scenes_run_to_the_end(tmp_path, path):
     """Every example scene at its full length (``pytest -m slow``; the star cluster's 20,000
-    stars take half a minute): it completes, its energy stays within its tolerance, and the
-    summary counts what it holds."""
+    stars take half a minute): it completes, its energy stays within its tolerance, the
+    summary counts what it holds, and its video's view keeps everything in the picture."""
     report = vv.run_scene(vv.load_model(path), tmp_path)
     summary = report.summary
     assert summary["complete"] and summary["success"] and summary["counts"]
     assert not [w for w in summary["warnings"] if w["kind"] == "energy_drift"], summary
+    # And the video's view keeps every body and particle in the picture over the whole run
+    # (a star field is framed on 98 % of its stars, by design: its stragglers may leave).
+    from test_framing import drawn_points, in_picture
+    from visviva.viz.frame import is_star_field
+    from visviva.viz.framing import chosen_camera
+    from visviva.viz.outputs import playback
+
+    recording = vv.io.load_recording(tmp_path / "recording.h5")
+    geometry = recording.geometry()
+    if geometry.points.shape[1] or geometry.bodies is not None:
+        view = playback(recording, None, None)
+        camera = chosen_camera(geometry, view.camera, view.frame, 960 / 540)
+        inside = in_picture(camera, drawn_points(recording), 960 / 540)
+        assert is_star_field(geometry) or inside.all(), f"{(~inside).sum()} points leave"
