@@ -185,3 +185,12 @@ def test_a_followed_body_stays_at_the_centre_of_a_moving_view(tmp_path, monkeypa
     assert status == 0, err
     page = (tmp_path / "viewer.html").read_text()
     assert '"follow":{"body":0' in page
+
+
+def test_labels_travel_with_the_recording_to_later_exports():
+    # `visviva export --to mp4` of a demo that names its bodies names them too: the
+    # recording's playback_labels reaches the video through playback().
+    recording = vv.Recording(np.arange(2.0), {"particle_position": np.zeros((2, 1, 3))})
+    assert not playback(recording, None, None).labels
+    recording.attrs["playback_labels"] = True
+    assert playback(recording, None, None).labels

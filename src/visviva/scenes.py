@@ -133,10 +133,11 @@ def dry_run(model: Model, *, duration: float | None = None, formats: Iterable[st
     seconds = _duration(model, duration)
     settings = model.integration
     steps = math.ceil(seconds / settings.dt - 1e-9)
-    try:
-        limit = largest_stable_step(model.system(), get(settings.method), model.initial_state())
-    except ModelError:  # not linearizable as q'' = F(q, v): rigid bodies' quaternions
-        limit = None
+    limit = (
+        None  # the advisor linearizes q'' = F(q, v); bodies' quaternions do not fit it
+        if model.body_count
+        else largest_stable_step(model.system(), get(settings.method), model.initial_state())
+    )
     return DryRun(
         particles=model.particle_count,
         systems=tuple(s.system for s in model.systems),

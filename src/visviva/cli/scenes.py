@@ -300,6 +300,7 @@ def export_command(
                 camera=chosen.camera,
                 frame=chosen.frame,
                 follow=chosen.follow,
+                labels=chosen.labels,
             )
         ]
     else:

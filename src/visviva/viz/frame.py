@@ -412,7 +412,7 @@ class _StarField:
         # Fewer points shine brighter (a fireworks shell of a few hundred sparks), up to 4×.
         gain = STAR_GAIN * float(np.clip(np.sqrt(2000 / max(order.size, 1)), 1.0, 4.0))
         raster.splat_points(self.light, frame.screen, order, frame.colour, gain)
-        raster.expose(self.light, color.copy(), color)
+        raster.expose(self.light, color)
 
 
 class FramePainter:

@@ -64,7 +64,7 @@ def write_output(
 
         render_video(recording, path, fps=fps, speed=speed, trail=trail, color_by=color_by,
                      camera=view.camera, frame=view.frame, follow=view.follow,
-                     labels=bool(recording.attrs.get("playback_labels", False)))  # fmt: skip
+                     labels=view.labels)  # fmt: skip
     elif suffix == ".html":
         from .viewer import write_viewer
 
@@ -80,7 +80,8 @@ def write_output(
 class Playback(NamedTuple):
     """How an output plays a recording: simulated seconds per second, the trail behind each
     point [s], what colours the points (``"scene"`` or ``"speed"``), the camera (``None``: a
-    framing) and what the framing keeps in view (``"all"`` or a body's name)."""
+    framing), what the framing keeps in view (``"all"`` or a body's name), the body the camera
+    follows (``None``: it stays put) and whether the video names the bodies."""
 
     speed: float
     trail: float
@@ -88,6 +89,7 @@ class Playback(NamedTuple):
     camera: Camera | None = None
     frame: str = "all"
     follow: str | None = None
+    labels: bool = False
 
 
 def playback(
@@ -107,7 +109,8 @@ def playback(
     ``visviva run -f mp4`` chose, not a year of video. The same for the view: ``camera`` (as
     :func:`~visviva.viz.framing.parse_camera` reads it) and ``frame``, else the recording's
     ``playback_camera`` and ``playback_frame``, else the framing of everything; ``follow``
-    (a rigid body's name: a camera that moves with it), else ``playback_follow``."""
+    (a rigid body's name: a camera that moves with it), else ``playback_follow``; whether the
+    video names the bodies, ``playback_labels``."""
     attrs = recording.attrs
     if speed is None:
         speed = float(attrs.get("playback_speed", 1.0))
@@ -123,4 +126,5 @@ def playback(
     from .framing import parse_camera
 
     chosen = None if camera is None else parse_camera(camera)
-    return Playback(speed, trail, color_by, chosen, frame, follow)
+    labels = bool(attrs.get("playback_labels", False))
+    return Playback(speed, trail, color_by, chosen, frame, follow, labels)

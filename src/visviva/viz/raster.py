@@ -343,14 +343,14 @@ def splat_points(
 
 
 @njit(cache=True)
-def expose(light: np.ndarray, background: np.ndarray, color: np.ndarray) -> None:
-    """``color = background + (1 − background)·(1 − exp(−light))``: light added to a dark
+def expose(light: np.ndarray, color: np.ndarray) -> None:
+    """``color ← color + (1 − color)·(1 − exp(−light))``, in place: light added to a dark
     background as film takes it, saturating smoothly where many points overlap."""
     height, width = light.shape[0], light.shape[1]
     for i in range(height):
         for j in range(width):
             for channel in range(3):
-                base = background[i, j, channel]
+                base = color[i, j, channel]
                 color[i, j, channel] = base + (1.0 - base) * (1.0 - math.exp(-light[i, j, channel]))
 
 
