@@ -16,7 +16,17 @@ def _wait_until_done(lines: list[str], timeout: float = 30.0) -> None:
         time.sleep(0.05)
 
 
+def _quiet() -> None:
+    """Wait until a burst of compilations (another test's) has ended: a new one starts here."""
+    deadline = time.monotonic() + 60.0
+    while _compiling._WATCH.ticker is not None:
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+
+
 def test_a_compilation_is_announced_counted_and_logged(caplog):
+    _compiling.watch_compiles()
+    _quiet()
     lines: list[str] = []
     transient: list[str] = []
     _compiling.watch_compiles()
@@ -46,6 +56,7 @@ def test_a_compilation_is_announced_counted_and_logged(caplog):
 
 def test_without_a_writer_the_python_api_only_logs(caplog):
     _compiling.watch_compiles()
+    _quiet()
     _compiling.tell(None)  # a script: nothing on the terminal, INFO lines on "visviva"
     with caplog.at_level(logging.INFO, logger="visviva"):
 

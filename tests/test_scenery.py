@@ -353,3 +353,15 @@ def test_the_colliders_cast_shadows_on_the_ground(recording, tmp_path):
     darker = images[1].mean(axis=2) - images[0].mean(axis=2) > 20.0  # of 255
     greyish = np.ptp(images[0], axis=2) < 25.0
     assert (darker & greyish & ~drawn).sum() > 300
+
+
+def test_a_surface_without_triangles_packs_beside_the_others():
+    # A degenerate body (sizes near 1e12 m, found by the hostile-number test) tessellated to no
+    # triangles, given as shape (0,): it used to stop the recording with a ValueError.
+    from visviva.geometry.packing import packed_surfaces
+
+    square = np.zeros((4, 3)), np.array([[0, 1, 2], [0, 2, 3]])
+    empty = np.zeros((2, 3)), np.array([], dtype=np.int64)
+    packed = packed_surfaces([square, empty, square], "body")
+    assert packed["body_triangles"].tolist() == [[0, 1, 2], [0, 2, 3], [6, 7, 8], [6, 8, 9]]
+    assert packed["body_triangle_start"].tolist() == [0, 2, 2, 4]

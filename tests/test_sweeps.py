@@ -603,3 +603,14 @@ def test_hostile_sweep_files_are_refused_without_a_traceback(document, text):
                 expand(sweep)
         except ModelError as error:
             assert str(error).strip()
+
+
+def test_one_path_inside_another_is_refused_naming_both(tmp_path):
+    # Found by the hostile-file test: "integration" swept with values replacing the whole
+    # table, and "integration.dt" inside it, used to end in a TypeError.
+    text = spring_sweep(
+        '[[parameters]]\npath = "integration"\nvalues = [false]\n'
+        '[[parameters]]\npath = "integration.dt"\nvalues = [0.01]\n'
+    )
+    with pytest.raises(SweepError, match=r"'integration' and 'integration\.dt' overlap"):
+        load_sweep(write(tmp_path, text))

@@ -27,8 +27,12 @@ def packed_surfaces(
     triangle_start = np.cumsum([0] + [t.shape[0] for _, t in surfaces], dtype=np.int64)
     return {
         f"{prefix}_vertices": np.concatenate([v for v, _ in surfaces]).astype(np.float64),
+        # reshape: a surface without triangles (a degenerate one) may come as shape (0,).
         f"{prefix}_triangles": np.concatenate(
-            [t + first for (_, t), first in zip(surfaces, vertex_start, strict=False)]
+            [
+                np.reshape(t, (-1, 3)) + first
+                for (_, t), first in zip(surfaces, vertex_start, strict=False)
+            ]
         ).astype(np.int64),
         f"{prefix}_vertex_start": vertex_start,
         f"{prefix}_triangle_start": triangle_start,

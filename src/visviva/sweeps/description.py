@@ -190,6 +190,15 @@ class SweepFile(Strict):
             path = parameter.path.replace(" ", "")
             if path in seen:
                 raise ValueError(f"the path {parameter.path!r} is swept twice; give it once")
+            # One path inside another ("integration" and "integration.dt"): the outer one's
+            # values replace the table the inner one would set a field of.
+            for other in seen:
+                outer, inner = sorted((path, other), key=len)
+                if inner.startswith(outer) and inner[len(outer)] in ".[":
+                    raise ValueError(
+                        f"the paths {outer!r} and {inner!r} overlap: {outer!r} replaces what "
+                        f"{inner!r} sets; sweep one of them"
+                    )
             seen.add(path)
         return self
 
